@@ -1,0 +1,435 @@
+"""The pipeline: mesh + parameters -> :class:`Design` (the one orchestrator).
+
+Stages: clean the mesh, round the edges, classify the vertices and find their normals, find the
+developed and spatial apices, build the vertex modules (creases, cones, cylinders, face pieces),
+lay them out, and derive the crease pattern.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ParameterError
+from .layout import shelf_layout
+from .mesh import load_mesh
+from .mesh.polymesh import PolyMesh
+from .module import Piece, build_module, face_piece_centres
+from .pattern import CreasePattern
+from .rounding import EdgeRounding, round_edges
+from .tolerances import tol
+from .vertex.apex import build_constraints, solve_apex, validate_apex
+from .vertex.frame import VertexFrame, vertex_frame
+from .vertex.normal import is_developable, solid_angle_front, vertex_normal
+
+log = logging.getLogger(__name__)
+
+DEFAULT_RADIUS = "10%"
+DEFAULT_DEPTH = "30%"
+DEFAULT_SAMPLES = 24
+
+STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
+
+
+def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:
+    """Absolute length(s) from a number, a ``"12%"`` string (of ``reference``) or an array.
+
+    Parameters
+    ----------
+    value : float, str or array_like
+    reference : float
+        The length that 100% stands for (the mean edge length).
+    name : str
+        Parameter name, for error messages.
+    count : int, optional
+        Expected length of a per-element array.
+
+    Returns
+    -------
+    float or (count,) float array
+    """
+    if isinstance(value, str):
+        text = value.strip()
+        try:
+            if text.endswith("%"):
+                out = float(text[:-1]) / 100.0 * reference
+            else:
+                out = float(text)
+        except ValueError:
+            raise ParameterError(
+                f"{name} must be a number or a percentage like '10%', got {value!r}", name=name
+            ) from None
+    else:
+        out = np.asarray(value, dtype=float)
+        if out.ndim == 0:
+            out = float(out)
+        elif count is not None and out.shape != (count,):
+            raise ParameterError(
+                f"per-element {name} must have shape ({count},), got {out.shape}", name=name
+            )
+    arr = np.atleast_1d(out)
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"{name} must be finite, got {value!r}", name=name)
+    if np.any(arr <= 0):
+        raise ParameterError(f"{name} must be positive, got {value!r}", name=name)
+    return out
+
+
+@dataclass
+class Parameters:
+    """The parameters of a design, as given and as resolved to absolute lengths.
+
+    Attributes
+    ----------
+    radius, depth : float, str or array
+        As given (absolute, ``"N%"`` of the mean edge length, or per edge / per vertex).
+    samples : int
+        Points per cylinder arc.
+    coplanar_deg : float
+        Neighbouring faces closer than this angle are merged on input.
+    """
+
+    radius: object = DEFAULT_RADIUS
+    depth: object = DEFAULT_DEPTH
+    samples: int = DEFAULT_SAMPLES
+    coplanar_deg: float = tol.coplanar_deg
+
+    def as_dict(self) -> dict:
+        def plain(x):
+            return np.asarray(x).tolist() if not isinstance(x, str | int | float) else x
+
+        return {
+            "radius": plain(self.radius),
+            "depth": plain(self.depth),
+            "samples": self.samples,
+            "coplanar_deg": self.coplanar_deg,
+        }
+
+
+@dataclass
+class VertexResult:
+    """Per-vertex results, arrays over all mesh vertices.
+
+    Attributes
+    ----------
+    kind : list of str
+        ``"cone"``, ``"saddle"``, ``"developable"`` or ``"boundary"``.
+    status : list of str
+        ``"ok"``, ``"saddle"``, ``"infeasible"``, ``"boundary"`` or ``"developable"``.
+    reason : list of str or None
+    angle_sum, defect, solid_angle : (n,) float
+    normal : (n, 3) float
+        Vertex normal ``D`` (NaN at boundary vertices).
+    normal_bound : (n,) float
+        The max-min value ``b`` of sec. 3.1.
+    sigma : (n,) int
+    depth_requested, depth : (n,) float
+        ``d`` asked for and ``(V - U) . D`` actually used (NaN without apex).
+    apex : (n, 3) float
+        Spatial apex V (NaN without cone).
+    apex_developed : (n, 2) float
+        Developed apex in the vertex's own frame (NaN where undefined).
+    apex_2d : (n, 2) float
+        Apex position in the crease pattern layout.
+    margin : (n,) float
+        Smallest slack of the dense validation (length units).
+    """
+
+    kind: list
+    status: list
+    reason: list
+    angle_sum: np.ndarray
+    defect: np.ndarray
+    solid_angle: np.ndarray
+    normal: np.ndarray
+    normal_bound: np.ndarray
+    sigma: np.ndarray
+    depth_requested: np.ndarray
+    depth: np.ndarray
+    apex: np.ndarray
+    apex_developed: np.ndarray
+    apex_2d: np.ndarray
+    margin: np.ndarray
+
+    @classmethod
+    def empty(cls, n: int) -> VertexResult:
+        nan = np.full(n, np.nan)
+        return cls(
+            kind=[""] * n, status=[""] * n, reason=[None] * n, angle_sum=nan.copy(),
+            defect=nan.copy(), solid_angle=nan.copy(), normal=np.full((n, 3), np.nan),
+            normal_bound=nan.copy(), sigma=np.zeros(n, dtype=np.int64),
+            depth_requested=nan.copy(), depth=nan.copy(), apex=np.full((n, 3), np.nan),
+            apex_developed=np.full((n, 2), np.nan), apex_2d=np.full((n, 2), np.nan),
+            margin=nan.copy(),
+        )
+
+
+@dataclass
+class Design:
+    """A curved-crease design: the cleaned mesh, its rounding, vertex results and pattern.
+
+    Attributes
+    ----------
+    mesh : PolyMesh
+    params : Parameters
+    rounding : EdgeRounding
+    vertices : VertexResult
+    pattern : CreasePattern
+    pieces : list of Piece
+    timings : dict of str to float
+        Seconds per stage.
+    source : str
+        What the mesh came from (path or example name).
+    """
+
+    mesh: PolyMesh
+    params: Parameters
+    rounding: EdgeRounding
+    vertices: VertexResult
+    pattern: CreasePattern
+    pieces: list
+    timings: dict = field(default_factory=dict)
+    source: str = ""
+
+    @property
+    def vertex_status(self) -> list:
+        """Status of every mesh vertex (see :data:`STATUSES`)."""
+        return self.vertices.status
+
+    def status_counts(self) -> dict:
+        """Number of vertices per status, in :data:`STATUSES` order."""
+        return {s: self.vertices.status.count(s) for s in STATUSES}
+
+    def report(self) -> dict:
+        """The content of ``report.json``."""
+        from .reporting import design_report
+
+        return design_report(self)
+
+    def summary(self) -> str:
+        """A short plain-text summary."""
+        from .reporting import design_summary
+
+        return design_summary(self)
+
+    def export(self, folder, *, title: str | None = None) -> list[Path]:
+        """Write ``design.fold``, ``report.json``, ``folded.obj`` and ``pattern.svg`` atomically.
+
+        Returns
+        -------
+        list of Path
+            The files written.
+        """
+        from .reporting import export_design
+
+        return export_design(self, folder, title=title)
+
+
+def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
+    if isinstance(depth, dict):
+        base = parse_length(depth.get("default", DEFAULT_DEPTH), reference, "depth")
+        out = np.full(n, float(base))
+        for k, val in depth.items():
+            if k == "default":
+                continue
+            if not (0 <= int(k) < n):
+                raise ParameterError(f"depth given for vertex {k}, which does not exist",
+                                     name="depth")
+            out[int(k)] = float(parse_length(val, reference, "depth"))
+        return out
+    d = parse_length(depth, reference, "depth", count=n)
+    return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
+
+
+def solve_vertex(mesh: PolyMesh, rounding: EdgeRounding, u: int, depth: float,
+                 res: VertexResult) -> tuple[VertexFrame, np.ndarray | None, np.ndarray | None]:
+    """Classify vertex ``u``, find its normal and apices; fill ``res`` at ``u``.
+
+    Returns
+    -------
+    frame : VertexFrame
+    apex : (3,) float or None
+        Spatial apex when the vertex gets a cone.
+    dev_apex : (2,) float or None
+    """
+    frame = vertex_frame(mesh, rounding, u)
+    ring = frame.ring
+    res.angle_sum[u] = mesh.vertex_angle_sum[u]
+    res.defect[u] = 2 * np.pi - res.angle_sum[u]
+    res.depth_requested[u] = depth
+    if not ring.closed:
+        res.kind[u] = res.status[u] = "boundary"
+        res.reason[u] = "boundary vertex: no cone; its module ends at the sheet's edge"
+        return frame, None, None
+    kappa = rounding.kappa[ring.edges]
+    res.solid_angle[u] = solid_angle_front(kappa, rounding.half_angle[ring.edges])
+    edge_dirs = np.array([s.R for s in frame.sides])
+    D, b, sigma = vertex_normal(edge_dirs, mesh.face_normal[ring.faces])
+    res.normal[u], res.normal_bound[u], res.sigma[u] = D, b, sigma
+    if is_developable(res.angle_sum[u]):
+        res.kind[u] = res.status[u] = "developable"
+        res.reason[u] = ("developable vertex (angle sum 2 pi): its development closes; it needs "
+                         "consistent material loss (not solved here)")
+        return frame, None, None
+    if b <= tol.normal_bound:
+        res.kind[u] = res.status[u] = "saddle"
+        res.reason[u] = (f"saddle vertex: no plane through it has all its faces on one side "
+                         f"(max-min bound {b:.3g} <= 0); no cone possible")
+        return frame, None, None
+    res.kind[u] = "cone"
+    v = frame.developed_apex()
+    if v is None:
+        res.status[u] = "infeasible"
+        res.reason[u] = "the development does not turn (rho is a translation): no developed apex"
+        return frame, None, None
+    res.apex_developed[u] = v
+    U = frame.U
+    lengths = np.array([s.length for s in frame.sides])
+    target = U + depth * D
+    starts = [U + t * lengths.mean() * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
+    margin = tol.margin * lengths.min()
+    low = np.fmin(frame.lmax_start, frame.lmax_end).min()
+    if not low > 0:
+        res.status[u] = "infeasible"
+        res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
+        return frame, None, None
+    failing = []
+    for n_samples, scale in ((9, 1.0), (33, 2.0), (65, 4.0)):
+        m = min(margin * scale, 0.25 * low)
+        cons = build_constraints(frame, v, sigma, n_samples, m)
+        sol = solve_apex(cons, target, starts)
+        if not sol.ok:
+            failing = sol.failing
+            break
+        check = validate_apex(frame, sol.apex, v, sigma)
+        if check.ok:
+            res.status[u] = "ok"
+            res.apex[u] = sol.apex
+            res.depth[u] = float((sol.apex - U) @ D)
+            res.margin[u] = check.margin
+            return frame, sol.apex, v
+        failing = check.failing
+    res.status[u] = "infeasible"
+    res.reason[u] = "no apex meets every constraint: " + "; ".join(failing[:6])
+    if len(failing) > 6:
+        res.reason[u] += f"; and {len(failing) - 6} more"
+    return frame, None, None
+
+
+def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np.ndarray]:
+    """Lay pieces out side by side and merge them into one crease pattern.
+
+    Returns
+    -------
+    pattern : CreasePattern
+    offsets : (n_pieces, 2) float
+        Translation applied to each piece.
+    """
+    boxes = []
+    arrays = [p.arrays() for p in pieces]
+    for p2, _ in arrays:
+        boxes.append([*p2.min(axis=0), *p2.max(axis=0)])
+    offsets = shelf_layout(np.array(boxes), gap)
+    v2, v3, faces, patches, face_piece = [], [], [], [], []
+    base = 0
+    for k, (piece, (p2, p3)) in enumerate(zip(pieces, arrays, strict=True)):
+        v2.append(p2 + offsets[k])
+        v3.append(p3)
+        for f, patch in zip(piece.faces, piece.patches, strict=True):
+            faces.append(np.asarray(f, dtype=np.int64) + base)
+            patches.append(patch)
+            face_piece.append(k)
+        base += len(p2)
+    pattern = CreasePattern(
+        vertices_2d=np.vstack(v2) if v2 else np.zeros((0, 2)),
+        vertices_3d=np.vstack(v3) if v3 else np.zeros((0, 3)),
+        faces=faces,
+        face_patch=patches,
+        face_piece=np.array(face_piece, dtype=np.int64),
+        piece_vertex=np.array([p.vertex for p in pieces], dtype=np.int64),
+    )
+    return pattern, offsets
+
+
+def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int = DEFAULT_SAMPLES,
+               coplanar_deg: float = tol.coplanar_deg, progress=None) -> Design:
+    """Turn a polyhedral mesh into its curved-crease rounded design.
+
+    Parameters
+    ----------
+    mesh : PolyMesh, str, Path or (vertices, faces)
+        A mesh, a file path (OBJ, OFF, PLY, STL, glTF), a built-in example name, or arrays.
+    radius : float, str or (n_edges,) float
+        Rounding radius: absolute, ``"10%"`` of the mean edge length, or per edge (in the order
+        of the cleaned mesh's ``edges``).
+    depth : float, str, (n_vertices,) float or dict
+        Apex depth ``d`` along the vertex normal (``P = U + d D``): absolute, a percentage of the
+        mean edge length, per vertex, or ``{"default": ..., vertex: value}``.
+    samples : int
+        Points per cylinder arc (>= 3).
+    coplanar_deg : float
+        Merge neighbouring faces whose normals differ by less than this (degrees).
+    progress : callable, optional
+        ``progress(stage, done, total)`` called during long stages.
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    MeshError
+        Unreadable or invalid mesh.
+    ParameterError
+        Invalid radius, depth or samples (a radius over an edge's limit names the edge).
+    """
+    timings = {}
+    t0 = time.perf_counter()
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
+        raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
+    if not (np.isfinite(coplanar_deg) and 0 <= coplanar_deg < 90):
+        raise ParameterError(
+            f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
+            name="coplanar_deg",
+        )
+    source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
+    pm, _ = load_mesh(mesh, coplanar_deg=coplanar_deg)
+    timings["read"] = time.perf_counter() - t0
+    params = Parameters(radius=radius, depth=depth, samples=int(samples),
+                        coplanar_deg=coplanar_deg)
+    ref = pm.mean_edge_length
+
+    t = time.perf_counter()
+    r = parse_length(radius, ref, "radius", count=pm.n_edges)
+    rounding = round_edges(pm, r)
+    timings["rounding"] = time.perf_counter() - t
+    depths = _resolve_depth(depth, ref, pm.n_vertices)
+    centres = face_piece_centres(pm, rounding)
+
+    t = time.perf_counter()
+    res = VertexResult.empty(pm.n_vertices)
+    solved = []
+    for u in range(pm.n_vertices):
+        solved.append(solve_vertex(pm, rounding, u, float(depths[u]), res))
+        if progress is not None:
+            progress("apices", u + 1, pm.n_vertices)
+    timings["apices"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    pieces = []
+    for u, (frame, apex, v) in enumerate(solved):
+        pieces.extend(build_module(pm, frame, centres, int(samples), apex, v))
+        if progress is not None:
+            progress("surface", u + 1, pm.n_vertices)
+    pattern, offsets = assemble_pattern(pieces, gap=0.1 * ref)
+    for k, piece in enumerate(pieces):
+        if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):
+            res.apex_2d[piece.vertex] = np.asarray(piece.points_2d[piece.apex_index]) + offsets[k]
+    timings["surface"] = time.perf_counter() - t
+    timings["total"] = time.perf_counter() - t0
+    return Design(mesh=pm, params=params, rounding=rounding, vertices=res, pattern=pattern,
+                  pieces=pieces, timings=timings, source=source)

@@ -1,0 +1,209 @@
+"""SVG drawing of the flat crease pattern, to print, cut, or load into Origami Simulator.
+
+Each edge is a ``<line>`` carrying its own ``stroke`` colour, in one group per assignment:
+mountain ``#ff0000``, valley ``#0000ff``, border/cut ``#000000`` (the colours Origami Simulator
+reads) and, optionally, flat ``#dddddd``. The y axis is flipped so the drawing is not mirrored.
+The scale bar and legend below the drawing are filled shapes without stroke and text, in a
+separate ``annotation`` group, so stroke-colour readers (Origami Simulator, laser software)
+ignore them.
+"""
+
+from __future__ import annotations
+
+import math
+from xml.sax.saxutils import escape
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..pattern import CreasePattern
+from .fold import validate_pattern
+
+__all__ = ["ASSIGNMENT_COLOR", "MM_PER_UNIT", "nice_length", "pattern_svg"]
+
+#: Stroke colour of each edge assignment.
+ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
+#: Group id and legend label of each edge assignment, in drawing order (bottom first).
+_GROUPS = (
+    ("F", "flat", "flat"),
+    ("B", "border", "cut"),
+    ("V", "valley", "valley"),
+    ("M", "mountain", "mountain"),
+)
+#: Millimetres per pattern length unit, for the units :func:`pattern_svg` accepts.
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "pt": 25.4 / 72.0}
+#: Printed size (mm) of the larger side of the drawing when no unit is given.
+_UNITLESS_MM = 200.0
+_MARGIN_MM = 10.0
+_FONT_MM = 3.5
+_SWATCH_MM = 8.0
+
+
+def nice_length(target: float) -> float:
+    """The round length ``{1, 2, 5} * 10**k`` closest to ``target`` on a log scale.
+
+    Parameters
+    ----------
+    target : float
+        Positive length.
+
+    Returns
+    -------
+    float
+    """
+    if not (target > 0 and math.isfinite(target)):
+        raise ParameterError(f"scale bar length must be positive, got {target}", name="target")
+    k = math.floor(math.log10(target))
+    candidates = [m * 10.0**e for e in (k - 1, k, k + 1) for m in (1, 2, 5)]
+    return min(candidates, key=lambda c: abs(math.log(c / target)))
+
+
+def _formatter(decimals: int):
+    """A deterministic number formatter with ``decimals`` fixed decimals, zeros stripped."""
+
+    def fmt(x: float) -> str:
+        s = f"{x:.{decimals}f}"
+        if "." in s:
+            s = s.rstrip("0").rstrip(".")
+        return "0" if s in ("-0", "") else s
+
+    return fmt
+
+
+def pattern_svg(
+    pattern: CreasePattern,
+    *,
+    units: str = "",
+    stroke_mm: float = 0.3,
+    flat_edges: bool = False,
+    angle_opacity: bool = False,
+) -> str:
+    """The flat layout of a crease pattern as an SVG document.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Checked with :func:`~filletfold.export.fold.validate_pattern`.
+    units : str
+        Length unit of the pattern coordinates: ``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"pt"``,
+        or ``""`` (no physical unit: the larger side is printed 200 mm long). Sets the printed
+        size (``width``/``height`` in mm) and the scale bar label.
+    stroke_mm : float
+        Printed line width in millimetres.
+    flat_edges : bool
+        Also draw ``F`` edges, very light grey, in a ``flat`` group.
+    angle_opacity : bool
+        Set each mountain and valley line's ``opacity`` to ``|fold angle| / 180``, which Origami
+        Simulator reads as the target fold angle.
+
+    Returns
+    -------
+    str
+        The SVG document (UTF-8, ends with a newline). Same input, same bytes.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown ``units`` or a non-positive ``stroke_mm``.
+    ExportError
+        When the pattern is inconsistent.
+    """
+    if units and units not in MM_PER_UNIT:
+        raise ParameterError(
+            f"units must be one of {', '.join(MM_PER_UNIT)} or '', got {units!r}", name="units"
+        )
+    if not (isinstance(stroke_mm, int | float) and math.isfinite(stroke_mm) and stroke_mm > 0):
+        raise ParameterError(
+            f"stroke_mm must be a positive number, got {stroke_mm!r}", name="stroke_mm"
+        )
+    validate_pattern(pattern)
+
+    v = pattern.vertices_2d
+    if len(v):
+        lo, hi = v.min(axis=0), v.max(axis=0)
+    else:
+        lo, hi = np.zeros(2), np.ones(2)
+    size = hi - lo
+    extent = float(size.max())
+    if extent <= 0:
+        extent = 1.0
+    mm_per_user = MM_PER_UNIT[units] if units else _UNITLESS_MM / extent
+    user = 1.0 / mm_per_user  # user units per mm
+    margin = _MARGIN_MM * user
+    font = _FONT_MM * user
+    decimals = max(0, 8 - math.floor(math.log10(extent + 2 * margin)))
+    fmt = _formatter(decimals)
+
+    # drawing coordinates: x right, y down, pattern's top-left at (margin, margin)
+    x = v[:, 0] - lo[0] + margin
+    y = hi[1] - v[:, 1] + margin
+    xs = [fmt(t) for t in x]
+    ys = [fmt(t) for t in y]
+
+    edges = np.asarray(pattern.edges, dtype=np.int64)
+    assign = np.asarray(pattern.edge_assignment)
+    angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64)
+    sw = fmt(stroke_mm * user)
+
+    body = []
+    legend = []
+    for code, gid, label in _GROUPS:
+        if code == "F" and not flat_edges:
+            continue
+        color = ASSIGNMENT_COLOR[code]
+        legend.append((color, label))
+        body.append(f'<g id="{gid}" stroke-width="{sw}" stroke-linecap="round" fill="none">')
+        for e in np.flatnonzero(assign == code):
+            a, b = edges[e]
+            attrs = f'x1="{xs[a]}" y1="{ys[a]}" x2="{xs[b]}" y2="{ys[b]}" stroke="{color}"'
+            if angle_opacity and code in ("M", "V"):
+                attrs += f' opacity="{min(abs(angle[e]) / 180.0, 1.0):.4f}"'
+            body.append(f"<line {attrs}/>")
+        body.append("</g>")
+
+    # scale bar and legend below the drawing
+    draw_w = float(size[0]) + 2 * margin
+    draw_h = float(size[1]) + 2 * margin
+    bar = nice_length(max(float(size[0]), extent * 0.2) / 5.0)
+    bar_h = 1.0 * user
+    bar_y = draw_h
+    label = f"{bar:g} {units}".rstrip()
+    ann = ['<g id="annotation" stroke="none">']
+    ann.append(
+        f'<g id="scale-bar"><rect x="{fmt(margin)}" y="{fmt(bar_y)}" width="{fmt(bar)}" '
+        f'height="{fmt(bar_h)}" fill="#000000"/>'
+    )
+    ann.append(
+        f'<text x="{fmt(margin + bar + 2 * user)}" y="{fmt(bar_y + bar_h)}" '
+        f'font-family="sans-serif" font-size="{fmt(font)}" fill="#000000">'
+        f"{escape(label)}</text></g>"
+    )
+    leg_y = bar_y + bar_h + 2 * font
+    xcur = margin
+    ann.append('<g id="legend" font-family="sans-serif" fill="#000000">')
+    for color, text in legend:
+        ann.append(
+            f'<rect x="{fmt(xcur)}" y="{fmt(leg_y - 0.5 * font)}" '
+            f'width="{fmt(_SWATCH_MM * user)}" height="{fmt(max(stroke_mm, 0.5) * user)}" '
+            f'fill="{color}"/>'
+        )
+        xcur += (_SWATCH_MM + 2.0) * user
+        ann.append(
+            f'<text x="{fmt(xcur)}" y="{fmt(leg_y)}" font-size="{fmt(font)}">{escape(text)}</text>'
+        )
+        xcur += (0.62 * _FONT_MM * len(text) + 6.0) * user
+    ann.append("</g></g>")
+
+    total_w = max(
+        draw_w, xcur + margin, margin + bar + (2 + 0.62 * _FONT_MM * len(label)) * user + margin
+    )
+    total_h = leg_y + font + margin
+    head = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" version="1.1" '
+        f'width="{total_w * mm_per_user:.3f}mm" height="{total_h * mm_per_user:.3f}mm" '
+        f'viewBox="0 0 {fmt(total_w)} {fmt(total_h)}">',
+        "<title>filletfold crease pattern</title>",
+        f"<desc>mountain red, valley blue, cut black; units: {escape(units or 'none')}</desc>",
+    ]
+    return "\n".join([*head, *body, *ann, "</svg>"]) + "\n"

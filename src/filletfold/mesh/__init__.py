@@ -1,0 +1,94 @@
+"""Meshes: reading, built-in examples, validation and half-edge connectivity.
+
+:func:`load_mesh` is the one entry point front ends call: it accepts a file, a built-in example
+name, a ``(vertices, faces)`` pair or a :class:`PolyMesh`, and returns a cleaned mesh.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MeshReadError
+from ..tolerances import tol
+from .clean import CleanLog, clean_mesh
+from .examples import EXAMPLES, Example, example_mesh, example_names, find_example
+from .examples import unknown_example_message as _unknown_example_message
+from .io import SUPPORTED_EXTENSIONS, read_mesh, write_obj, write_off
+from .polymesh import PolyMesh, VertexRing
+
+__all__ = [
+    "EXAMPLES",
+    "SUPPORTED_EXTENSIONS",
+    "CleanLog",
+    "Example",
+    "PolyMesh",
+    "VertexRing",
+    "clean_mesh",
+    "example_mesh",
+    "example_names",
+    "load_mesh",
+    "read_mesh",
+    "write_obj",
+    "write_off",
+]
+
+
+def load_mesh(
+    source,
+    *,
+    coplanar_deg: float = tol.coplanar_deg,
+    merge_coplanar: bool = True,
+) -> tuple[PolyMesh, CleanLog]:
+    """Load and clean a mesh from a file, a built-in example, arrays, or a PolyMesh.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, tuple or PolyMesh
+        * a path to an existing mesh file (see :func:`read_mesh`);
+        * a built-in example name (a str that is not an existing path), see
+          :func:`example_names`;
+        * a pair ``(vertices, faces)``: vertices ``(n, 3)`` float, faces an ``(m, k)`` int array
+          or a list of index lists;
+        * a :class:`PolyMesh`, cleaned again.
+    coplanar_deg, merge_coplanar
+        Passed to :func:`clean_mesh`.
+
+    Returns
+    -------
+    mesh : PolyMesh
+    log : CleanLog
+
+    Raises
+    ------
+    MeshReadError
+        The file cannot be read, or a str names neither an existing file nor an example.
+    MeshError
+        The mesh is invalid (see :func:`clean_mesh`).
+    """
+    if isinstance(source, PolyMesh):
+        vertices, faces = source.vertices, source.faces
+    elif isinstance(source, str):
+        if Path(source).exists():
+            vertices, faces = read_mesh(source)
+        elif find_example(source) is not None:
+            vertices, faces = example_mesh(source)
+        else:
+            raise MeshReadError(
+                f"{source}: no such file and no built-in example named {source!r}; "
+                f"{_unknown_example_message(source)}"
+            )
+    elif isinstance(source, os.PathLike):
+        vertices, faces = read_mesh(source)
+    elif isinstance(source, tuple | list) and len(source) == 2:
+        vertices, faces = source
+        if isinstance(faces, np.ndarray) and faces.ndim == 2:
+            faces = list(faces)
+    else:
+        raise MeshReadError(
+            f"cannot load a mesh from a {type(source).__name__}: expected a file path, a "
+            f"built-in example name, a (vertices, faces) pair or a PolyMesh"
+        )
+    return clean_mesh(vertices, faces, coplanar_deg=coplanar_deg, merge_coplanar=merge_coplanar)

@@ -1,0 +1,126 @@
+"""The crease pattern: flat pieces with their folded positions, creases and patches.
+
+A :class:`CreasePattern` is what every export reads. Each pattern vertex has a 2D position (in
+the flat layout) and a 3D position (in the folded form); faces are polygons counter-clockwise in
+2D, and the same polygons are front-facing in 3D.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .tolerances import tol
+
+
+@dataclass
+class CreasePattern:
+    """Flat pieces, folded positions, and crease data.
+
+    Attributes
+    ----------
+    vertices_2d : (n, 2) float
+        Positions in the flat layout (same length unit as the mesh).
+    vertices_3d : (n, 3) float
+        Positions in the folded form.
+    faces : list of (k,) int
+        Polygons, counter-clockwise in 2D.
+    face_patch : list of str
+        The surface patch of each face: ``"cone <vertex>"``, ``"cylinder <edge>"`` or
+        ``"face <face>"`` (indices into the cleaned mesh and its edge list).
+    face_piece : (n_faces,) int
+        The flat piece (vertex module) each face belongs to.
+    piece_vertex : (n_pieces,) int
+        The mesh vertex whose module each piece is.
+    edges : (m, 2) int
+        Pattern edges, ``a < b``, sorted.
+    edge_assignment : (m,) str
+        ``"M"``, ``"V"``, ``"B"`` (piece border or cut) or ``"F"`` (inside a smooth patch, or the
+        tangent-continuous join between a cylinder and a face).
+    edge_fold_angle : (m,) float
+        Fold angle in degrees, FOLD's sign convention: valley positive, mountain negative, 0 for
+        B and F.
+    edge_faces : (m, 2) int
+        The one or two faces beside each edge (-1 where there is none).
+    """
+
+    vertices_2d: np.ndarray
+    vertices_3d: np.ndarray
+    faces: list
+    face_patch: list
+    face_piece: np.ndarray
+    piece_vertex: np.ndarray
+    edges: np.ndarray = field(default=None)
+    edge_assignment: np.ndarray = field(default=None)
+    edge_fold_angle: np.ndarray = field(default=None)
+    edge_faces: np.ndarray = field(default=None)
+
+    def __post_init__(self):
+        self.vertices_2d = np.asarray(self.vertices_2d, dtype=np.float64).reshape(-1, 2)
+        self.vertices_3d = np.asarray(self.vertices_3d, dtype=np.float64).reshape(-1, 3)
+        self.face_piece = np.asarray(self.face_piece, dtype=np.int64)
+        self.piece_vertex = np.asarray(self.piece_vertex, dtype=np.int64)
+        if self.edges is None:
+            self._derive_edges()
+
+    @property
+    def n_pieces(self) -> int:
+        return len(self.piece_vertex)
+
+    def face_normal_3d(self) -> np.ndarray:
+        """(n_faces, 3) float: unit front normals of the folded faces (Newell's method)."""
+        out = np.empty((len(self.faces), 3))
+        for i, f in enumerate(self.faces):
+            p = self.vertices_3d[f]
+            n = np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0)
+            out[i] = n / np.linalg.norm(n)
+        return out
+
+    def _derive_edges(self):
+        """Edges from faces; assignment and fold angle from the folded geometry.
+
+        An edge with one face is a border or cut (B). An edge between two faces of one patch,
+        between a cylinder and a face piece (tangent continuous by construction), or between
+        two face pieces meeting within ``tol.coplanar_deg`` (across a flat, unrounded edge) is F
+        with fold angle 0. Any other edge is a crease: M where the surface is convex seen from the
+        front, V otherwise, with the fold angle between the two faces' 3D normals.
+        """
+        a = np.concatenate(self.faces)
+        b = np.concatenate([np.roll(f, -1) for f in self.faces])
+        face_of = np.repeat(np.arange(len(self.faces)), [len(f) for f in self.faces])
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        n = len(self.vertices_2d)
+        key = lo * n + hi
+        uniq, inv = np.unique(key, return_inverse=True)
+        edges = np.stack([uniq // n, uniq % n], axis=1)
+        ef = -np.ones((len(uniq), 2), dtype=np.int64)
+        forward = a < b
+        ef[inv[forward], 0] = face_of[forward]
+        ef[inv[~forward], 1] = face_of[~forward]
+        normals = self.face_normal_3d()
+        assign = np.full(len(uniq), "B", dtype="<U1")
+        angle = np.zeros(len(uniq))
+        inner = (ef >= 0).all(axis=1)
+        fa, fb = ef[inner, 0], ef[inner, 1]
+        na, nb = normals[fa], normals[fb]
+        # edge direction as traversed in face fa (a -> b with a < b, since fa holds lo -> hi)
+        d = self.vertices_3d[edges[inner, 1]] - self.vertices_3d[edges[inner, 0]]
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        cr = np.cross(na, nb)
+        sin = np.einsum("ij,ij->i", cr, d)
+        cos = np.einsum("ij,ij->i", na, nb)
+        theta = np.degrees(np.arctan2(sin, cos))  # > 0: convex from the front (mountain)
+        patch = np.array(self.face_patch, dtype=object)
+        kind = np.array([p.split(" ")[0] for p in self.face_patch] or [""])
+        ka, kb = kind[fa], kind[fb]
+        tangent = ((ka == "cylinder") & (kb == "face")) | ((ka == "face") & (kb == "cylinder"))
+        coplanar = (ka == "face") & (kb == "face") & (np.abs(theta) < tol.coplanar_deg)
+        smooth = (patch[fa] == patch[fb]) | tangent | coplanar
+        a_in = np.where(smooth, "F", np.where(theta > 0, "M", "V"))
+        assign[inner] = a_in
+        angle[inner] = np.where(smooth, 0.0, -theta)
+        self.edges = edges
+        self.edge_faces = ef
+        self.edge_assignment = assign
+        self.edge_fold_angle = angle

@@ -1,0 +1,165 @@
+"""What a design reports: ``report.json``, the terminal summary, and the output folder."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .export import fold_document, fold_json, folded_obj, pattern_svg, report_json, write_outputs
+
+OUTPUT_FILES = ("design.fold", "report.json", "folded.obj", "pattern.svg")
+
+
+def _num(x):
+    """A float for JSON, or None for NaN."""
+    x = float(x)
+    return None if not np.isfinite(x) else x
+
+
+def _vec(x):
+    x = np.asarray(x, dtype=float)
+    return None if not np.all(np.isfinite(x)) else x.tolist()
+
+
+def design_report(design) -> dict:
+    """The content of ``report.json`` (see the README for every key).
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    dict
+    """
+    mesh = design.mesh
+    rd = design.rounding
+    res = design.vertices
+    pat = design.pattern
+    edges = []
+    for e, (a, b) in enumerate(mesh.edges):
+        f, g = mesh.edge_faces[e]
+        boundary = f < 0 or g < 0
+        edges.append({
+            "vertices": [int(a), int(b)],
+            "faces": None if boundary else [int(f), int(g)],
+            "length": float(mesh.edge_length[e]),
+            "radius": float(rd.radius[e]),
+            "half_angle": float(rd.half_angle[e]),
+            "assignment": "B" if boundary else ("M" if rd.kappa[e] > 0 else "V"),
+            "arc_length": float(rd.arc_length[e]),
+            "strip_width": float(rd.strip_width[e]),
+            "material_loss": float(rd.loss[e]),
+            "radius_limit": _num(rd.limit[e]),
+        })
+    vertices = []
+    for u in range(mesh.n_vertices):
+        item = {
+            "kind": res.kind[u],
+            "status": res.status[u],
+        }
+        if res.status[u] != "ok":
+            item["reason"] = res.reason[u]
+        item.update({
+            "angle_sum": _num(res.angle_sum[u]),
+            "angle_defect": _num(res.defect[u]),
+            "solid_angle": _num(res.solid_angle[u]),
+            "sigma": int(res.sigma[u]) or None,
+            "normal": _vec(res.normal[u]),
+            "normal_bound": _num(res.normal_bound[u]),
+            "apex": _vec(res.apex[u]),
+            "apex_developed": _vec(res.apex_developed[u]),
+            "apex_2d": _vec(res.apex_2d[u]),
+            "depth_requested": _num(res.depth_requested[u]),
+            "depth": _num(res.depth[u]),
+            "margin": _num(res.margin[u]),
+        })
+        vertices.append(item)
+    counts = {k: int(np.sum(pat.edge_assignment == k)) for k in ("M", "V", "B", "F")}
+    return {
+        "filletfold": __version__,
+        "source": design.source,
+        "parameters": design.params.as_dict(),
+        "mean_edge_length": float(mesh.mean_edge_length),
+        "uniform_radius_limit": _num(rd.uniform_limit),
+        "status_counts": design.status_counts(),
+        "mesh": {
+            "vertices": mesh.vertices.tolist(),
+            "faces": [f.tolist() for f in mesh.faces],
+        },
+        "edges": edges,
+        "vertices": vertices,
+        "pattern": {
+            "pieces": int(pat.n_pieces),
+            "vertices": len(pat.vertices_2d),
+            "faces": len(pat.faces),
+            "edges": counts,
+            "max_edge_mismatch": float(edge_mismatch(pat).max(initial=0.0)),
+        },
+        "timings": {k: float(v) for k, v in design.timings.items()},
+    }
+
+
+def edge_mismatch(pattern) -> np.ndarray:
+    """(n_edges,) 2D length minus 3D length of every pattern edge (>= 0 up to round-off)."""
+    e = pattern.edges
+    l2 = np.linalg.norm(pattern.vertices_2d[e[:, 0]] - pattern.vertices_2d[e[:, 1]], axis=1)
+    l3 = np.linalg.norm(pattern.vertices_3d[e[:, 0]] - pattern.vertices_3d[e[:, 1]], axis=1)
+    return l2 - l3
+
+
+def design_summary(design) -> str:
+    """A few lines for the terminal."""
+    mesh = design.mesh
+    counts = design.status_counts()
+    pat = design.pattern
+    shown = ", ".join(f"{v} {k}" for k, v in counts.items() if v)
+    r = design.rounding.radius[~mesh.is_boundary_edge]
+    depth = design.vertices.depth[np.isfinite(design.vertices.depth)]
+    lines = [
+        f"mesh: {mesh.n_vertices} vertices, {mesh.n_edges} edges, {mesh.n_faces} faces "
+        f"(mean edge {mesh.mean_edge_length:.4g})",
+        f"radius: {r.min():.4g}" + (f"-{r.max():.4g}" if len(r) and r.max() > r.min() else "")
+        + f" (largest uniform radius {design.rounding.uniform_limit:.4g})" if len(r) else
+        "radius: no interior edge",
+        f"vertices: {shown}",
+    ]
+    if len(depth):
+        lines.append(f"apex depth used: {depth.min():.4g}-{depth.max():.4g}")
+    lines.append(
+        f"pattern: {pat.n_pieces} pieces, {len(pat.faces)} faces, "
+        f"{int(np.sum(pat.edge_assignment == 'M'))} mountain / "
+        f"{int(np.sum(pat.edge_assignment == 'V'))} valley crease segments, "
+        f"max edge mismatch {edge_mismatch(pat).max(initial=0.0):.2e}"
+    )
+    for u, st in enumerate(design.vertices.status):
+        if st not in ("ok", "boundary"):
+            lines.append(f"  vertex {u}: {st} - {design.vertices.reason[u]}")
+    lines.append(f"time: {design.timings.get('total', 0.0):.2f} s")
+    return "\n".join(lines)
+
+
+def export_design(design, folder, *, title: str | None = None) -> list[Path]:
+    """Write the design's files into ``folder`` atomically (all of them or none).
+
+    Files: ``design.fold``, ``report.json``, ``folded.obj``, ``pattern.svg``.
+
+    Returns
+    -------
+    list of Path
+    """
+    t = time.perf_counter()
+    title = title or f"filletfold design of {design.source}"
+    doc = fold_document(design.pattern, title=title,
+                        description="Curved-crease rounded design: vertex modules")
+    files = {
+        "design.fold": fold_json(doc),
+        "folded.obj": folded_obj(design.pattern),
+        "pattern.svg": pattern_svg(design.pattern),
+    }
+    design.timings["export"] = time.perf_counter() - t
+    files["report.json"] = report_json(design_report(design))
+    return write_outputs(folder, {k: files[k] for k in OUTPUT_FILES})

@@ -1,0 +1,252 @@
+"""Edge rounding: one right circular cylinder per interior edge (paper sec. 2.1, 4.1).
+
+For an interior edge with front normals ``N_a`` (face holding ``a -> b``) and ``N_b``:
+
+* ``gamma`` is half the angle between the normals, ``kappa = +1`` for a mountain (convex seen from
+  the front) and ``-1`` for a valley;
+* the rounded arc has length ``a = 2 r gamma``, it replaces a strip of width ``A = 2 r tan(gamma)``
+  (``A / 2`` on each face, from the edge to the tangent line), and the material loss is
+  ``w = A - a``;
+* the cylinder's axis passes through ``O = M - kappa (r / cos gamma) unit(N_a + N_b)`` (``M`` the
+  edge midpoint) along the edge.
+
+Boundary edges and flat edges (between coplanar faces that could not be merged, e.g. a ring of
+faces around a hole) are not rounded (radius 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ParameterError
+from .mesh.polymesh import PolyMesh
+from .tolerances import tol
+
+
+def edge_dihedral(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:
+    """Half angle and mountain/valley sign of every edge.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+
+    Returns
+    -------
+    half_angle : (n_edges,) float
+        ``gamma``: half the angle between the two face normals (radians); 0 at boundary edges.
+    kappa : (n_edges,) int
+        +1 mountain (convex seen from the front), -1 valley, 0 boundary or flat.
+    """
+    ef = mesh.edge_faces
+    inner = (ef >= 0).all(axis=1)
+    gamma = np.zeros(mesh.n_edges)
+    kappa = np.zeros(mesh.n_edges, dtype=np.int64)
+    na = mesh.face_normal[ef[inner, 0]]
+    nb = mesh.face_normal[ef[inner, 1]]
+    t = mesh.vertices[mesh.edges[inner, 1]] - mesh.vertices[mesh.edges[inner, 0]]
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    cr = np.cross(na, nb)
+    sin = np.linalg.norm(cr, axis=1)
+    cos = np.einsum("ij,ij->i", na, nb)
+    gamma[inner] = 0.5 * np.arctan2(sin, cos)
+    kappa[inner] = np.sign(np.einsum("ij,ij->i", cr, t)).astype(np.int64)
+    return gamma, kappa
+
+
+def loss_from_radius(radius, half_angle):
+    """Material loss ``w = 2 r (tan(gamma) - gamma)`` of a rounded edge (sec. 4.1)."""
+    radius = np.asarray(radius, dtype=float)
+    half_angle = np.asarray(half_angle, dtype=float)
+    return 2.0 * radius * (np.tan(half_angle) - half_angle)
+
+
+def radius_from_loss(loss, half_angle):
+    """Radius ``r = w / (2 (tan(gamma) - gamma))`` that causes material loss ``w`` (sec. 4.1)."""
+    loss = np.asarray(loss, dtype=float)
+    half_angle = np.asarray(half_angle, dtype=float)
+    return loss / (2.0 * (np.tan(half_angle) - half_angle))
+
+
+def _corner_table(mesh: PolyMesh):
+    """Per face corner: the outgoing and incoming edge, the corner angle.
+
+    Returns
+    -------
+    e_out, e_in : (n_halfedges,) int
+        Edge of the half-edge leaving the corner vertex, and of the one entering it.
+    alpha : (n_halfedges,) float
+        Face angle at the corner (radians).
+    """
+    he_edge = mesh.halfedge_edge
+    prev = np.empty_like(he_edge)
+    for fi in range(mesh.n_faces):
+        s, e = mesh.face_start[fi], mesh.face_start[fi + 1]
+        prev[s:e] = np.roll(np.arange(s, e), 1)
+    return he_edge, he_edge[prev], mesh.corner_angles()
+
+
+def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarray):
+    """Largest valid radius of every edge, given the radii of its neighbours.
+
+    A radius is valid when, at every face corner, the two tangent lines cross before the
+    midpoint cross-sections of both edges (``l_max > 0`` on both), so that every face keeps a
+    flat piece and every cylinder keeps its midpoint base curve.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    edge_radius : (n_edges,) float
+        Requested radii (0 at boundary edges).
+    half_angle : (n_edges,) float
+
+    Returns
+    -------
+    limit : (n_edges,) float
+        Largest radius per edge with the other radii fixed (``inf`` at boundary edges, 0 when the
+        neighbours alone already leave no room).
+    uniform_limit : float
+        Largest radius that is valid when used on every interior edge.
+    """
+    e_out, e_in, alpha = _corner_table(mesh)
+    tan_g = np.tan(half_angle)
+    rounded = edge_radius > 0
+    length = mesh.edge_length
+    offset = np.where(rounded, edge_radius * tan_g, 0.0)  # tangent line's distance from the edge
+    sin, cos = np.sin(alpha), np.cos(alpha)
+    limit = np.full(mesh.n_edges, np.inf)
+    uniform = np.inf
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for e, g in ((e_out, e_in), (e_in, e_out)):
+            # At the corner, T lies at x_e = (d_g + d_e cos) / sin along e and at
+            # x_g = (d_e + d_g cos) / sin along g; both must stay below half their edge.
+            # Each is  k * d_e <= m  with k, m below; only k > 0 bounds d_e from above.
+            for k, m in ((cos / sin, 0.5 * length[e] - offset[g] / sin),
+                         (1.0 / sin, 0.5 * length[g] - offset[g] * cos / sin)):
+                d_max = np.where(k > 0, m / k, np.where(m >= 0, np.inf, 0.0))
+                r_max = np.where(rounded[e], np.maximum(d_max, 0.0) / tan_g[e], np.inf)
+                np.minimum.at(limit, e, r_max)
+            # uniform radius r on every rounded edge: d = r tan(gamma)
+            te = np.where(rounded[e], tan_g[e], 0.0)
+            tg = np.where(rounded[g], tan_g[g], 0.0)
+            for k, half in (((tg + te * cos) / sin, 0.5 * length[e]),
+                            ((te + tg * cos) / sin, 0.5 * length[g])):
+                bound = np.where(k > 0, half / k, np.inf)
+                uniform = min(uniform, float(bound.min(initial=np.inf)))
+    return limit, uniform
+
+
+@dataclass
+class EdgeRounding:
+    """The cylinders of all edges.
+
+    Attributes
+    ----------
+    radius : (n_edges,) float
+        Rounding radius (0 for boundary and flat edges).
+    half_angle : (n_edges,) float
+        ``gamma`` (radians).
+    kappa : (n_edges,) int
+        +1 mountain, -1 valley, 0 boundary.
+    arc_length : (n_edges,) float
+        ``a = 2 r gamma``.
+    strip_width : (n_edges,) float
+        ``A = 2 r tan(gamma)``.
+    loss : (n_edges,) float
+        ``w = A - a``.
+    axis_point : (n_edges, 3) float
+        ``O``, the axis point in the midpoint cross-section (edge midpoint at boundary edges).
+    limit : (n_edges,) float
+        Largest valid radius per edge given its neighbours (see :func:`radius_limits`).
+    uniform_limit : float
+        Largest valid uniform radius.
+    """
+
+    radius: np.ndarray
+    half_angle: np.ndarray
+    kappa: np.ndarray
+    arc_length: np.ndarray
+    strip_width: np.ndarray
+    loss: np.ndarray
+    axis_point: np.ndarray
+    limit: np.ndarray
+    uniform_limit: float
+
+
+def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -> EdgeRounding:
+    """Round every interior edge with a cylinder tangent to both faces.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    radius : float or (n_edges,) float
+        Absolute radius, uniform or per edge (values at boundary and flat edges are ignored).
+    flat_deg : float
+        An interior edge whose faces meet within this angle (degrees) is flat: not rounded
+        (radius 0), its two faces join smoothly.
+
+    Returns
+    -------
+    EdgeRounding
+
+    Raises
+    ------
+    ParameterError
+        If a radius is not finite or not positive, or exceeds its edge's limit (the message
+        names the edge, its vertices, the limit and the largest uniform radius).
+    """
+    gamma, kappa = edge_dihedral(mesh)
+    inner = ~mesh.is_boundary_edge
+    r = np.broadcast_to(np.asarray(radius, dtype=float), (mesh.n_edges,)).copy()
+    if np.ndim(radius) and np.shape(radius) != (mesh.n_edges,):
+        raise ParameterError(
+            f"per-edge radius must have shape ({mesh.n_edges},), got {np.shape(radius)}",
+            name="radius",
+        )
+    flat = inner & (2 * gamma < np.radians(flat_deg))
+    rounded = inner & ~flat
+    if not np.all(np.isfinite(r[rounded])):
+        raise ParameterError("radius must be finite", name="radius")
+    if np.any(r[rounded] <= 0):
+        e = int(np.nonzero(rounded & (r <= 0))[0][0])
+        raise ParameterError(
+            f"radius must be positive (edge {e} has {r[e]:g})", name="radius", edge=e
+        )
+    r[~inner | flat] = 0.0
+    kappa[flat] = 0
+    limit, uniform = radius_limits(mesh, r, gamma)
+    over = r > limit
+    if over.any():
+        ratio = np.where(over, r / np.maximum(limit, 1e-300), 0)
+        e = int(np.argmax(ratio))
+        a, b = mesh.edges[e]
+        raise ParameterError(
+            f"radius {r[e]:.6g} on edge {e} (vertices {a}-{b}) exceeds its limit "
+            f"{limit[e]:.6g}: the face pieces next to it would vanish "
+            f"({int(over.sum())} edge(s) over their limit; the largest radius valid on every "
+            f"edge is {uniform:.6g})",
+            name="radius",
+            edge=e,
+        )
+    mid = 0.5 * (mesh.vertices[mesh.edges[:, 0]] + mesh.vertices[mesh.edges[:, 1]])
+    axis = mid.copy()
+    ef = mesh.edge_faces
+    nsum = mesh.face_normal[ef[rounded, 0]] + mesh.face_normal[ef[rounded, 1]]
+    nsum /= np.linalg.norm(nsum, axis=1)[:, None]
+    shift = kappa[rounded] * r[rounded] / np.cos(gamma[rounded])
+    axis[rounded] = mid[rounded] - shift[:, None] * nsum
+    gamma = np.where(flat, 0.0, gamma)
+    arc = 2 * r * gamma
+    strip = 2 * r * np.tan(gamma)
+    return EdgeRounding(
+        radius=r,
+        half_angle=gamma,
+        kappa=kappa,
+        arc_length=arc,
+        strip_width=strip,
+        loss=strip - arc,
+        axis_point=axis,
+        limit=limit,
+        uniform_limit=uniform,
+    )

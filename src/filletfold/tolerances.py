@@ -1,0 +1,49 @@
+"""The one tolerance object of filletfold.
+
+All comparisons against zero in the library go through ``tol``; lengths are relative to the
+mesh's mean edge length unless the name says otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Numerical tolerances.
+
+    Attributes
+    ----------
+    merge : float
+        Vertices closer than ``merge * bbox_diagonal`` are merged on input.
+    planar : float
+        A polygon face is planar when every vertex is within ``planar * face_size`` of its plane.
+    area : float
+        A face with area below ``area * mean_edge_length**2`` is degenerate.
+    coplanar_deg : float
+        Default angle (degrees) under which two neighbouring faces are merged as coplanar.
+    angle : float
+        Absolute angle tolerance (radians) for "equal angles" such as angle sum == 2*pi.
+    developable : float
+        A vertex is developable when ``|2*pi - angle_sum| < developable`` (radians).
+    normal_bound : float
+        The max-min vertex-normal bound ``b`` must exceed this for a cone to exist.
+    margin : float
+        Safety margin of the sampled apex constraints, as a share of the shortest incident edge.
+    validate : float
+        Slack allowed when the solved apex is validated densely, relative to the local edge length.
+    """
+
+    merge: float = 1e-9
+    planar: float = 1e-6
+    area: float = 1e-12
+    coplanar_deg: float = 1e-3
+    angle: float = 1e-9
+    developable: float = 1e-7
+    normal_bound: float = 1e-9
+    margin: float = 5e-3
+    validate: float = 1e-9
+
+
+tol = Tolerances()

@@ -1,0 +1,372 @@
+"""clean_mesh: repairs (merging, orientation, coplanar faces) and every rejection path."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from filletfold.errors import MeshError
+from filletfold.mesh import CleanLog, PolyMesh, clean_mesh, example_mesh
+from filletfold.tolerances import tol
+
+
+def signed_volume(mesh: PolyMesh) -> float:
+    p = mesh.vertices - mesh.vertices.mean(axis=0)
+    total = 0.0
+    for f in mesh.faces:
+        q = p[f]
+        total += sum(np.dot(q[0], np.cross(q[i], q[i + 1])) for i in range(1, len(f) - 1))
+    return total / 6.0
+
+
+def cube():
+    return example_mesh("cube")
+
+
+def triangulated_cube():
+    v, faces = cube()
+    return v, [t for f in faces for t in (f[[0, 1, 2]], f[[0, 2, 3]])]
+
+
+def subdivided_cube(triangles: bool = False):
+    """Each cube face split into 4 quads (or 8 triangles) through edge midpoints and centre."""
+    v, faces = cube()
+    pts = [tuple(p) for p in v]
+    index = {p: i for i, p in enumerate(pts)}
+
+    def vid(p):
+        p = tuple(np.round(p, 12))
+        if p not in index:
+            index[p] = len(pts)
+            pts.append(p)
+        return index[p]
+
+    out = []
+    for f in faces:
+        c = vid(v[f].mean(axis=0))
+        corners = [vid(v[i]) for i in f]
+        mids = [vid((v[f[i]] + v[f[(i + 1) % 4]]) / 2) for i in range(4)]
+        for i in range(4):
+            quad = [corners[i], mids[i], c, mids[i - 1]]
+            if triangles:
+                out += [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]]
+            else:
+                out.append(quad)
+    return np.array(pts, dtype=np.float64), [np.array(f) for f in out]
+
+
+def assert_is_unit_cube(mesh: PolyMesh):
+    assert mesh.n_faces == 6 and mesh.n_vertices == 8
+    assert all(len(f) == 4 for f in mesh.faces)
+    assert_allclose(mesh.edge_length, 1.0, atol=1e-12)
+    assert_allclose(signed_volume(mesh), 1.0, atol=1e-12)
+
+
+# ------------------------------------------------------------------------------ repairs
+def test_clean_returns_polymesh_and_log():
+    mesh, log = clean_mesh(*cube())
+    assert isinstance(mesh, PolyMesh) and isinstance(log, CleanLog)
+    assert_is_unit_cube(mesh)
+    assert_allclose(log.vertex_map, np.arange(8))
+    assert_allclose(log.face_origin, np.arange(6))
+
+
+def test_triangulated_cube_merges_back_to_quads():
+    mesh, log = clean_mesh(*triangulated_cube())
+    assert_is_unit_cube(mesh)
+    assert log.merged_faces == 6
+    assert sorted(log.face_origin.tolist()) == [0, 2, 4, 6, 8, 10]
+
+
+def test_merge_coplanar_can_be_disabled():
+    mesh, log = clean_mesh(*triangulated_cube(), merge_coplanar=False)
+    assert mesh.n_faces == 12 and log.merged_faces == 0
+
+
+@pytest.mark.parametrize("triangles", [False, True])
+def test_subdivided_cube_merges_to_six_quads_and_eight_vertices(triangles):
+    v, faces = subdivided_cube(triangles)
+    assert len(v) == 26
+    mesh, log = clean_mesh(v, faces)
+    assert_is_unit_cube(mesh)
+    assert log.merged_faces == len(faces) - 6
+    assert log.removed_vertices == 18  # 12 edge midpoints + 6 face centres
+    kept = log.vertex_map >= 0
+    assert kept.sum() == 8
+    assert_allclose(mesh.vertices[log.vertex_map[kept]], v[kept])
+    assert_allclose(np.abs(v[kept]), 0.5)
+
+
+def test_subdivided_open_box_drops_straight_boundary_corners():
+    v, faces = subdivided_cube()
+    keep = [f for f in faces if not np.allclose(v[f, 2], 0.5)]
+    mesh, log = clean_mesh(v, keep)
+    assert mesh.n_faces == 5 and mesh.n_vertices == 8
+    assert log.merged_faces == len(keep) - 5
+    assert not mesh.is_closed
+
+
+def test_duplicate_vertices_are_merged():
+    v, faces = cube()
+    soup_v = np.concatenate([v[f] for f in faces])  # every face with its own 4 vertices
+    soup_f = [np.arange(4 * i, 4 * i + 4) for i in range(6)]
+    soup_v += np.random.default_rng(0).normal(scale=1e-13, size=soup_v.shape)
+    mesh, log = clean_mesh(soup_v, soup_f)
+    assert mesh.n_vertices == 8 and mesh.n_faces == 6
+    assert log.merged_vertices == 16
+    assert_allclose(mesh.vertices[log.vertex_map], soup_v, atol=1e-12)
+
+
+def test_inconsistent_orientation_is_fixed():
+    v, faces = cube()
+    faces = [f[::-1] if i in (1, 4) else f for i, f in enumerate(faces)]
+    mesh, log = clean_mesh(v, faces)
+    assert log.flipped_faces == 2
+    assert_is_unit_cube(mesh)
+
+
+def test_inside_out_cube_is_turned_outward():
+    v, faces = cube()
+    mesh, log = clean_mesh(v, [f[::-1] for f in faces])
+    assert log.flipped_faces == 6
+    assert_is_unit_cube(mesh)
+    centre_to_face = mesh.face_centroid - mesh.vertices.mean(axis=0)
+    assert (np.einsum("ij,ij->i", mesh.face_normal, centre_to_face) > 0).all()
+
+
+def test_open_mesh_keeps_majority_orientation():
+    v, faces = example_mesh("open-box")
+    faces = [f[::-1] if i == 2 else f for i, f in enumerate(faces)]
+    mesh, log = clean_mesh(v, faces)
+    assert log.flipped_faces == 1
+    assert_allclose(mesh.faces[2], faces[2][[0, 3, 2, 1]])
+
+
+def test_each_component_is_oriented_on_its_own():
+    v, faces = cube()
+    v2 = np.vstack([v, v + np.array([3.0, 0.0, 0.0])])
+    faces2 = list(faces) + [f[::-1] + 8 for f in faces]  # second cube inside out
+    mesh, log = clean_mesh(v2, faces2)
+    assert log.flipped_faces == 6
+    assert_allclose(signed_volume(mesh), 2.0, atol=1e-12)
+
+
+def test_unreferenced_vertices_are_removed():
+    v, faces = cube()
+    v = np.vstack([[9.0, 9.0, 9.0], v])
+    mesh, log = clean_mesh(v, [f + 1 for f in faces])
+    assert mesh.n_vertices == 8 and log.removed_vertices == 1
+    assert log.vertex_map[0] == -1
+    assert_allclose(log.vertex_map[1:], np.arange(8))
+
+
+def test_non_convex_polygons_are_kept_and_triangles_merged_into_them():
+    v, faces = example_mesh("l-prism")
+    tris = []
+    for f in faces:
+        if len(f) == 6:  # fan from the corner opposite the reflex corner
+            j = int(np.argmax([np.abs(v[i, :2] - v[f, :2].min(axis=0)).sum() == 0 for i in f]))
+            g = np.roll(f, -j)
+            tris += [g[[0, i, i + 1]] for i in range(1, 5)]
+        else:
+            tris += [f[[0, 1, 2]], f[[0, 2, 3]]]
+    assert len(tris) == 20
+    mesh, log = clean_mesh(v, tris)
+    assert mesh.n_faces == 8 and log.merged_faces == 12
+    assert sorted(len(f) for f in mesh.faces) == [4] * 6 + [6, 6]
+    assert_allclose(mesh.corner_angles().max(), 1.5 * np.pi, atol=1e-12)
+
+
+def test_coplanar_region_with_hole_is_not_merged():
+    # a flat 3 x 3 grid of unit squares without the centre one: boundary is two loops
+    g = np.array([[x, y, 0.0] for y in range(4) for x in range(4)])
+    quads = [
+        np.array([j * 4 + i, j * 4 + i + 1, (j + 1) * 4 + i + 1, (j + 1) * 4 + i])
+        for j in range(3)
+        for i in range(3)
+        if (i, j) != (1, 1)
+    ]
+    mesh, log = clean_mesh(g, quads)
+    assert mesh.n_faces == 8 and log.merged_faces == 0
+
+
+def test_nearly_coplanar_faces_merge_within_tolerance_only():
+    def bent_pair(angle_deg):
+        t = np.radians(angle_deg)
+        v = np.array(
+            [
+                [0, 0, 0],
+                [1, 0, 0],
+                [1, 1, 0],
+                [0, 1, 0],
+                [1 + np.cos(t), 0, np.sin(t)],
+                [1 + np.cos(t), 1, np.sin(t)],
+            ]
+        )
+        return v, [np.array([0, 1, 2, 3]), np.array([1, 4, 5, 2])]
+
+    assert clean_mesh(*bent_pair(1e-5))[0].n_faces == 1
+    assert clean_mesh(*bent_pair(0.01))[0].n_faces == 2
+    # within coplanar_deg but the merged polygon would not be planar: kept apart
+    assert clean_mesh(*bent_pair(0.01), coplanar_deg=1.0)[0].n_faces == 2
+    assert clean_mesh(*bent_pair(1e-5), coplanar_deg=0)[0].n_faces == 2
+
+
+def test_faces_as_2d_array_and_float_indices():
+    v, faces = cube()
+    arr = np.array(faces)
+    mesh, _ = clean_mesh(v.tolist(), arr.astype(np.float64))
+    assert_is_unit_cube(mesh)
+
+
+# ---------------------------------------------------------------------------- rejections
+def test_nan_vertex_rejected_naming_the_vertex():
+    v, faces = cube()
+    v[3, 1] = np.nan
+    with pytest.raises(MeshError, match=r"vertex 3 has a non-finite coordinate") as info:
+        clean_mesh(v, faces)
+    assert info.value.vertex == 3
+
+
+def test_bad_vertex_shape_rejected():
+    with pytest.raises(MeshError, match=r"vertices must have shape \(n, 3\), got \(4, 2\)"):
+        clean_mesh(np.zeros((4, 2)), [[0, 1, 2]])
+
+
+def test_index_out_of_range_rejected():
+    v, faces = cube()
+    faces[1] = np.array([0, 1, 9, 3])
+    with pytest.raises(
+        MeshError, match=r"face 1 refers to vertex 9, outside the 8 vertices"
+    ) as info:
+        clean_mesh(v, faces)
+    assert info.value.face == 1
+    with pytest.raises(MeshError, match=r"face 0 refers to vertex -1"):
+        clean_mesh(v, [[-1, 0, 1]])
+
+
+def test_non_integer_face_rejected():
+    with pytest.raises(MeshError, match=r"face 0 has non-integer vertex indices"):
+        clean_mesh(np.eye(3), [[0, 1, 1.5]])
+    with pytest.raises(MeshError, match=r"face 0 is not a list of vertex indices"):
+        clean_mesh(np.eye(3), [["a", "b", "c"]])
+
+
+def test_empty_mesh_rejected():
+    with pytest.raises(MeshError, match=r"empty"):
+        clean_mesh(np.zeros((0, 3)), [])
+    with pytest.raises(MeshError, match=r"empty"):
+        clean_mesh(np.eye(3), [])
+
+
+def test_face_collapsed_by_merging_is_degenerate():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 1e-14], [1, 1, 0]], dtype=float)
+    faces = [[0, 1, 2], [1, 4, 3]]  # vertices 1 and 3 coincide
+    with pytest.raises(MeshError, match=r"degenerate face 1: it has 2 distinct vertices") as info:
+        clean_mesh(v, faces)
+    assert info.value.face == 1
+
+
+def test_short_face_is_degenerate():
+    with pytest.raises(MeshError, match=r"degenerate face 0: it has 2 distinct"):
+        clean_mesh(np.eye(3), [[0, 1]])
+
+
+def test_zero_area_face_is_degenerate():
+    v = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], dtype=float)
+    with pytest.raises(MeshError, match=r"degenerate face 1: its area 0 is below") as info:
+        clean_mesh(v, [[0, 1, 3], [0, 1, 2]])
+    assert info.value.face == 1
+
+
+def test_face_visiting_a_vertex_twice_is_degenerate():
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 2, 0]], dtype=float)
+    with pytest.raises(MeshError, match=r"degenerate face 0: it visits a vertex twice"):
+        clean_mesh(v, [[0, 1, 2, 4, 2, 3]])
+
+
+def test_duplicate_face_rejected():
+    v, faces = example_mesh("tetrahedron")
+    with pytest.raises(
+        MeshError, match=r"degenerate face 4: it uses the same vertices as face 0"
+    ) as info:
+        clean_mesh(v, [*faces, faces[0][::-1]])
+    assert info.value.face == 4
+
+
+def test_non_manifold_edge_rejected_naming_the_edge():
+    v = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, -1, 0]], dtype=float)
+    fins = [[0, 1, 2], [0, 1, 3], [0, 1, 4]]  # three triangles on edge (0, 1)
+    with pytest.raises(MeshError, match=r"non-manifold edge \(0, 1\): shared by 3 faces") as info:
+        clean_mesh(v, fins)
+    assert info.value.edge == (0, 1)
+
+
+def test_non_manifold_edge_named_by_input_indices_after_merging():
+    v = np.array(
+        [[9, 9, 9], [0, 0, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, -1, 0], [0, 0, 1]], dtype=float
+    )
+    fins = [[1, 2, 3], [1, 2, 4], [1, 6, 5]]  # 6 duplicates 2
+    with pytest.raises(MeshError, match=r"non-manifold edge \(1, 2\)") as info:
+        clean_mesh(v, fins)
+    assert info.value.edge == (1, 2)
+
+
+def test_bowtie_rejected_naming_the_vertex():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0, 2, 0], [1, 2, 0]], dtype=float)
+    with pytest.raises(
+        MeshError, match=r"non-manifold vertex 2: its faces form 2 separate fans"
+    ) as info:
+        clean_mesh(v, [[0, 1, 2], [2, 4, 3]])
+    assert info.value.vertex == 2
+
+
+def test_two_cubes_touching_at_a_corner_rejected():
+    v, faces = cube()
+    corner = int(np.argmax(v.sum(axis=1)))  # (0.5, 0.5, 0.5)
+    v2 = v + 1.0  # its (-0.5, -0.5, -0.5) corner lands on the first cube's corner
+    faces2 = list(faces) + [f + 8 for f in faces]
+    with pytest.raises(MeshError, match=rf"non-manifold vertex {corner}:") as info:
+        clean_mesh(np.vstack([v, v2]), faces2)
+    assert info.value.vertex == corner
+
+
+def test_moebius_strip_rejected():
+    n = 8
+    t = 2 * np.pi * np.arange(n) / n
+    verts, quads = [], []
+    for i, ti in enumerate(t):
+        for s in (-0.3, 0.3):
+            r = 1 + s * np.cos(ti / 2)
+            verts.append([r * np.cos(ti), r * np.sin(ti), s * np.sin(ti / 2)])
+        j = (i + 1) % n
+        a, b = 2 * i, 2 * i + 1
+        c, d = (2 * j, 2 * j + 1) if j else (2 * j + 1, 2 * j)  # the half twist
+        quads.append([a, c, d, b])
+    tris = [t for q in quads for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]])]
+    with pytest.raises(MeshError, match=r"non-orientable surface: the component containing face"):
+        clean_mesh(np.array(verts), tris)
+
+
+def test_non_planar_face_rejected():
+    v, faces = cube()
+    v = v.copy()
+    v[int(np.argmax(v.sum(axis=1)))] += [0, 0, 0.01]
+    with pytest.raises(MeshError, match=r"face \d+ is not planar: a vertex is") as info:
+        clean_mesh(v, faces)
+    assert info.value.face in range(6)
+
+
+def test_tolerances_are_used():
+    # a duplicate closer than tol.merge * diagonal merges, one further away does not
+    v, faces = cube()
+    diag = np.sqrt(3.0)
+    extra = np.vstack([v, v[0] + [0.1 * tol.merge * diag, 0, 0]])
+    faces2 = [np.where(f == 0, 8, f) if i == 0 else f for i, f in enumerate(faces)]
+    mesh, log = clean_mesh(extra, faces2)
+    assert log.merged_vertices == 1 and mesh.n_vertices == 8
+    far = np.vstack([v, v[0] + [10 * tol.merge * diag, 0, 0]])
+    mesh, log = clean_mesh(far, faces2)  # now a crack: face 0 no longer shares vertex 0
+    assert log.merged_vertices == 0 and mesh.n_vertices == 9
+    assert not mesh.is_closed
