@@ -111,6 +111,13 @@ f 4 1 \\
     assert mesh.n_faces == 5 and mesh.is_closed and log.flipped_faces == 0
 
 
+def test_obj_with_byte_order_mark(tmp_path):
+    path = tmp_path / "bom.obj"
+    path.write_bytes("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".encode("utf-8-sig"))
+    v, faces = read_mesh(path)
+    assert v.shape == (3, 3) and len(faces) == 1
+
+
 def test_obj_uppercase_extension(tmp_path):
     v, faces = example_mesh("cube")
     write_obj(tmp_path / "CUBE.OBJ", v, faces)

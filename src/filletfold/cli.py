@@ -59,7 +59,7 @@ def examples():
     table = Table("name", "vertices", "faces", "kind", "description")
     for name, ex in EXAMPLES.items():
         v, f = example_mesh(name)
-        table.add_row(name, str(len(v)), str(len(f)), ", ".join(ex.tags), ex.description)
+        table.add_row(name, str(len(v)), str(len(f)), ", ".join(ex.kinds), ex.description)
     console.print(table)
 
 

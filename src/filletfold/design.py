@@ -287,6 +287,11 @@ def solve_vertex(mesh: PolyMesh, rounding: EdgeRounding, u: int, depth: float,
         res.reason[u] = "the development does not turn (rho is a translation): no developed apex"
         return frame, None, None
     res.apex_developed[u] = v
+    if np.any(frame.corner_angle > np.pi):
+        res.status[u] = "infeasible"
+        res.reason[u] = "a face has a reflex corner at this vertex: the straight crease on it " \
+            "would leave the face"
+        return frame, None, None
     U = frame.U
     lengths = np.array([s.length for s in frame.sides])
     target = U + depth * D

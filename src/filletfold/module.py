@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import shapely
 
+from .errors import MeshError
 from .mesh.polymesh import PolyMesh
 from .rounding import EdgeRounding
 from .vertex.apex import crease_length
@@ -94,14 +95,22 @@ class Piece:
 
 
 def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
-    """Centre of every flat face piece (area centroid of its tangent-line polygon).
+    """Centre of every flat face piece, from which the whole piece is visible.
 
     The face piece of a face is bounded by the tangent lines of its edges (the edge itself for a
-    boundary edge); its corners are the crossing points T.
+    boundary or flat edge); its corners are the crossing points T. Each vertex's share of the
+    piece is cut off by straight segments from the edge midpoints to this centre, so the centre
+    must see the whole piece: it is the centroid of the piece's kernel (the piece itself when
+    convex).
 
     Returns
     -------
     centre : (n_faces, 3) float
+
+    Raises
+    ------
+    MeshError
+        If a face piece is not star-shaped (no point sees all of it).
     """
     half = 0.5 * rounding.strip_width
     out = np.empty((mesh.n_faces, 3))
@@ -115,24 +124,48 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
         d = half[mesh.halfedge_edge[he]]
         base = p + d[:, None] * np.cross(n, u)  # a point of each edge's tangent line
         T = np.empty_like(p)
-        k = len(face)
-        for j in range(k):  # corner j: lines of edge j-1 and edge j
+        for j in range(len(face)):  # corner j: lines of edge j-1 and edge j
             a = np.stack([u[j - 1], -u[j]], axis=1)
             z, *_ = np.linalg.lstsq(a, base[j] - base[j - 1], rcond=None)
             T[j] = base[j - 1] + z[0] * u[j - 1]
         e1 = u[0]
         e2 = np.cross(n, e1)
         xy = np.stack([(T - p[0]) @ e1, (T - p[0]) @ e2], axis=1)
-        x, y = xy[:, 0], xy[:, 1]
-        cross = x * np.roll(y, -1) - np.roll(x, -1) * y
-        area = 0.5 * cross.sum()
-        if abs(area) > 1e-300:
-            cx = ((x + np.roll(x, -1)) * cross).sum() / (6 * area)
-            cy = ((y + np.roll(y, -1)) * cross).sum() / (6 * area)
-        else:
-            cx, cy = x.mean(), y.mean()
-        out[fi] = p[0] + cx * e1 + cy * e2
+        centre = _kernel_centroid(xy)
+        if centre is None:
+            raise MeshError(
+                f"face {fi} is not star-shaped after rounding: no point of it sees the whole "
+                "face piece; split it into convex polygons or use a smaller radius",
+                face=fi,
+            )
+        out[fi] = p[0] + centre[0] * e1 + centre[1] * e2
     return out
+
+
+def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
+    """Centroid of the kernel of a counter-clockwise polygon (k, 2), or None if it is empty."""
+    poly = shapely.Polygon(xy)
+    if poly.is_valid and poly.exterior.is_ccw and _is_convex(xy):
+        c = poly.centroid
+        return np.array([c.x, c.y])
+    size = float(np.ptp(xy, axis=0).max()) * 4 + 1.0
+    kernel = poly if poly.is_valid else shapely.convex_hull(poly)
+    for a, b in zip(xy, np.roll(xy, -1, axis=0), strict=True):
+        t = b - a
+        nrm = np.array([-t[1], t[0]]) / np.linalg.norm(t) * size  # left of a -> b is inside
+        t = t / np.linalg.norm(t) * size
+        half = shapely.Polygon([a - t, b + t, b + t + nrm, a - t + nrm])
+        kernel = kernel.intersection(half)
+    if kernel.is_empty or kernel.area <= 1e-12 * poly.area:
+        return None
+    c = kernel.centroid
+    return np.array([c.x, c.y])
+
+
+def _is_convex(xy: np.ndarray) -> bool:
+    d = np.roll(xy, -1, axis=0) - xy
+    cross = d[:, 0] * np.roll(d[:, 1], -1) - d[:, 1] * np.roll(d[:, 0], -1)
+    return bool(np.all(cross >= 0))
 
 
 def hole_heights(frame: VertexFrame) -> np.ndarray:
@@ -268,7 +301,12 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
         fr = frame.face_frames[i]
         c = piece.point(("centre", face), apply(frame.face_map[i], to_chart(fr, centres[face])),
                         centres[face])
-        piece.face([t0, b0, c, b1, t1], f"face {face}")
+        corner = [t0, b0, c, b1, t1]
+        if apex is None and frame.corner_angle[i] > np.pi:
+            # at a reflex corner the straight hole border would leave the face: go through T
+            T3 = frame.T_end[i]
+            corner.append(piece.point(("T", i), apply(frame.face_map[i], to_chart(fr, T3)), T3))
+        piece.face(corner, f"face {face}")
         if apex is not None:
             piece.face([piece.apex_index, t0, t1], f"cone {u}")
     return piece

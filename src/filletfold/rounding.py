@@ -55,18 +55,26 @@ def edge_dihedral(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:
     return gamma, kappa
 
 
+def tan_minus_angle(half_angle):
+    """``tan(gamma) - gamma`` without cancellation for small angles (series below 0.1)."""
+    g = np.asarray(half_angle, dtype=float)
+    g2 = g * g
+    series = g * g2 * (1 / 3 + g2 * (2 / 15 + g2 * (17 / 315 + g2 * 62 / 2835)))
+    return np.where(np.abs(g) < 0.1, series, np.tan(g) - g)
+
+
 def loss_from_radius(radius, half_angle):
     """Material loss ``w = 2 r (tan(gamma) - gamma)`` of a rounded edge (sec. 4.1)."""
     radius = np.asarray(radius, dtype=float)
     half_angle = np.asarray(half_angle, dtype=float)
-    return 2.0 * radius * (np.tan(half_angle) - half_angle)
+    return 2.0 * radius * tan_minus_angle(half_angle)
 
 
 def radius_from_loss(loss, half_angle):
     """Radius ``r = w / (2 (tan(gamma) - gamma))`` that causes material loss ``w`` (sec. 4.1)."""
     loss = np.asarray(loss, dtype=float)
     half_angle = np.asarray(half_angle, dtype=float)
-    return loss / (2.0 * (np.tan(half_angle) - half_angle))
+    return loss / (2.0 * tan_minus_angle(half_angle))
 
 
 def _corner_table(mesh: PolyMesh):
@@ -88,53 +96,64 @@ def _corner_table(mesh: PolyMesh):
 
 
 def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarray):
-    """Largest valid radius of every edge, given the radii of its neighbours.
+    """Largest valid radius of every edge, and the corners that the given radii break.
 
     A radius is valid when, at every face corner, the two tangent lines cross before the
     midpoint cross-sections of both edges (``l_max > 0`` on both), so that every face keeps a
-    flat piece and every cylinder keeps its midpoint base curve.
+    flat piece and every cylinder keeps its midpoint base curve. At a corner with angle
+    ``alpha`` and tangent-line offsets ``d_e = r_e tan(gamma_e)``, the crossing T lies at
+    ``x_e = (d_g + d_e cos(alpha)) / sin(alpha)`` along edge ``e`` from the corner.
 
     Parameters
     ----------
     mesh : PolyMesh
     edge_radius : (n_edges,) float
-        Requested radii (0 at boundary edges).
+        Requested radii (0 at boundary and flat edges).
     half_angle : (n_edges,) float
 
     Returns
     -------
     limit : (n_edges,) float
-        Largest radius per edge with the other radii fixed (``inf`` at boundary edges, 0 when the
-        neighbours alone already leave no room).
+        Largest radius of each edge when the edges it shares a corner with are rounded alike
+        (``inf`` at edges that are not rounded).
+    given : (n_edges,) float
+        Largest radius of each edge with the other edges at their requested radii (0 when
+        those alone leave no room).
+    broken : (n_edges,) bool
+        Edges whose tangent-line crossing passes their midpoint with the requested radii.
     uniform_limit : float
-        Largest radius that is valid when used on every interior edge.
+        Largest radius that is valid when used on every rounded edge.
     """
     e_out, e_in, alpha = _corner_table(mesh)
     tan_g = np.tan(half_angle)
     rounded = edge_radius > 0
     length = mesh.edge_length
-    offset = np.where(rounded, edge_radius * tan_g, 0.0)  # tangent line's distance from the edge
+    offset = np.where(rounded, edge_radius * tan_g, 0.0)
     sin, cos = np.sin(alpha), np.cos(alpha)
     limit = np.full(mesh.n_edges, np.inf)
-    uniform = np.inf
+    given = np.full(mesh.n_edges, np.inf)
+    broken = np.zeros(mesh.n_edges, dtype=bool)
     with np.errstate(divide="ignore", invalid="ignore"):
         for e, g in ((e_out, e_in), (e_in, e_out)):
-            # At the corner, T lies at x_e = (d_g + d_e cos) / sin along e and at
-            # x_g = (d_e + d_g cos) / sin along g; both must stay below half their edge.
-            # Each is  k * d_e <= m  with k, m below; only k > 0 bounds d_e from above.
-            for k, m in ((cos / sin, 0.5 * length[e] - offset[g] / sin),
-                         (1.0 / sin, 0.5 * length[g] - offset[g] * cos / sin)):
-                d_max = np.where(k > 0, m / k, np.where(m >= 0, np.inf, 0.0))
-                r_max = np.where(rounded[e], np.maximum(d_max, 0.0) / tan_g[e], np.inf)
-                np.minimum.at(limit, e, r_max)
-            # uniform radius r on every rounded edge: d = r tan(gamma)
             te = np.where(rounded[e], tan_g[e], 0.0)
             tg = np.where(rounded[g], tan_g[g], 0.0)
-            for k, half in (((tg + te * cos) / sin, 0.5 * length[e]),
-                            ((te + tg * cos) / sin, 0.5 * length[g])):
-                bound = np.where(k > 0, half / k, np.inf)
-                uniform = min(uniform, float(bound.min(initial=np.inf)))
-    return limit, uniform
+            # both crossings: along e (own) and along g (other), each  k * d_e <= m
+            for k, m, ku, half in (
+                (cos / sin, 0.5 * length[e] - offset[g] / sin, (tg + te * cos) / sin,
+                 0.5 * length[e]),
+                (1.0 / sin, 0.5 * length[g] - offset[g] * cos / sin, (te + tg * cos) / sin,
+                 0.5 * length[g]),
+            ):
+                d_max = np.where(k > 0, m / k, np.where(m >= 0, np.inf, 0.0))
+                r_given = np.where(rounded[e], np.maximum(d_max, 0.0) / te, np.inf)
+                np.minimum.at(given, e, r_given)
+                r_uni = np.where(rounded[e] & (ku > 0), half / ku, np.inf)
+                np.minimum.at(limit, e, r_uni)
+            x_e = (offset[g] + offset[e] * cos) / sin
+            over = rounded[e] & (x_e > 0.5 * length[e] * (1 + 1e-12))
+            broken[e[over]] = True
+            broken[g[over & rounded[g]]] = True
+    return limit, given, broken, float(limit.min(initial=np.inf))
 
 
 @dataclass
@@ -158,7 +177,8 @@ class EdgeRounding:
     axis_point : (n_edges, 3) float
         ``O``, the axis point in the midpoint cross-section (edge midpoint at boundary edges).
     limit : (n_edges,) float
-        Largest valid radius per edge given its neighbours (see :func:`radius_limits`).
+        Largest valid radius per edge when its neighbours are rounded alike (see
+        :func:`radius_limits`).
     uniform_limit : float
         Largest valid uniform radius.
     """
@@ -198,12 +218,12 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
     """
     gamma, kappa = edge_dihedral(mesh)
     inner = ~mesh.is_boundary_edge
-    r = np.broadcast_to(np.asarray(radius, dtype=float), (mesh.n_edges,)).copy()
     if np.ndim(radius) and np.shape(radius) != (mesh.n_edges,):
         raise ParameterError(
             f"per-edge radius must have shape ({mesh.n_edges},), got {np.shape(radius)}",
             name="radius",
         )
+    r = np.broadcast_to(np.asarray(radius, dtype=float), (mesh.n_edges,)).copy()
     flat = inner & (2 * gamma < np.radians(flat_deg))
     rounded = inner & ~flat
     if not np.all(np.isfinite(r[rounded])):
@@ -215,17 +235,16 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
         )
     r[~inner | flat] = 0.0
     kappa[flat] = 0
-    limit, uniform = radius_limits(mesh, r, gamma)
-    over = r > limit
-    if over.any():
-        ratio = np.where(over, r / np.maximum(limit, 1e-300), 0)
+    limit, given, broken, uniform = radius_limits(mesh, r, gamma)
+    if broken.any():
+        ratio = np.where(broken, r / limit, 0.0)
         e = int(np.argmax(ratio))
         a, b = mesh.edges[e]
         raise ParameterError(
             f"radius {r[e]:.6g} on edge {e} (vertices {a}-{b}) exceeds its limit "
-            f"{limit[e]:.6g}: the face pieces next to it would vanish "
-            f"({int(over.sum())} edge(s) over their limit; the largest radius valid on every "
-            f"edge is {uniform:.6g})",
+            f"{limit[e]:.6g} (beyond it the face pieces next to the edge vanish; with its "
+            f"neighbours' radii it can be at most {given[e]:.6g}); {int(broken.sum())} edge(s) "
+            f"are over their limit, the largest radius valid on every edge is {uniform:.6g}",
             name="radius",
             edge=e,
         )
@@ -245,7 +264,7 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
         kappa=kappa,
         arc_length=arc,
         strip_width=strip,
-        loss=strip - arc,
+        loss=loss_from_radius(r, gamma),
         axis_point=axis,
         limit=limit,
         uniform_limit=uniform,

@@ -210,40 +210,112 @@ def _close_vertex_representatives(v: np.ndarray) -> np.ndarray:
     return first[labels]
 
 
-def _newell(p: np.ndarray) -> np.ndarray:
-    """(3,) float: Newell vector (twice the vector area) of the polygon ``p`` (k, 3)."""
-    return np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0)
+@dataclass(frozen=True)
+class _Flat:
+    """A polygon list as flat corner arrays (corner ``c`` = vertex ``index[c]`` of ``face[c]``)."""
+
+    index: np.ndarray  # (n_corners,) vertex of each corner
+    start: np.ndarray  # (n_faces + 1,) first corner of each face
+    size: np.ndarray  # (n_faces,)
+    face: np.ndarray  # (n_corners,)
+    next: np.ndarray  # (n_corners,) next corner in the same face
+    prev: np.ndarray  # (n_corners,)
+
+    @classmethod
+    def of(cls, face_list) -> _Flat:
+        size = np.array([len(f) for f in face_list], dtype=np.int64)
+        start = np.concatenate([[0], np.cumsum(size)])
+        index = np.concatenate(face_list).astype(np.int64)
+        face = np.repeat(np.arange(len(face_list)), size)
+        local = np.arange(len(index)) - start[face]
+        nxt = start[face] + (local + 1) % size[face]
+        prv = start[face] + (local - 1) % size[face]
+        return cls(index, start, size, face, nxt, prv)
+
+    def split(self, values: np.ndarray) -> list[np.ndarray]:
+        return np.split(values, self.start[1:-1])
+
+
+def _face_newell(fl: _Flat, v: np.ndarray) -> np.ndarray:
+    """(n_faces, 3) float: Newell vectors (twice the vector areas), computed about each centroid."""
+    p = v[fl.index]
+    centroid = np.add.reduceat(p, fl.start[:-1], axis=0) / fl.size[:, None]
+    p = p - centroid[fl.face]
+    return np.add.reduceat(np.cross(p, p[fl.next]), fl.start[:-1], axis=0)
+
+
+def _corner_angles(fl: _Flat, v: np.ndarray) -> np.ndarray:
+    """(n_corners,) float: interior angle at each corner (radians, reflex corners above pi)."""
+    n = _face_newell(fl, v)
+    n = n / np.linalg.norm(n, axis=1)[:, None]
+    p = v[fl.index]
+    to_next = v[fl.index[fl.next]] - p
+    to_prev = v[fl.index[fl.prev]] - p
+    s = np.einsum("ij,ij->i", np.cross(to_next, to_prev), n[fl.face])
+    c = np.einsum("ij,ij->i", to_next, to_prev)
+    return np.mod(np.arctan2(s, c), 2 * np.pi)
+
+
+def _face_planarity(fl: _Flat, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Max distance of each face's vertices from its Newell plane, and each face's diameter.
+
+    Returns
+    -------
+    distance, diameter : (n_faces,) float
+    """
+    p = v[fl.index]
+    centroid = np.add.reduceat(p, fl.start[:-1], axis=0) / fl.size[:, None]
+    n = _face_newell(fl, v)
+    n = n / np.linalg.norm(n, axis=1)[:, None]
+    dist = np.abs(np.einsum("ij,ij->i", p - centroid[fl.face], n[fl.face]))
+    distance = np.maximum.reduceat(dist, fl.start[:-1])
+    diameter = np.zeros(len(fl.size))
+    local = np.arange(len(fl.index)) - fl.start[fl.face]
+    for step in range(1, int(fl.size.max()) // 2 + 1):
+        other = fl.start[fl.face] + (local + step) % fl.size[fl.face]
+        d = np.linalg.norm(v[fl.index[other]] - p, axis=1)
+        diameter = np.maximum(diameter, np.maximum.reduceat(d, fl.start[:-1]))
+    return distance, diameter
 
 
 def _remap_faces(face_list, rep, v) -> list[np.ndarray]:
-    out = []
-    for i, f in enumerate(face_list):
-        g = rep[f]
-        if len(g):
-            g = g[g != np.roll(g, 1)] if len(g) > 1 else g
-        distinct = len(np.unique(g))
-        if distinct < 3:
-            raise MeshError(
-                f"degenerate face {i}: it has {distinct} distinct vertices after merging "
-                f"duplicates (at least 3 needed)",
-                face=i,
-            )
-        if distinct < len(g):
-            raise MeshError(f"degenerate face {i}: it visits a vertex twice ({g.tolist()})", face=i)
-        out.append(g)
-    lengths = [np.linalg.norm(v[np.roll(g, -1)] - v[g], axis=1) for g in out]
-    mean_edge = float(np.concatenate(lengths).mean())
+    fl = _Flat.of(face_list)
+    g = rep[fl.index]
+    n = len(v)
+    # distinct vertices per face, and the face with consecutive repeats dropped
+    pairs = np.unique(fl.face * n + g)
+    distinct = np.bincount(pairs // n, minlength=len(fl.size))
+    keep = g != g[fl.prev]
+    kept = np.bincount(fl.face[keep], minlength=len(fl.size))
+    few = np.nonzero(distinct < 3)[0]
+    if len(few):
+        i = int(few[0])
+        raise MeshError(
+            f"degenerate face {i}: it has {int(distinct[i])} distinct vertices after merging "
+            f"duplicates (at least 3 needed)",
+            face=i,
+        )
+    twice = np.nonzero(distinct < kept)[0]
+    if len(twice):
+        i = int(twice[0])
+        face = g[keep][fl.face[keep] == i]
+        raise MeshError(f"degenerate face {i}: it visits a vertex twice ({face.tolist()})", face=i)
+    out = np.split(g[keep], np.cumsum(kept)[:-1])
+    fl = _Flat.of(out)
+    mean_edge = float(np.linalg.norm(v[fl.index[fl.next]] - v[fl.index], axis=1).mean())
     min_area = tol.area * mean_edge**2
+    area = 0.5 * np.linalg.norm(_face_newell(fl, v), axis=1)
+    small = np.nonzero(area <= min_area)[0]
+    if len(small):
+        i = int(small[0])
+        raise MeshError(
+            f"degenerate face {i}: its area {area[i]:.3g} is below {min_area:.3g} "
+            f"(tol.area * mean_edge**2)",
+            face=i,
+        )
     seen: dict[tuple, int] = {}
-    for i, g in enumerate(out):
-        area = 0.5 * float(np.linalg.norm(_newell(v[g] - v[g].mean(axis=0))))
-        if area <= min_area:
-            raise MeshError(
-                f"degenerate face {i}: its area {area:.3g} is below {min_area:.3g} "
-                f"(tol.area * mean_edge**2)",
-                face=i,
-            )
-        key = tuple(sorted(g.tolist()))
+    for i, f in enumerate(out):
+        key = tuple(sorted(f.tolist()))
         if key in seen:
             raise MeshError(
                 f"degenerate face {i}: it uses the same vertices as face {seen[key]} "
@@ -259,14 +331,12 @@ class _HalfEdges:
     """Flat half-edge arrays of a polygon list whose orientation may be inconsistent."""
 
     def __init__(self, face_list: list[np.ndarray], n_vertices: int):
-        size = np.array([len(f) for f in face_list], dtype=np.int64)
-        start = np.concatenate([[0], np.cumsum(size)])
-        self.start = start
-        self.frm = np.concatenate(face_list)
-        self.to = np.concatenate([np.roll(f, -1) for f in face_list])
-        self.face = np.repeat(np.arange(len(face_list)), size)
-        local = np.arange(len(self.frm)) - start[self.face]
-        self.next = start[self.face] + (local + 1) % size[self.face]
+        fl = _Flat.of(face_list)
+        self.start = fl.start
+        self.frm = fl.index
+        self.to = fl.index[fl.next]
+        self.face = fl.face
+        self.next = fl.next
         lo = np.minimum(self.frm, self.to)
         hi = np.maximum(self.frm, self.to)
         keys, self.edge, counts = np.unique(
@@ -385,24 +455,10 @@ def _orient(he: _HalfEdges, face_list, v, face_origin) -> tuple[list[np.ndarray]
 
 
 # ------------------------------------------------------------------------ 6. coplanar merge
-def _face_normals(face_list, v) -> np.ndarray:
-    normals = np.array([_newell(v[f] - v[f].mean(axis=0)) for f in face_list])
-    return normals / np.linalg.norm(normals, axis=1)[:, None]
-
-
-def _planarity(p: np.ndarray) -> tuple[float, float]:
-    """(max distance from the Newell plane, diameter) of the polygon ``p`` (k, 3)."""
-    c = p.mean(axis=0)
-    n = _newell(p - c)
-    n = n / np.linalg.norm(n)
-    dist = float(np.abs((p - c) @ n).max())
-    diam = float(np.sqrt(((p[:, None, :] - p[None, :, :]) ** 2).sum(axis=2).max()))
-    return dist, diam
-
-
 def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
     he = _HalfEdges(face_list, len(v))
-    normal = _face_normals(face_list, v)
+    normal = _face_newell(_Flat.of(face_list), v)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
     inner = np.nonzero(he.edge_count == 2)[0]
     fa = he.face[he.edge_he0[inner]]
     fb = he.face[he.edge_he1[inner]]
@@ -420,9 +476,7 @@ def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
     members: dict[int, list[int]] = {}
     for f, g in enumerate(group.tolist()):
         members.setdefault(g, []).append(f)
-    replaced: dict[int, np.ndarray] = {}  # first face of a merged group -> merged polygon
-    dropped: set[int] = set()
-    removed = 0
+    loops: dict[int, np.ndarray] = {}  # group -> merged polygon
     for g, fs in members.items():
         if len(fs) < 2:
             continue
@@ -430,10 +484,18 @@ def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
         if loop is None:
             logger.debug("coplanar faces %s kept: boundary is not one simple loop", fs)
             continue
-        dist, diam = _planarity(v[loop])
-        if dist > tol.planar * diam:
-            logger.debug("coplanar faces %s kept: merged polygon would not be planar", fs)
-            continue
+        loops[g] = loop
+    if loops:
+        dist, diam = _face_planarity(_Flat.of(list(loops.values())), v)
+        for g, d, size in zip(list(loops), dist, diam, strict=True):
+            if d > tol.planar * size:
+                logger.debug("coplanar faces %s kept: merged polygon not planar", members[g])
+                del loops[g]
+    replaced: dict[int, np.ndarray] = {}  # first face of a merged group -> merged polygon
+    dropped: set[int] = set()
+    removed = 0
+    for g, loop in loops.items():
+        fs = members[g]
         replaced[fs[0]] = loop
         dropped.update(fs[1:])
         removed += len(fs) - 1
@@ -473,21 +535,10 @@ def _group_boundary(fs, he, group, twin_face, g) -> np.ndarray | None:
     return np.array(loop, dtype=np.int64)
 
 
-def _corner_angles(f: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """(k,) float: interior angle at each corner of polygon ``f`` (radians, reflex > pi)."""
-    p = v[f]
-    n = _newell(p - p.mean(axis=0))
-    n = n / np.linalg.norm(n)
-    nxt = np.roll(p, -1, axis=0) - p
-    prv = np.roll(p, 1, axis=0) - p
-    s = np.cross(nxt, prv) @ n
-    c = np.einsum("ij,ij->i", nxt, prv)
-    return np.mod(np.arctan2(s, c), 2 * np.pi)
-
-
 def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
     faces = [f.tolist() for f in face_list]
-    straight = [np.abs(_corner_angles(f, v) - np.pi) <= tol.angle for f in face_list]
+    fl = _Flat.of(face_list)
+    straight = fl.split(np.abs(_corner_angles(fl, v) - np.pi) <= tol.angle)
     incident: dict[int, list[int]] = {}
     edges: set[tuple[int, int]] = set()
     for i, f in enumerate(faces):
@@ -522,14 +573,13 @@ def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
 
 # ----------------------------------------------------------------------------- 7. planarity
 def _check_planar(face_list, v, face_origin) -> None:
-    for i, f in enumerate(face_list):
-        if len(f) == 3:
-            continue
-        dist, diam = _planarity(v[f])
-        if dist > tol.planar * diam:
-            k = int(face_origin[i])
-            raise MeshError(
-                f"face {k} is not planar: a vertex is {dist:.3g} from its best plane, more than "
-                f"{tol.planar:g} x its diameter {diam:.3g}",
-                face=k,
-            )
+    dist, diam = _face_planarity(_Flat.of(face_list), v)
+    bad = np.nonzero(dist > tol.planar * diam)[0]
+    if len(bad):
+        i = int(bad[0])
+        k = int(face_origin[i])
+        raise MeshError(
+            f"face {k} is not planar: a vertex is {dist[i]:.3g} from its best plane, more than "
+            f"{tol.planar:g} x its diameter {diam[i]:.3g}",
+            face=k,
+        )

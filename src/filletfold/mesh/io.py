@@ -70,7 +70,7 @@ def read_mesh(path) -> tuple[np.ndarray, list[np.ndarray]]:
         except OSError as exc:
             raise MeshReadError(f"{name}: cannot read file: {exc.strerror or exc}") from exc
         try:
-            text = data.decode("utf-8")
+            text = data.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             raise MeshReadError(
                 f"{name}: not a text {ext[1:].upper()} file (byte {exc.start} is not UTF-8)"

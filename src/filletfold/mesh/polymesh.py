@@ -194,6 +194,14 @@ class PolyMesh:
     def corner_angles(self) -> np.ndarray:
         """(n_halfedges,) float: the face angle at the tail vertex of each half-edge (radians).
 
+        Cached; see :attr:`halfedge_corner_angle`.
+        """
+        return self.halfedge_corner_angle
+
+    @cached_property
+    def halfedge_corner_angle(self) -> np.ndarray:
+        """(n_halfedges,) float: the face angle at the tail vertex of each half-edge (radians).
+
         The angle at corner ``halfedge_from[h]`` between the edge to ``halfedge_to[h]`` and the
         edge to the face's previous vertex, measured inside the face (atan2, so small angles
         keep their precision; reflex corners give angles above pi).

@@ -156,6 +156,8 @@ class VertexFrame:
         has no such face.
     T_start, T_end : (n_sides, 3) float
         Those crossing points.
+    corner_angle : (n_faces,) float
+        Face angle of each ring face at the vertex (radians; above pi at a reflex corner).
     """
 
     vertex: int
@@ -170,6 +172,7 @@ class VertexFrame:
     lmax_end: np.ndarray
     T_start: np.ndarray
     T_end: np.ndarray
+    corner_angle: np.ndarray
 
     @property
     def n_sides(self) -> int:
@@ -281,6 +284,8 @@ def vertex_frame(mesh: PolyMesh, rounding: EdgeRounding, u: int) -> VertexFrame:
         nxt = normals[i] if (ring.closed or i < nf) else None
         sides.append(build_side(mesh, rounding, u, int(e), prev, nxt))
     frames = [face_frame(mesh, int(f), U) for f in ring.faces]
+    angles = mesh.corner_angles()
+    corner_angle = np.array([angles[mesh.halfedge(u, int(q))] for q in ring.neighbors[:nf]])
     lmax_start = np.full(ne, np.nan)
     lmax_end = np.full(ne, np.nan)
     T_start = np.full((ne, 3), np.nan)
@@ -296,7 +301,7 @@ def vertex_frame(mesh: PolyMesh, rounding: EdgeRounding, u: int) -> VertexFrame:
     frame = VertexFrame(
         vertex=u, ring=ring, U=U, sides=sides, face_frames=frames, cyl_map=[None] * ne,
         face_map=[None] * nf, rho=None, lmax_start=lmax_start, lmax_end=lmax_end,
-        T_start=T_start, T_end=T_end,
+        T_start=T_start, T_end=T_end, corner_angle=corner_angle,
     )
     if ring.closed:
         current = np.eye(3)  # tau = f_{n-1}
