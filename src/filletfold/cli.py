@@ -81,6 +81,9 @@ def round_cmd(
                                        "length.")] = DEFAULT_DEPTH,
     samples: Annotated[int, typer.Option("--samples", "-n", min=3, help="Points per cylinder "
                                          "arc.")] = DEFAULT_SAMPLES,
+    clamp: Annotated[bool, typer.Option("--clamp", help="Reduce each radius over its edge's "
+                                        "limit to 90% of the limit instead of stopping.")]
+    = False,
     coplanar_tol: Annotated[float, typer.Option("--coplanar-tol", help="Merge neighbouring "
                                                 "faces within this angle (degrees).")]
     = tol.coplanar_deg,
@@ -105,7 +108,7 @@ def round_cmd(
                     tasks[stage] = bar.add_task(stage, total=total)
                 bar.update(tasks[stage], completed=done)
 
-            design = round_mesh(mesh, radius=radius, depth=depth, samples=samples,
+            design = round_mesh(mesh, radius=radius, depth=depth, samples=samples, clamp=clamp,
                                 coplanar_deg=coplanar_tol, progress=progress)
         if not quiet:
             console.print(design.summary(), highlight=False)

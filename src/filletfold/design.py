@@ -20,7 +20,7 @@ from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
 from .module import Piece, build_module, face_piece_centres
 from .pattern import CreasePattern
-from .rounding import EdgeRounding, round_edges
+from .rounding import EdgeRounding, clamp_radii, round_edges
 from .tolerances import tol
 from .vertex.apex import build_constraints, solve_apex, validate_apex
 from .vertex.frame import VertexFrame, vertex_frame
@@ -89,6 +89,8 @@ class Parameters:
         As given (absolute, ``"N%"`` of the mean edge length, or per edge / per vertex).
     samples : int
         Points per cylinder arc.
+    clamp : bool
+        Whether radii over their limit were reduced to fit.
     coplanar_deg : float
         Neighbouring faces closer than this angle are merged on input.
     """
@@ -96,6 +98,7 @@ class Parameters:
     radius: object = DEFAULT_RADIUS
     depth: object = DEFAULT_DEPTH
     samples: int = DEFAULT_SAMPLES
+    clamp: bool = False
     coplanar_deg: float = tol.coplanar_deg
 
     def as_dict(self) -> dict:
@@ -106,6 +109,7 @@ class Parameters:
             "radius": plain(self.radius),
             "depth": plain(self.depth),
             "samples": self.samples,
+            "clamp": self.clamp,
             "coplanar_deg": self.coplanar_deg,
         }
 
@@ -361,7 +365,8 @@ def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np
 
 
 def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int = DEFAULT_SAMPLES,
-               coplanar_deg: float = tol.coplanar_deg, progress=None) -> Design:
+               clamp: bool = False, coplanar_deg: float = tol.coplanar_deg,
+               progress=None) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
     Parameters
@@ -376,6 +381,9 @@ def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int
         mean edge length, per vertex, or ``{"default": ..., vertex: value}``.
     samples : int
         Points per cylinder arc (>= 3).
+    clamp : bool
+        Reduce radii over their edge's limit to 90% of it (see
+        :func:`filletfold.rounding.clamp_radii`) instead of raising.
     coplanar_deg : float
         Merge neighbouring faces whose normals differ by less than this (degrees).
     progress : callable, optional
@@ -404,13 +412,15 @@ def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
     pm, _ = load_mesh(mesh, coplanar_deg=coplanar_deg)
     timings["read"] = time.perf_counter() - t0
-    params = Parameters(radius=radius, depth=depth, samples=int(samples),
+    params = Parameters(radius=radius, depth=depth, samples=int(samples), clamp=bool(clamp),
                         coplanar_deg=coplanar_deg)
     ref = pm.mean_edge_length
 
     t = time.perf_counter()
     r = parse_length(radius, ref, "radius", count=pm.n_edges)
-    rounding = round_edges(pm, r)
+    if clamp:
+        r = clamp_radii(pm, r, flat_deg=coplanar_deg)
+    rounding = round_edges(pm, r, flat_deg=coplanar_deg)
     timings["rounding"] = time.perf_counter() - t
     depths = _resolve_depth(depth, ref, pm.n_vertices)
     centres = face_piece_centres(pm, rounding)

@@ -111,8 +111,8 @@ def edge_mismatch(pattern) -> np.ndarray:
     return l2 - l3
 
 
-def design_summary(design) -> str:
-    """A few lines for the terminal."""
+def design_summary(design, max_listed: int = 8) -> str:
+    """A few lines for the terminal (at most ``max_listed`` vertices that are not ok)."""
     mesh = design.mesh
     counts = design.status_counts()
     pat = design.pattern
@@ -135,9 +135,14 @@ def design_summary(design) -> str:
         f"{int(np.sum(pat.edge_assignment == 'V'))} valley crease segments, "
         f"max edge mismatch {edge_mismatch(pat).max(initial=0.0):.2e}"
     )
-    for u, st in enumerate(design.vertices.status):
-        if st not in ("ok", "boundary"):
-            lines.append(f"  vertex {u}: {st} - {design.vertices.reason[u]}")
+    flagged = [u for u, st in enumerate(design.vertices.status) if st not in ("ok", "boundary")]
+    for u in flagged[:max_listed]:
+        reason = design.vertices.reason[u]
+        if len(reason) > 160:
+            reason = reason[:157] + "..."
+        lines.append(f"  vertex {u}: {design.vertices.status[u]} - {reason}")
+    if len(flagged) > max_listed:
+        lines.append(f"  ... and {len(flagged) - max_listed} more (see report.json)")
     lines.append(f"time: {design.timings.get('total', 0.0):.2f} s")
     return "\n".join(lines)
 

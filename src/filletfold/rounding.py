@@ -156,6 +156,39 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
     return limit, given, broken, float(limit.min(initial=np.inf))
 
 
+def clamp_radii(mesh: PolyMesh, edge_radius, *, share: float = 0.9,
+                flat_deg: float = tol.coplanar_deg) -> np.ndarray:
+    """Reduce requested radii to valid ones, edge by edge.
+
+    Each edge keeps its request when valid; otherwise it gets ``share`` of its limit, and
+    edges whose tangent-line crossings still pass their midpoints shrink by ``share`` until
+    none does.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    edge_radius : float or (n_edges,) float
+    share : float
+        Fraction of the limit to use, in (0, 1).
+
+    Returns
+    -------
+    (n_edges,) float
+        Radii (0 at boundary and flat edges).
+    """
+    gamma, _ = edge_dihedral(mesh)
+    inner = ~mesh.is_boundary_edge & (2 * gamma >= np.radians(flat_deg))
+    r = np.where(inner, np.broadcast_to(np.asarray(edge_radius, float), (mesh.n_edges,)), 0.0)
+    limit, *_ = radius_limits(mesh, r, gamma)
+    r = np.where(r > share * limit, share * limit, r)
+    for _ in range(200):
+        _, _, broken, _ = radius_limits(mesh, r, gamma)
+        if not broken.any():
+            break
+        r[broken] *= share
+    return r
+
+
 @dataclass
 class EdgeRounding:
     """The cylinders of all edges.
@@ -244,7 +277,8 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
             f"radius {r[e]:.6g} on edge {e} (vertices {a}-{b}) exceeds its limit "
             f"{limit[e]:.6g} (beyond it the face pieces next to the edge vanish; with its "
             f"neighbours' radii it can be at most {given[e]:.6g}); {int(broken.sum())} edge(s) "
-            f"are over their limit, the largest radius valid on every edge is {uniform:.6g}",
+            f"are over their limit, the largest radius valid on every edge is {uniform:.6g} "
+            "(or let filletfold reduce each radius to fit: --clamp)",
             name="radius",
             edge=e,
         )

@@ -54,9 +54,38 @@ def max_min_direction(u: np.ndarray) -> tuple[np.ndarray, float]:
     nd = np.linalg.norm(d)
     d = d / nd if nd > 1e-12 else d0
     b = float(np.min(u @ d))
-    if b < float(np.min(u @ d0)):
-        d, b = d0, float(np.min(u @ d0))
-    return d, b
+    if b > 0:
+        return d, b
+    # no open half-space holds every u_k: the convex form degenerates (D -> 0); find the
+    # (negative) max-min on the sphere from the best of a dense set of directions
+    grid = _fibonacci_sphere(2000)
+    start = grid[np.argmax((grid @ u.T).min(axis=1))]
+    res = minimize(
+        lambda x: -x[3],
+        np.concatenate([start, [np.min(u @ start)]]),
+        jac=lambda x: np.array([0.0, 0.0, 0.0, -1.0]),
+        constraints=[
+            {"type": "ineq", "fun": lambda x: u @ x[:3] - x[3],
+             "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))])},
+            {"type": "eq", "fun": lambda x: np.array([x[:3] @ x[:3] - 1.0]),
+             "jac": lambda x: np.concatenate([2 * x[:3], [0.0]])[None]},
+        ],
+        method="SLSQP",
+        options={"ftol": 1e-15, "maxiter": 200},
+    )
+    cands = [start, res.x[:3] / np.linalg.norm(res.x[:3])]
+    vals = [float(np.min(u @ c)) for c in cands]
+    k = int(np.argmax(vals))
+    return cands[k], vals[k]
+
+
+def _fibonacci_sphere(n: int) -> np.ndarray:
+    """(n, 3) float: nearly uniform unit vectors."""
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (1 + 5**0.5) * i
+    r = np.sqrt(1 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
 def vertex_normal(edge_dirs: np.ndarray, face_normals: np.ndarray):

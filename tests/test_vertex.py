@@ -1,0 +1,177 @@
+"""Vertex classification, normals, developed and spatial apices (sec. 2.4, 2.5, 3.1, 3.2).
+
+Reference figures are the METHOD-NOTES' (edge length 1).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+from scipy.spatial import ConvexHull
+
+import filletfold
+from filletfold.mesh import load_mesh
+from filletfold.rounding import round_edges
+from filletfold.tolerances import tol
+from filletfold.vertex.apex import build_constraints, solve_apex, validate_apex
+from filletfold.vertex.frame import vertex_frame
+from filletfold.vertex.normal import max_min_direction, vertex_normal
+
+from .conftest import ALL, CLOSED_CONVEX, design_of
+
+
+def frame_of(name, r, u=0):
+    m = load_mesh(name)[0]
+    return m, vertex_frame(m, round_edges(m, r), u)
+
+
+def test_icosahedron_reference_figures():
+    m, fr = frame_of("icosahedron", 0.15)
+    D, b, sigma = vertex_normal(np.array([s.R for s in fr.sides]), m.face_normal[fr.ring.faces])
+    assert sigma == -1
+    assert_allclose(b, 0.52573, atol=5e-6)
+    assert_allclose(D, -fr.U / np.linalg.norm(fr.U), atol=1e-7)
+    assert_allclose(np.degrees(fr.rotation_angle()), -60.0, atol=1e-9)
+    w = 2 * 0.15 * (np.tan(fr.sides[0].gamma) - fr.sides[0].gamma)
+    assert_allclose(np.linalg.norm(fr.developed_apex()), w, rtol=1e-9)
+    assert_allclose(w, 0.005131, atol=5e-7)
+
+
+def test_cube_reference_figures():
+    _, fr = frame_of("cube", 0.1)
+    assert_allclose(np.degrees(fr.rotation_angle()), -90.0, atol=1e-9)
+    w = 2 * 0.1 * (np.tan(np.pi / 4) - np.pi / 4)
+    assert_allclose(np.linalg.norm(fr.developed_apex()), w / 2 * np.sqrt(2), rtol=1e-9)
+    assert_allclose(np.linalg.norm(fr.developed_apex()), 0.030349, atol=5e-7)
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_rho_turns_by_minus_the_defect(name):
+    m = load_mesh(name)[0]
+    rd = round_edges(m, "10%" and 0.1 * m.mean_edge_length)
+    for u in range(m.n_vertices):
+        fr = vertex_frame(m, rd, u)
+        if not fr.ring.closed:
+            continue
+        defect = 2 * np.pi - m.vertex_angle_sum[u]
+        turn = fr.rotation_angle()
+        assert abs(np.angle(np.exp(1j * (turn + defect)))) < 1e-9
+        v = fr.developed_apex()
+        if v is not None:  # v is the fixed point of rho
+            assert_allclose(fr.rho[:2, :2] @ v + fr.rho[:2, 2], v, atol=1e-12)
+
+
+def test_icosahedron_depth_window_projects():
+    """Depths outside the window [0.13, 0.53] (r = 0.15) are projected to its ends."""
+    m, fr = frame_of("icosahedron", 0.15)
+    D = -fr.U / np.linalg.norm(fr.U)
+    v = fr.developed_apex()
+    used = {}
+    for d in (0.05, 0.3, 0.8):
+        cons = build_constraints(fr, v, -1, 9, 0.0)
+        sol = solve_apex(cons, fr.U + d * D, [fr.U + t * D for t in (0.25, 0.5, 1.0)])
+        assert sol.ok
+        assert validate_apex(fr, sol.apex, v, -1).ok
+        used[d] = (sol.apex - fr.U) @ D
+    assert_allclose(used[0.3], 0.3, atol=1e-12)
+    assert 0.125 < used[0.05] < 0.135
+    assert 0.53 < used[0.8] < 0.54
+
+
+def test_depth_used_is_reported():
+    d = filletfold.round_mesh("icosahedron", radius=0.15, depth=0.05)
+    assert d.status_counts()["ok"] == 12
+    assert np.all(d.vertices.depth > 0.125) and np.all(d.vertices.depth < 0.145)
+    assert_allclose(d.vertices.depth_requested, 0.05)
+
+
+@pytest.mark.parametrize("depth", ["15%", "30%", "45%", "60%"])
+@pytest.mark.parametrize("name", ["icosahedron", "cube"])
+def test_done_when_all_ok_over_depths(name, depth):
+    d = design_of(name, radius="10%", depth=depth)
+    assert d.status_counts()["ok"] == d.mesh.n_vertices
+
+
+def test_saddles_are_classified():
+    for name, expect in (("l-prism", 2), ("torus", 24), ("saddle-patch", 9)):
+        d = design_of(name)
+        assert d.status_counts()["saddle"] == expect
+        for u, st_ in enumerate(d.vertices.status):
+            if st_ == "saddle":
+                assert d.vertices.normal_bound[u] <= tol.normal_bound
+                assert "saddle" in d.vertices.reason[u]
+                assert np.all(np.isnan(d.vertices.apex[u]))
+
+
+@pytest.mark.parametrize("name", CLOSED_CONVEX)
+def test_convex_solids_have_back_side_normals(name):
+    d = design_of(name)
+    assert np.all(d.vertices.sigma == -1)
+    assert np.all(d.vertices.solid_angle > 2 * np.pi)
+
+
+@pytest.mark.parametrize("name", CLOSED_CONVEX)
+def test_apices_of_convex_solids_lie_inside(name):
+    d = design_of(name)
+    m = d.mesh
+    for u in range(m.n_vertices):
+        V = d.vertices.apex[u]
+        assert d.vertices.status[u] == "ok"
+        for f, face in enumerate(m.faces):
+            assert (V - m.vertices[face[0]]) @ m.face_normal[f] < 0
+
+
+def test_boundary_vertices_are_reported():
+    d = design_of("open-box")
+    m = d.mesh
+    for u in range(m.n_vertices):
+        assert (d.vertices.status[u] == "boundary") == bool(m.is_boundary_vertex[u])
+
+
+def test_max_min_direction_matches_brute_force():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        u = rng.normal(size=(6, 3)) * 0.6 + axis
+        u /= np.linalg.norm(u, axis=1)[:, None]
+        d, b = max_min_direction(u)
+        cand = rng.normal(size=(20000, 3))
+        cand /= np.linalg.norm(cand, axis=1)[:, None]
+        assert b >= (cand @ u.T).min(axis=1).max() - 1e-6
+        assert_allclose(np.linalg.norm(d), 1.0)
+
+
+def random_convex(seed: int):
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(12, 3))
+    p /= np.linalg.norm(p, axis=1)[:, None]
+    p *= rng.uniform(0.8, 1.2, size=(12, 1)) * np.array([1.0, 1.3, 0.8])
+    hull = ConvexHull(p)
+    faces = []
+    for s, eq in zip(hull.simplices, hull.equations, strict=True):
+        a, b, c = p[s]
+        faces.append(s if np.cross(b - a, c - a) @ eq[:3] > 0 else s[::-1])
+    return p, faces
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), share=st.floats(0.2, 0.6), depth=st.floats(0.1, 0.8))
+def test_random_convex_polyhedra_every_solved_apex_is_valid(seed, share, depth):
+    """Whatever the instance, an ok vertex passes the dense check, and no vertex is a saddle."""
+    v, f = random_convex(seed)
+    m = load_mesh((v, f))[0]
+    limit = round_edges(m, 1e-3 * m.mean_edge_length).uniform_limit
+    d = filletfold.round_mesh(m, radius=share * limit, depth=depth * m.mean_edge_length)
+    assert d.status_counts()["saddle"] == 0
+    rd = d.rounding
+    for u in range(m.n_vertices):
+        if d.vertices.status[u] != "ok":
+            assert d.vertices.status[u] == "infeasible" and d.vertices.reason[u]
+            continue
+        fr = vertex_frame(d.mesh, rd, u)
+        check = validate_apex(fr, d.vertices.apex[u], fr.developed_apex(), -1, n_samples=513)
+        assert check.ok, check.failing
