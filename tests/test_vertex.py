@@ -66,7 +66,7 @@ def test_rho_turns_by_minus_the_defect(name):
 
 def test_icosahedron_depth_window_projects():
     """Depths outside the window [0.13, 0.53] (r = 0.15) are projected to its ends."""
-    m, fr = frame_of("icosahedron", 0.15)
+    _, fr = frame_of("icosahedron", 0.15)
     D = -fr.U / np.linalg.norm(fr.U)
     v = fr.developed_apex()
     used = {}

@@ -98,6 +98,7 @@ def design_report(design) -> dict:
             "faces": len(pat.faces),
             "edges": counts,
             "max_edge_mismatch": float(edge_mismatch(pat).max(initial=0.0)),
+            "max_relative_edge_mismatch": float(relative_mismatch(pat).max(initial=0.0)),
         },
         "timings": {k: float(v) for k, v in design.timings.items()},
     }
@@ -109,6 +110,13 @@ def edge_mismatch(pattern) -> np.ndarray:
     l2 = np.linalg.norm(pattern.vertices_2d[e[:, 0]] - pattern.vertices_2d[e[:, 1]], axis=1)
     l3 = np.linalg.norm(pattern.vertices_3d[e[:, 0]] - pattern.vertices_3d[e[:, 1]], axis=1)
     return l2 - l3
+
+
+def relative_mismatch(pattern) -> np.ndarray:
+    """(n_edges,) edge mismatch divided by the 2D edge length (converges with order 2)."""
+    e = pattern.edges
+    l2 = np.linalg.norm(pattern.vertices_2d[e[:, 0]] - pattern.vertices_2d[e[:, 1]], axis=1)
+    return edge_mismatch(pattern) / np.where(l2 > 0, l2, 1.0)
 
 
 def design_summary(design, max_listed: int = 8) -> str:
@@ -133,7 +141,8 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"pattern: {pat.n_pieces} pieces, {len(pat.faces)} faces, "
         f"{int(np.sum(pat.edge_assignment == 'M'))} mountain / "
         f"{int(np.sum(pat.edge_assignment == 'V'))} valley crease segments, "
-        f"max edge mismatch {edge_mismatch(pat).max(initial=0.0):.2e}"
+        f"max edge mismatch {edge_mismatch(pat).max(initial=0.0):.2e} "
+        f"(relative {relative_mismatch(pat).max(initial=0.0):.2e})"
     )
     flagged = [u for u, st in enumerate(design.vertices.status) if st not in ("ok", "boundary")]
     for u in flagged[:max_listed]:

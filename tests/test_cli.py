@@ -1,0 +1,73 @@
+"""The command line: thin front end, clear errors, no tracebacks."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from filletfold.cli import main
+
+
+def test_examples_lists_the_builtins(capsys):
+    assert main(["examples"]) == 0
+    out = capsys.readouterr().out
+    for name in ("icosahedron", "cube", "torus", "open-box"):
+        assert name in out
+
+
+def test_round_writes_the_design(tmp_path, capsys):
+    out = tmp_path / "ico"
+    assert main(["round", "icosahedron", "-o", str(out), "--radius", "0.15", "--depth",
+                 "0.3"]) == 0
+    text = capsys.readouterr().out
+    assert "12 ok" in text and "wrote 4 files" in text
+    report = json.loads((out / "report.json").read_text())
+    assert report["parameters"]["radius"] == "0.15"
+    assert report["status_counts"]["ok"] == 12
+
+
+def test_relative_radius_and_depth(tmp_path):
+    assert main(["round", "cube", "--radius", "10%", "--depth", "60%", "-o",
+                 str(tmp_path / "c")]) == 0
+    report = json.loads((tmp_path / "c" / "report.json").read_text())
+    assert report["edges"][0]["radius"] == pytest.approx(0.1)
+    assert report["vertices"][0]["depth_requested"] == pytest.approx(0.6)
+
+
+def test_dry_run_writes_nothing(tmp_path):
+    assert main(["round", "cube", "--dry-run", "-o", str(tmp_path / "x")]) == 0
+    assert not (tmp_path / "x").exists()
+
+
+def test_file_input_and_clamp(tmp_path):
+    from filletfold.mesh import example_mesh, write_obj
+
+    v, f = example_mesh("house")
+    write_obj(tmp_path / "house.obj", v, f)
+    assert main(["round", str(tmp_path / "house.obj"), "--radius", "40%", "--clamp", "-o",
+                 str(tmp_path / "h")]) == 0
+    assert (tmp_path / "h" / "design.fold").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["round", "no-such-thing"], "no such file and no built-in example"),
+        (["round", "cube", "--radius", "3"], "exceeds its limit"),
+        (["round", "cube", "--depth", "abc"], "depth must be a number"),
+    ],
+)
+def test_errors_are_one_line_with_exit_code_2(args, match, capsys, tmp_path):
+    assert main([*args, "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "error:" in err and match in " ".join(err.split())
+    assert "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_unreadable_file(tmp_path, capsys):
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nf 1 2 banana\n")
+    assert main(["round", str(bad), "-o", str(tmp_path / "o")]) == 2
+    assert "bad.obj" in capsys.readouterr().err

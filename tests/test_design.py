@@ -1,0 +1,256 @@
+"""Geometric invariants of every generated design (the core issue's checks)."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+import shapely
+from numpy.testing import assert_allclose
+
+import filletfold
+from filletfold.errors import MeshReadError, ParameterError
+from filletfold.reporting import edge_mismatch, relative_mismatch
+from filletfold.vertex.apex import crease_length
+from filletfold.vertex.frame import vertex_frame
+
+from .conftest import design_of
+
+
+def patch_faces(pattern, kind):
+    return [i for i, p in enumerate(pattern.face_patch) if p.split()[0] == kind]
+
+
+def test_contraction_everywhere(example_design):
+    """No 3D chord is longer than its flat counterpart."""
+    L = example_design.mesh.mean_edge_length
+    assert edge_mismatch(example_design.pattern).min() > -1e-12 * L
+
+
+def test_ruling_lengths_are_isometric(example_design):
+    d = example_design
+    p, m = d.pattern, d.mesh
+    e2 = lambda a, b: np.linalg.norm(p.vertices_2d[a] - p.vertices_2d[b])  # noqa: E731
+    e3 = lambda a, b: np.linalg.norm(p.vertices_3d[a] - p.vertices_3d[b])  # noqa: E731
+    apex = {tuple(np.round(d.vertices.apex[u], 12)) for u in range(m.n_vertices)}
+    checked = 0
+    for i, face in enumerate(p.faces):
+        kind, idx = p.face_patch[i].split()
+        pairs = list(zip(face, np.roll(face, -1), strict=True))
+        if kind == "face":  # flat piece: every edge and diagonal
+            pairs = [(a, b) for a in face for b in face if a < b]
+        elif kind == "cone":  # rulings from the apex
+            pairs = [(a, b) for a, b in pairs
+                     if tuple(np.round(p.vertices_3d[a], 12)) in apex
+                     or tuple(np.round(p.vertices_3d[b], 12)) in apex]
+        else:  # cylinder rulings run along the mesh edge
+            a0, b0 = m.edges[int(idx)]
+            t = m.vertices[b0] - m.vertices[a0]
+            t /= np.linalg.norm(t)
+            pairs = [(a, b) for a, b in pairs
+                     if abs(abs((p.vertices_3d[b] - p.vertices_3d[a]) @ t) - e3(a, b)) < 1e-12]
+        for a, b in pairs:
+            assert abs(e2(a, b) - e3(a, b)) < 1e-11 * m.mean_edge_length
+            checked += 1
+    assert checked > len(p.faces)
+
+
+def test_pieces_lie_on_their_planes_and_cylinders(example_design):
+    d = example_design
+    p, m, rd = d.pattern, d.mesh, d.rounding
+    for i, face in enumerate(p.faces):
+        kind, idx = p.face_patch[i].split()
+        pts = p.vertices_3d[face]
+        if kind == "face":
+            f = int(idx)
+            assert np.abs((pts - m.vertices[m.faces[f][0]]) @ m.face_normal[f]).max() < 1e-10
+        elif kind == "cylinder":
+            e = int(idx)
+            t = m.vertices[m.edges[e, 1]] - m.vertices[m.edges[e, 0]]
+            t /= np.linalg.norm(t)
+            q = pts - rd.axis_point[e]
+            dist = np.linalg.norm(q - np.outer(q @ t, t), axis=1)
+            assert_allclose(dist, rd.radius[e], atol=1e-10)
+
+
+def test_creases_are_mountains_at_back_apices_valleys_at_front(example_design):
+    """A cone whose apex lies behind the surface (sigma = -1) folds every crease as a mountain."""
+    d = example_design
+    p = d.pattern
+    cone_of = np.array([int(s.split()[1]) if s.startswith("cone") else -1 for s in p.face_patch])
+    crease = np.isin(p.edge_assignment, ["M", "V"])
+    assert np.all(np.sign(p.edge_fold_angle[crease]) == np.where(
+        p.edge_assignment[crease] == "M", -1, 1))
+    for k in np.nonzero(crease)[0]:
+        fa, fb = p.edge_faces[k]
+        u = max(cone_of[fa], cone_of[fb])
+        assert u >= 0, "every crease borders a cone"
+        assert p.edge_assignment[k] == ("M" if d.vertices.sigma[u] < 0 else "V")
+    # cylinder/face joins and facets are F with angle 0; borders are B
+    assert np.all(p.edge_fold_angle[~crease] == 0)
+    assert np.all((p.edge_assignment == "B") == (p.edge_faces < 0).any(axis=1))
+
+
+def test_no_overlap_in_the_pattern(example_design):
+    p = example_design.pattern
+    polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
+    assert all(q.is_valid and q.area > 0 for q in polys)
+    total = sum(q.area for q in polys)
+    assert shapely.union_all(polys).area == pytest.approx(total, rel=1e-9)
+
+
+def test_faces_counter_clockwise_in_2d_and_front_facing_in_3d(example_design):
+    d = example_design
+    p, m = d.pattern, d.mesh
+    normals = p.face_normal_3d()
+    for i, face in enumerate(p.faces):
+        q = p.vertices_2d[face]
+        assert np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]) > 0
+        kind, idx = p.face_patch[i].split()
+        if kind == "face":
+            assert normals[i] @ m.face_normal[int(idx)] > 1 - 1e-9
+
+
+def test_crease_loop_closes_around_every_cone(example_design):
+    d = example_design
+    p = d.pattern
+    for k in range(p.n_pieces):
+        u = p.piece_vertex[k]
+        if d.vertices.status[u] != "ok" or np.sum(p.piece_vertex == u) != 1:
+            continue
+        faces = np.nonzero(p.face_piece == k)[0]
+        sel = np.isin(p.edge_faces, faces).any(axis=1) & np.isin(p.edge_assignment, ["M", "V"])
+        deg = np.bincount(p.edges[sel].ravel(), minlength=len(p.vertices_2d))
+        ends = np.nonzero(deg == 1)[0]
+        assert set(deg[deg > 0]) <= {1, 2} and len(ends) == 2
+        # the two ends are the same point of the folded form (across the cut)
+        assert_allclose(p.vertices_3d[ends[0]], p.vertices_3d[ends[1]], atol=1e-12)
+        # and in the plane they are related by the rotation about the apex
+        apex2 = d.vertices.apex_2d[u]
+        r = np.linalg.norm(p.vertices_2d[ends] - apex2, axis=1)
+        assert_allclose(r[0], r[1], rtol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["icosahedron", "cube", "random-convex", "dimpled-cube", "house"])
+def test_tangent_continuity_at_cylinder_face_joins(name):
+    d = design_of(name)
+    m, rd = d.mesh, d.rounding
+    worst = 0.0
+    for u in range(m.n_vertices):
+        fr = vertex_frame(m, rd, u)
+        V, v = d.vertices.apex[u], d.vertices.apex_developed[u]
+        n = len(fr.sides)
+        for i, side in enumerate(fr.sides):
+            h = 1e-6 * side.arc
+            for s, nb in ((side.arc, (i + 1) % n), (0.0, i - 1)):
+                l0, _ = crease_length(fr, i, V, v, np.array([s]))
+                l1, _ = crease_length(fr, i, V, v, np.array([s - h if s else h]))
+                slope = (l0[0] - l1[0]) / (h if s else -h)
+                tangent = fr.cyl_map[i][:2, :2] @ np.array([1.0, slope])
+                # the straight crease on the neighbouring face, in the same chart
+                other = fr.sides[nb]
+                so = 0.0 if s else other.arc
+                lo, _ = crease_length(fr, nb, V, v, np.array([so]))
+                mo = fr.cyl_map[nb] if nb > i or s == 0.0 else fr.face_map[i] @ fr.gluing_start(nb)
+                if s == 0.0 and i == 0:
+                    mo = fr.cyl_map[n - 1]
+                    mo = np.linalg.inv(fr.rho) @ mo
+                p_other = mo[:2, :2] @ np.array([so, lo[0]]) + mo[:2, 2]
+                l_here, _ = crease_length(fr, i, V, v, np.array([s]))
+                p_here = fr.cyl_map[i][:2, :2] @ np.array([s, l_here[0]]) + fr.cyl_map[i][:2, 2]
+                seg = p_other - p_here
+                cos = abs(seg @ tangent) / np.linalg.norm(seg) / np.linalg.norm(tangent)
+                worst = max(worst, np.degrees(np.arccos(min(1.0, cos))))
+    assert worst < 1e-3  # degrees; finite-difference slope limits the check itself
+
+
+@pytest.mark.parametrize("name", ["icosahedron", "cube", "random-convex"])
+def test_mismatch_converges_under_refinement(name):
+    """Doubling the sampling divides the relative chord mismatch by 4 (absolute: by 8)."""
+    rel, ab = [], []
+    for n in (9, 17, 33):
+        p = design_of(name, samples=n).pattern
+        rel.append(relative_mismatch(p).max())
+        ab.append(edge_mismatch(p).max())
+    assert 3.8 < rel[0] / rel[1] < 4.2 and 3.8 < rel[1] / rel[2] < 4.2
+    assert 7.6 < ab[0] / ab[1] < 8.4 and 7.6 < ab[1] / ab[2] < 8.4
+
+
+def test_icosahedron_fold_angles_match_reference():
+    d = filletfold.round_mesh("icosahedron", radius=0.15, depth=0.3, samples=64)
+    a = d.pattern.edge_fold_angle[d.pattern.edge_assignment == "M"]
+    assert a.min() == pytest.approx(-73.18, abs=0.01)
+    assert a.max() == pytest.approx(-64.14, abs=0.01)
+
+
+def test_real_object_non_saddles_are_solved_or_reported():
+    d = design_of("blob")
+    counts = d.status_counts()
+    assert counts["saddle"] > 0 and counts["ok"] > d.mesh.n_vertices // 2
+    for u, st in enumerate(d.vertices.status):
+        assert st in ("ok", "saddle", "infeasible")
+        if st != "ok":
+            assert d.vertices.reason[u]
+
+
+def test_export_writes_the_four_files(tmp_path):
+    d = design_of("cube")
+    files = d.export(tmp_path / "out")
+    assert sorted(f.name for f in files) == ["design.fold", "folded.obj", "pattern.svg",
+                                             "report.json"]
+    fold = json.loads((tmp_path / "out" / "design.fold").read_text())
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert fold["frame_classes"] == ["creasePattern"]
+    assert len(fold["vertices_coords"][0]) == 2
+    frame = fold["file_frames"][0]
+    assert frame["frame_classes"] == ["foldedForm"] and frame["frame_parent"] == 0
+    assert frame["frame_inherit"] is True and len(frame["vertices_coords"][0]) == 3
+    n_edges, n_faces = len(report["edges"]), len(report["mesh"]["faces"])
+    for name in fold["filletfold:faces_patch"]:
+        kind, idx = re.fullmatch(r"(cone|cylinder|face) (\d+)", name).groups()
+        bound = {"cone": len(report["mesh"]["vertices"]), "cylinder": n_edges, "face": n_faces}
+        assert int(idx) < bound[kind]
+    assert report["mesh"]["vertices"] == d.mesh.vertices.tolist()
+    assert all(v["status"] == "ok" for v in report["vertices"])
+    for e in report["edges"]:
+        assert set(e) >= {"vertices", "faces", "radius", "half_angle"}
+    assert set(report["vertices"][0]) >= {"kind", "status", "normal", "apex", "apex_2d", "depth",
+                                          "margin"}
+    # same design, same bytes
+    d.export(tmp_path / "again")
+    for f in files:
+        assert (tmp_path / "again" / f.name).read_bytes() == f.read_bytes() or f.name == \
+            "report.json"
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"samples": 2}, ParameterError, "samples must be an integer >= 3"),
+        ({"radius": "abc"}, ParameterError, "radius must be a number or a percentage"),
+        ({"radius": "-5%"}, ParameterError, "radius must be positive"),
+        ({"radius": 3.0}, ParameterError, r"exceeds its limit 0\.5"),
+        ({"depth": -1}, ParameterError, "depth must be positive"),
+        ({"depth": float("nan")}, ParameterError, "depth must be finite"),
+        ({"depth": np.ones(3)}, ParameterError, r"per-element depth must have shape \(8,\)"),
+        ({"depth": {"default": 0.3, 99: 0.2}}, ParameterError, "vertex 99, which does not exist"),
+        ({"coplanar_deg": -1}, ParameterError, "coplanar tolerance"),
+    ],
+)
+def test_bad_parameters(kwargs, error, match):
+    with pytest.raises(error, match=match):
+        filletfold.round_mesh("cube", **kwargs)
+
+
+def test_unknown_mesh_name():
+    with pytest.raises(MeshReadError, match="no built-in example named 'cubee'"):
+        filletfold.round_mesh("cubee")
+
+
+def test_per_vertex_depth():
+    d = filletfold.round_mesh("cube", depth={"default": "30%", 3: 0.5})
+    assert_allclose(d.vertices.depth_requested[3], 0.5)
+    assert_allclose(d.vertices.depth[3], 0.5, atol=1e-9)
+    assert_allclose(np.delete(d.vertices.depth, 3), 0.3, atol=1e-9)
