@@ -72,8 +72,11 @@ class Piece:
             out.pop()
         if len(out) < 3:
             return
-        p = np.array([self.points_2d[i] for i in out])
-        area = 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+        area = 0.0
+        for j in range(len(out)):
+            x0, y0 = self.points_2d[out[j - 1]]
+            x1, y1 = self.points_2d[out[j]]
+            area += x0 * y1 - x1 * y0
         if area < 0:
             out = out[::-1]
         self.faces.append(out)
@@ -86,12 +89,20 @@ class Piece:
     def overlaps(self, rel: float = 1e-9) -> bool:
         """True when faces of the piece overlap in 2D (or one is not a valid polygon)."""
         p2, _ = self.arrays()
-        polys = [shapely.Polygon(p2[f]) for f in self.faces]
-        if not all(p.is_valid for p in polys):
+        polys = face_polygons(p2, self.faces)
+        if not shapely.is_valid(polys).all():
             return True
-        total = sum(p.area for p in polys)
+        total = shapely.area(polys).sum()
         union = shapely.union_all(polys).area
         return union < total * (1 - rel)
+
+
+def face_polygons(points_2d: np.ndarray, faces) -> np.ndarray:
+    """(n_faces,) shapely Polygons of faces given as index lists into ``points_2d`` (k, 2)."""
+    sizes = np.array([len(f) for f in faces])
+    idx = np.concatenate(faces)
+    rings = shapely.linearrings(points_2d[idx], indices=np.repeat(np.arange(len(faces)), sizes))
+    return shapely.polygons(rings)
 
 
 def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:

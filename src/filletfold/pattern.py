@@ -70,12 +70,21 @@ class CreasePattern:
 
     def face_normal_3d(self) -> np.ndarray:
         """(n_faces, 3) float: unit front normals of the folded faces (Newell's method)."""
-        out = np.empty((len(self.faces), 3))
-        for i, f in enumerate(self.faces):
-            p = self.vertices_3d[f]
-            n = np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0)
-            out[i] = n / np.linalg.norm(n)
-        return out
+        a, b, start = self._halfedges()
+        p = self.vertices_3d[a]
+        centre = np.add.reduceat(p, start[:-1], axis=0) / np.diff(start)[:, None]
+        offset = np.repeat(centre, np.diff(start), axis=0)
+        n = np.add.reduceat(np.cross(p - offset, self.vertices_3d[b] - offset), start[:-1], axis=0)
+        return n / np.linalg.norm(n, axis=1)[:, None]
+
+    def _halfedges(self):
+        """(from (h,), to (h,), face_start (n_faces + 1,)) of the faces' half-edges."""
+        sizes = np.array([len(f) for f in self.faces], dtype=np.int64)
+        start = np.concatenate([[0], np.cumsum(sizes)])
+        a = np.concatenate(self.faces).astype(np.int64)
+        nxt = np.arange(len(a)) + 1
+        nxt[start[1:] - 1] = start[:-1]
+        return a, a[nxt], start
 
     def _derive_edges(self):
         """Edges from faces; assignment and fold angle from the folded geometry.
@@ -86,9 +95,8 @@ class CreasePattern:
         with fold angle 0. Any other edge is a crease: M where the surface is convex seen from the
         front, V otherwise, with the fold angle between the two faces' 3D normals.
         """
-        a = np.concatenate(self.faces)
-        b = np.concatenate([np.roll(f, -1) for f in self.faces])
-        face_of = np.repeat(np.arange(len(self.faces)), [len(f) for f in self.faces])
+        a, b, start = self._halfedges()
+        face_of = np.repeat(np.arange(len(self.faces)), np.diff(start))
         lo, hi = np.minimum(a, b), np.maximum(a, b)
         n = len(self.vertices_2d)
         key = lo * n + hi
