@@ -175,3 +175,59 @@ def test_random_convex_polyhedra_every_solved_apex_is_valid(seed, share, depth):
         fr = vertex_frame(d.mesh, rd, u)
         check = validate_apex(fr, d.vertices.apex[u], fr.developed_apex(), -1, n_samples=513)
         assert check.ok, check.failing
+
+
+def folded_degree4_vertex(a=(1.2, 1.9), t=0.6):
+    """Four triangles around one interior vertex whose angles sum to 2 pi, folded in 3D."""
+    a1, a2 = a
+    a3, a4 = np.pi - a1, np.pi - a2  # Kawasaki-like choice; the sum is 2 pi
+    d0 = np.array([1.0, 0, 0])
+    d1 = np.array([np.cos(a1), np.sin(a1), 0])
+    n1 = np.array([-np.sin(a1), np.cos(a1), 0])
+    d2 = np.cos(a2) * d1 + np.sin(a2) * (np.cos(t) * n1 + np.sin(t) * np.array([0, 0, 1.0]))
+    g = np.array([[1, d0 @ d2], [d0 @ d2, 1]])
+    x, y = np.linalg.solve(g, [np.cos(a4), np.cos(a3)])
+    inplane = x * d0 + y * d2
+    z = np.sqrt(1 - inplane @ inplane)
+    n = np.cross(d2, d0)
+    d3 = inplane + z * n / np.linalg.norm(n)
+    v = np.vstack([[0, 0, 0], d0, d1, d2, d3])
+    f = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]]
+    return v, f
+
+
+def test_developable_vertex_is_detected_and_reported():
+    v, f = folded_degree4_vertex()
+    m = load_mesh((v, f))[0]
+    u = int(np.argmin(np.linalg.norm(m.vertices, axis=1)))
+    assert abs(m.vertex_angle_sum[u] - 2 * np.pi) < 1e-12
+    d = filletfold.round_mesh(m, radius="2%")
+    assert d.vertices.status[u] == "developable"
+    assert "material loss" in d.vertices.reason[u]
+    assert np.all(np.isnan(d.vertices.apex[u]))
+    # its module still exists, without a cone, and the pattern stays valid
+    assert u in d.pattern.piece_vertex
+    assert not any(p == f"cone {u}" for p in d.pattern.face_patch)
+
+
+def test_crease_through_T_gives_a_clean_module():
+    """At l = l_max the straight crease on a face has zero length (METHOD-NOTES 11)."""
+    from filletfold.module import build_module, face_piece_centres, face_polygons
+    from filletfold.vertex.apex import crease_length
+
+    m = load_mesh("icosahedron")[0]
+    rd = round_edges(m, 0.15)
+    fr = vertex_frame(m, rd, 0)
+    v = fr.developed_apex()
+    D = -fr.U / np.linalg.norm(fr.U)
+    sol = solve_apex(build_constraints(fr, v, -1, 9, 0.0), fr.U + 0.02 * D,
+                     [fr.U + t * D for t in (0.2, 0.5)])
+    l_end, _ = crease_length(fr, 0, sol.apex, v, np.array([fr.sides[0].arc]))
+    assert_allclose(l_end[0], fr.lmax_end[0], rtol=1e-9)
+    pieces = build_module(m, fr, face_piece_centres(m, rd), 24, sol.apex, v)
+    assert len(pieces) == 1
+    p2, _ = pieces[0].arrays()
+    polys = face_polygons(p2, pieces[0].faces)
+    assert np.all([q.is_valid for q in polys]) and min(q.area for q in polys) > 1e-6
+    used = {i for f in pieces[0].faces for i in f}
+    assert used == set(range(len(p2)))

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
+from scipy.spatial import cKDTree
 
 from .errors import MeshError
 from .mesh.polymesh import PolyMesh
@@ -62,8 +63,11 @@ class Piece:
             self.points_3d.append(np.asarray(p3, dtype=float).reshape(3))
         return self._keys[key]
 
-    def face(self, idx, patch: str):
-        """Add a polygon (duplicate consecutive indices dropped), made counter-clockwise."""
+    def face(self, idx, patch: str, min_area: float = 0.0):
+        """Add a polygon (duplicate consecutive indices dropped), made counter-clockwise.
+
+        A polygon with fewer than 3 distinct corners or twice-area ``<= 2 min_area`` is dropped.
+        """
         out = []
         for i in idx:
             if not out or out[-1] != i:
@@ -77,10 +81,49 @@ class Piece:
             x0, y0 = self.points_2d[out[j - 1]]
             x1, y1 = self.points_2d[out[j]]
             area += x0 * y1 - x1 * y0
+        if abs(area) <= 2 * min_area:
+            return
         if area < 0:
             out = out[::-1]
         self.faces.append(out)
         self.patches.append(patch)
+
+    def merge_coincident(self, eps: float) -> None:
+        """Merge points that coincide in 2D and 3D (within ``eps``); drop faces that vanish.
+
+        This happens where a crease runs exactly through a tangent-line crossing T
+        (``l = l_max``, METHOD-NOTES 11): the straight crease on the face has zero length.
+        """
+        p2, p3 = self.arrays()
+        pairs = cKDTree(p2).query_pairs(eps, output_type="ndarray")
+        if len(pairs) == 0:
+            return
+        pairs = pairs[np.linalg.norm(p3[pairs[:, 0]] - p3[pairs[:, 1]], axis=1) < eps]
+        root = np.arange(len(p2))
+        for a, b in sorted(map(tuple, pairs)):
+            ra, rb = root[a], root[b]
+            while root[ra] != ra:
+                ra = root[ra]
+            while root[rb] != rb:
+                rb = root[rb]
+            root[max(ra, rb)] = min(ra, rb)
+        for i in range(len(root)):
+            r = i
+            while root[r] != r:
+                r = root[r]
+            root[i] = r
+        faces, patches = self.faces, self.patches
+        self.faces, self.patches = [], []
+        for f, patch in zip(faces, patches, strict=True):
+            self.face([int(root[i]) for i in f], patch, min_area=eps * eps)
+        used = sorted({i for f in self.faces for i in f})
+        new = {old: k for k, old in enumerate(used)}
+        self.points_2d = [self.points_2d[i] for i in used]
+        self.points_3d = [self.points_3d[i] for i in used]
+        self.faces = [[new[i] for i in f] for f in self.faces]
+        self._keys = {k: new[root[i]] for k, i in self._keys.items() if root[i] in new}
+        if self.apex_index is not None:
+            self.apex_index = new.get(int(root[self.apex_index]))
 
     def arrays(self):
         """(points_2d (k, 2), points_3d (k, 3))."""
@@ -320,4 +363,5 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
         piece.face(corner, f"face {face}")
         if apex is not None:
             piece.face([piece.apex_index, t0, t1], f"cone {u}")
+    piece.merge_coincident(1e-9 * min(s.length for s in frame.sides))
     return piece
