@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import pytest
+from scipy.spatial import ConvexHull
 
 import filletfold
 from filletfold.mesh import EXAMPLES, example_names
@@ -22,3 +24,17 @@ def design_of(name: str, radius="10%", depth="30%", samples: int = 24) -> fillet
 @pytest.fixture(params=ALL)
 def example_design(request) -> filletfold.Design:
     return design_of(request.param)
+
+
+def random_convex(seed: int):
+    """A random convex polyhedron (triangles, outward) from ``seed``."""
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(12, 3))
+    p /= np.linalg.norm(p, axis=1)[:, None]
+    p *= rng.uniform(0.8, 1.2, size=(12, 1)) * np.array([1.0, 1.3, 0.8])
+    hull = ConvexHull(p)
+    faces = []
+    for s, eq in zip(hull.simplices, hull.equations, strict=True):
+        a, b, c = p[s]
+        faces.append(s if np.cross(b - a, c - a) @ eq[:3] > 0 else s[::-1])
+    return p, faces

@@ -8,28 +8,33 @@ import re
 import numpy as np
 import pytest
 import shapely
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 import filletfold
 from filletfold.errors import MeshReadError, ParameterError
 from filletfold.reporting import edge_mismatch, relative_mismatch
+from filletfold.rounding import round_edges
 from filletfold.vertex.apex import crease_length
 from filletfold.vertex.frame import vertex_frame
 
-from .conftest import design_of
+from .conftest import design_of, random_convex
 
 
 def patch_faces(pattern, kind):
     return [i for i, p in enumerate(pattern.face_patch) if p.split()[0] == kind]
 
 
-def test_contraction_everywhere(example_design):
+def check_contraction_everywhere(d):
+    example_design = d
     """No 3D chord is longer than its flat counterpart."""
     L = example_design.mesh.mean_edge_length
     assert edge_mismatch(example_design.pattern).min() > -1e-12 * L
 
 
-def test_ruling_lengths_are_isometric(example_design):
+def check_ruling_lengths_are_isometric(d):
+    example_design = d
     d = example_design
     p, m = d.pattern, d.mesh
     e2 = lambda a, b: np.linalg.norm(p.vertices_2d[a] - p.vertices_2d[b])  # noqa: E731
@@ -57,7 +62,8 @@ def test_ruling_lengths_are_isometric(example_design):
     assert checked > len(p.faces)
 
 
-def test_pieces_lie_on_their_planes_and_cylinders(example_design):
+def check_pieces_lie_on_their_planes_and_cylinders(d):
+    example_design = d
     d = example_design
     p, m, rd = d.pattern, d.mesh, d.rounding
     for i, face in enumerate(p.faces):
@@ -75,7 +81,8 @@ def test_pieces_lie_on_their_planes_and_cylinders(example_design):
             assert_allclose(dist, rd.radius[e], atol=1e-10)
 
 
-def test_creases_are_mountains_at_back_apices_valleys_at_front(example_design):
+def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
+    example_design = d
     """A cone whose apex lies behind the surface (sigma = -1) folds every crease as a mountain."""
     d = example_design
     p = d.pattern
@@ -93,7 +100,8 @@ def test_creases_are_mountains_at_back_apices_valleys_at_front(example_design):
     assert np.all((p.edge_assignment == "B") == (p.edge_faces < 0).any(axis=1))
 
 
-def test_no_overlap_in_the_pattern(example_design):
+def check_no_overlap_in_the_pattern(d):
+    example_design = d
     p = example_design.pattern
     polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
     assert all(q.is_valid and q.area > 0 for q in polys)
@@ -101,7 +109,8 @@ def test_no_overlap_in_the_pattern(example_design):
     assert shapely.union_all(polys).area == pytest.approx(total, rel=1e-9)
 
 
-def test_faces_counter_clockwise_in_2d_and_front_facing_in_3d(example_design):
+def check_faces_counter_clockwise_in_2d_and_front_facing_in_3d(d):
+    example_design = d
     d = example_design
     p, m = d.pattern, d.mesh
     normals = p.face_normal_3d()
@@ -113,7 +122,8 @@ def test_faces_counter_clockwise_in_2d_and_front_facing_in_3d(example_design):
             assert normals[i] @ m.face_normal[int(idx)] > 1 - 1e-9
 
 
-def test_crease_loop_closes_around_every_cone(example_design):
+def check_crease_loop_closes_around_every_cone(d):
+    example_design = d
     d = example_design
     p = d.pattern
     for k in range(p.n_pieces):
@@ -131,6 +141,32 @@ def test_crease_loop_closes_around_every_cone(example_design):
         apex2 = d.vertices.apex_2d[u]
         r = np.linalg.norm(p.vertices_2d[ends] - apex2, axis=1)
         assert_allclose(r[0], r[1], rtol=1e-9)
+
+
+CHECKS = [check_contraction_everywhere, check_ruling_lengths_are_isometric,
+          check_pieces_lie_on_their_planes_and_cylinders,
+          check_creases_are_mountains_at_back_apices_valleys_at_front,
+          check_no_overlap_in_the_pattern,
+          check_faces_counter_clockwise_in_2d_and_front_facing_in_3d,
+          check_crease_loop_closes_around_every_cone]
+
+
+@pytest.mark.parametrize("check", CHECKS, ids=lambda c: c.__name__[6:])
+def test_invariants_on_every_example(example_design, check):
+    check(example_design)
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), share=st.floats(0.15, 0.7), depth=st.floats(0.1, 1.0),
+       samples=st.integers(3, 30))
+def test_invariants_on_generated_meshes(seed, share, depth, samples):
+    """Random convex polyhedra, radii, depths and samplings: every invariant holds."""
+    v, f = random_convex(seed)
+    m = filletfold.load_mesh((v, f))[0]
+    d = filletfold.round_mesh(m, radius=share * round_edges(m, 1e-3).uniform_limit,
+                              depth=depth * m.mean_edge_length, samples=samples)
+    for check in CHECKS:
+        check(d)
 
 
 @pytest.mark.parametrize("name", ["icosahedron", "cube", "random-convex", "dimpled-cube", "house"])
@@ -189,9 +225,9 @@ def test_real_object_non_saddles_are_solved_or_reported():
     d = design_of("blob")
     counts = d.status_counts()
     assert counts["saddle"] > 0 and counts["ok"] > d.mesh.n_vertices // 2
-    for u, st in enumerate(d.vertices.status):
-        assert st in ("ok", "saddle", "infeasible")
-        if st != "ok":
+    for u, status in enumerate(d.vertices.status):
+        assert status in ("ok", "saddle", "infeasible")
+        if status != "ok":
             assert d.vertices.reason[u]
 
 

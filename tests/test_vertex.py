@@ -10,7 +10,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
-from scipy.spatial import ConvexHull
 
 import filletfold
 from filletfold.mesh import load_mesh
@@ -20,7 +19,7 @@ from filletfold.vertex.apex import build_constraints, solve_apex, validate_apex
 from filletfold.vertex.frame import vertex_frame
 from filletfold.vertex.normal import max_min_direction, vertex_normal
 
-from .conftest import ALL, CLOSED_CONVEX, design_of
+from .conftest import ALL, CLOSED_CONVEX, design_of, random_convex
 
 
 def frame_of(name, r, u=0):
@@ -143,19 +142,6 @@ def test_max_min_direction_matches_brute_force():
         cand /= np.linalg.norm(cand, axis=1)[:, None]
         assert b >= (cand @ u.T).min(axis=1).max() - 1e-6
         assert_allclose(np.linalg.norm(d), 1.0)
-
-
-def random_convex(seed: int):
-    rng = np.random.default_rng(seed)
-    p = rng.normal(size=(12, 3))
-    p /= np.linalg.norm(p, axis=1)[:, None]
-    p *= rng.uniform(0.8, 1.2, size=(12, 1)) * np.array([1.0, 1.3, 0.8])
-    hull = ConvexHull(p)
-    faces = []
-    for s, eq in zip(hull.simplices, hull.equations, strict=True):
-        a, b, c = p[s]
-        faces.append(s if np.cross(b - a, c - a) @ eq[:3] > 0 else s[::-1])
-    return p, faces
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
