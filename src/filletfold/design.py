@@ -7,7 +7,6 @@ lay them out, and derive the crease pattern.
 
 from __future__ import annotations
 
-import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,17 +21,13 @@ from .module import Piece, build_module, face_piece_centres
 from .pattern import CreasePattern
 from .rounding import EdgeRounding, clamp_radii, round_edges
 from .tolerances import tol
-from .vertex.apex import build_constraints, solve_apex, validate_apex
-from .vertex.frame import VertexFrame, vertex_frame
-from .vertex.normal import is_developable, solid_angle_front, vertex_normal
+from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_vertex_apex
 
-log = logging.getLogger(__name__)
 
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
 
-STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
 
 
 def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:
@@ -115,64 +110,6 @@ class Parameters:
 
 
 @dataclass
-class VertexResult:
-    """Per-vertex results, arrays over all mesh vertices.
-
-    Attributes
-    ----------
-    kind : list of str
-        ``"cone"``, ``"saddle"``, ``"developable"`` or ``"boundary"``.
-    status : list of str
-        ``"ok"``, ``"saddle"``, ``"infeasible"``, ``"boundary"`` or ``"developable"``.
-    reason : list of str or None
-    angle_sum, defect, solid_angle : (n,) float
-    normal : (n, 3) float
-        Vertex normal ``D`` (NaN at boundary vertices).
-    normal_bound : (n,) float
-        The max-min value ``b`` of sec. 3.1.
-    sigma : (n,) int
-    depth_requested, depth : (n,) float
-        ``d`` asked for and ``(V - U) . D`` actually used (NaN without apex).
-    apex : (n, 3) float
-        Spatial apex V (NaN without cone).
-    apex_developed : (n, 2) float
-        Developed apex in the vertex's own frame (NaN where undefined).
-    apex_2d : (n, 2) float
-        Apex position in the crease pattern layout.
-    margin : (n,) float
-        Smallest slack of the dense validation (length units).
-    """
-
-    kind: list
-    status: list
-    reason: list
-    angle_sum: np.ndarray
-    defect: np.ndarray
-    solid_angle: np.ndarray
-    normal: np.ndarray
-    normal_bound: np.ndarray
-    sigma: np.ndarray
-    depth_requested: np.ndarray
-    depth: np.ndarray
-    apex: np.ndarray
-    apex_developed: np.ndarray
-    apex_2d: np.ndarray
-    margin: np.ndarray
-
-    @classmethod
-    def empty(cls, n: int) -> VertexResult:
-        nan = np.full(n, np.nan)
-        return cls(
-            kind=[""] * n, status=[""] * n, reason=[None] * n, angle_sum=nan.copy(),
-            defect=nan.copy(), solid_angle=nan.copy(), normal=np.full((n, 3), np.nan),
-            normal_bound=nan.copy(), sigma=np.zeros(n, dtype=np.int64),
-            depth_requested=nan.copy(), depth=nan.copy(), apex=np.full((n, 3), np.nan),
-            apex_developed=np.full((n, 2), np.nan), apex_2d=np.full((n, 2), np.nan),
-            margin=nan.copy(),
-        )
-
-
-@dataclass
 class Design:
     """A curved-crease design: the cleaned mesh, its rounding, vertex results and pattern.
 
@@ -247,86 +184,6 @@ def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
         return out
     d = parse_length(depth, reference, "depth", count=n)
     return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
-
-
-def solve_vertex(mesh: PolyMesh, rounding: EdgeRounding, u: int, depth: float,
-                 res: VertexResult) -> tuple[VertexFrame, np.ndarray | None, np.ndarray | None]:
-    """Classify vertex ``u``, find its normal and apices; fill ``res`` at ``u``.
-
-    Returns
-    -------
-    frame : VertexFrame
-    apex : (3,) float or None
-        Spatial apex when the vertex gets a cone.
-    dev_apex : (2,) float or None
-    """
-    frame = vertex_frame(mesh, rounding, u)
-    ring = frame.ring
-    res.angle_sum[u] = mesh.vertex_angle_sum[u]
-    res.defect[u] = 2 * np.pi - res.angle_sum[u]
-    res.depth_requested[u] = depth
-    if not ring.closed:
-        res.kind[u] = res.status[u] = "boundary"
-        res.reason[u] = "boundary vertex: no cone; its module ends at the sheet's edge"
-        return frame, None, None
-    kappa = rounding.kappa[ring.edges]
-    res.solid_angle[u] = solid_angle_front(kappa, rounding.half_angle[ring.edges])
-    edge_dirs = np.array([s.R for s in frame.sides])
-    D, b, sigma = vertex_normal(edge_dirs, mesh.face_normal[ring.faces])
-    res.normal[u], res.normal_bound[u], res.sigma[u] = D, b, sigma
-    if is_developable(res.angle_sum[u]):
-        res.kind[u] = res.status[u] = "developable"
-        res.reason[u] = ("developable vertex (angle sum 2 pi): its development closes; it needs "
-                         "consistent material loss (not solved here)")
-        return frame, None, None
-    if b <= tol.normal_bound:
-        res.kind[u] = res.status[u] = "saddle"
-        res.reason[u] = (f"saddle vertex: no plane through it has all its faces on one side "
-                         f"(max-min bound {b:.3g} <= 0); no cone possible")
-        return frame, None, None
-    res.kind[u] = "cone"
-    v = frame.developed_apex()
-    if v is None:
-        res.status[u] = "infeasible"
-        res.reason[u] = "the development does not turn (rho is a translation): no developed apex"
-        return frame, None, None
-    res.apex_developed[u] = v
-    if np.any(frame.corner_angle > np.pi):
-        res.status[u] = "infeasible"
-        res.reason[u] = "a face has a reflex corner at this vertex: the straight crease on it " \
-            "would leave the face"
-        return frame, None, None
-    U = frame.U
-    lengths = np.array([s.length for s in frame.sides])
-    target = U + depth * D
-    starts = [U + t * lengths.mean() * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
-    margin = tol.margin * lengths.min()
-    low = np.fmin(frame.lmax_start, frame.lmax_end).min()
-    if not low > 0:
-        res.status[u] = "infeasible"
-        res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
-        return frame, None, None
-    failing = []
-    for n_samples, scale in ((9, 1.0), (33, 2.0), (65, 4.0)):
-        m = min(margin * scale, 0.25 * low)
-        cons = build_constraints(frame, v, sigma, n_samples, m)
-        sol = solve_apex(cons, target, starts)
-        if not sol.ok:
-            failing = sol.failing
-            break
-        check = validate_apex(frame, sol.apex, v, sigma)
-        if check.ok:
-            res.status[u] = "ok"
-            res.apex[u] = sol.apex
-            res.depth[u] = float((sol.apex - U) @ D)
-            res.margin[u] = check.margin
-            return frame, sol.apex, v
-        failing = check.failing
-    res.status[u] = "infeasible"
-    res.reason[u] = "no apex meets every constraint: " + "; ".join(failing[:6])
-    if len(failing) > 6:
-        res.reason[u] += f"; and {len(failing) - 6} more"
-    return frame, None, None
 
 
 def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np.ndarray]:
@@ -427,9 +284,15 @@ def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int
 
     t = time.perf_counter()
     res = VertexResult.empty(pm.n_vertices)
+    frames = [classify_vertex(pm, rounding, u, res) for u in range(pm.n_vertices)]
+    timings["normals"] = time.perf_counter() - t
+
+    t = time.perf_counter()
     solved = []
-    for u in range(pm.n_vertices):
-        solved.append(solve_vertex(pm, rounding, u, float(depths[u]), res))
+    for u, frame in enumerate(frames):
+        apex, v = (solve_vertex_apex(frame, float(depths[u]), res) if res.status[u] == ""
+                   else (None, None))
+        solved.append((frame, apex, v))
         if progress is not None:
             progress("apices", u + 1, pm.n_vertices)
     timings["apices"] = time.perf_counter() - t

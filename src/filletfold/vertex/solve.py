@@ -1,0 +1,177 @@
+"""Per-vertex stages: classification, vertex normal, apices (paper sec. 2.4-3.2).
+
+:class:`VertexResult` holds the per-vertex results of a design as arrays; the functions here
+fill it one vertex at a time.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mesh.polymesh import PolyMesh
+from ..rounding import EdgeRounding
+from ..tolerances import tol
+from .apex import build_constraints, solve_apex, validate_apex
+from .frame import VertexFrame, vertex_frame
+from .normal import is_developable, solid_angle_front, vertex_normal
+
+STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
+
+
+@dataclass
+class VertexResult:
+    """Per-vertex results, arrays over all mesh vertices.
+
+    Attributes
+    ----------
+    kind : list of str
+        ``"cone"``, ``"saddle"``, ``"developable"`` or ``"boundary"``.
+    status : list of str
+        ``"ok"``, ``"saddle"``, ``"infeasible"``, ``"boundary"`` or ``"developable"``.
+    reason : list of str or None
+    angle_sum, defect, solid_angle : (n,) float
+    normal : (n, 3) float
+        Vertex normal ``D`` (NaN at boundary vertices).
+    normal_bound : (n,) float
+        The max-min value ``b`` of sec. 3.1.
+    sigma : (n,) int
+    depth_requested, depth : (n,) float
+        ``d`` asked for and ``(V - U) . D`` actually used (NaN without apex).
+    apex : (n, 3) float
+        Spatial apex V (NaN without cone).
+    apex_developed : (n, 2) float
+        Developed apex in the vertex's own frame (NaN where undefined).
+    apex_2d : (n, 2) float
+        Apex position in the crease pattern layout.
+    margin : (n,) float
+        Smallest slack of the dense validation (length units).
+    """
+
+    kind: list
+    status: list
+    reason: list
+    angle_sum: np.ndarray
+    defect: np.ndarray
+    solid_angle: np.ndarray
+    normal: np.ndarray
+    normal_bound: np.ndarray
+    sigma: np.ndarray
+    depth_requested: np.ndarray
+    depth: np.ndarray
+    apex: np.ndarray
+    apex_developed: np.ndarray
+    apex_2d: np.ndarray
+    margin: np.ndarray
+
+    @classmethod
+    def empty(cls, n: int) -> VertexResult:
+        nan = np.full(n, np.nan)
+        return cls(
+            kind=[""] * n, status=[""] * n, reason=[None] * n, angle_sum=nan.copy(),
+            defect=nan.copy(), solid_angle=nan.copy(), normal=np.full((n, 3), np.nan),
+            normal_bound=nan.copy(), sigma=np.zeros(n, dtype=np.int64),
+            depth_requested=nan.copy(), depth=nan.copy(), apex=np.full((n, 3), np.nan),
+            apex_developed=np.full((n, 2), np.nan), apex_2d=np.full((n, 2), np.nan),
+            margin=nan.copy(),
+        )
+
+
+
+def classify_vertex(mesh: PolyMesh, rounding: EdgeRounding, u: int,
+                    res: VertexResult) -> VertexFrame:
+    """Build vertex ``u``'s frame, classify it and find its normal (sec. 2.5, 3.1).
+
+    Fills ``res`` at ``u``: angle sum, defect, solid angle, normal, bound, sigma, kind, and the
+    status for every vertex that cannot get a cone (``status`` stays ``""`` otherwise).
+
+    Returns
+    -------
+    VertexFrame
+    """
+    frame = vertex_frame(mesh, rounding, u)
+    ring = frame.ring
+    res.angle_sum[u] = mesh.vertex_angle_sum[u]
+    res.defect[u] = 2 * np.pi - res.angle_sum[u]
+    if not ring.closed:
+        res.kind[u] = res.status[u] = "boundary"
+        res.reason[u] = "boundary vertex: no cone; its module ends at the sheet's edge"
+        return frame
+    kappa = rounding.kappa[ring.edges]
+    res.solid_angle[u] = solid_angle_front(kappa, rounding.half_angle[ring.edges])
+    edge_dirs = np.array([s.R for s in frame.sides])
+    D, b, sigma = vertex_normal(edge_dirs, mesh.face_normal[ring.faces])
+    res.normal[u], res.normal_bound[u], res.sigma[u] = D, b, sigma
+    if is_developable(res.angle_sum[u]):
+        res.kind[u] = res.status[u] = "developable"
+        res.reason[u] = ("developable vertex (angle sum 2 pi): its development closes; it needs "
+                         "consistent material loss (not solved here)")
+        return frame
+    if b <= tol.normal_bound:
+        res.kind[u] = res.status[u] = "saddle"
+        res.reason[u] = (f"saddle vertex: no plane through it has all its faces on one side "
+                         f"(max-min bound {b:.3g} <= 0); no cone possible")
+        return frame
+    res.kind[u] = "cone"
+    return frame
+
+
+def solve_vertex_apex(frame: VertexFrame, depth: float,
+                      res: VertexResult) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Developed and spatial apex of a cone vertex (sec. 2.4, 3.2), validated densely.
+
+    Sets ``res.status`` to ``ok`` (with apex, depth used and margin) or ``infeasible`` (with
+    the constraints that fail) at the frame's vertex.
+
+    Returns
+    -------
+    apex : (3,) float or None
+    dev_apex : (2,) float or None
+        Developed apex in the vertex's common 2D frame.
+    """
+    u = frame.vertex
+    res.depth_requested[u] = depth
+    D, sigma = res.normal[u], int(res.sigma[u])
+    v = frame.developed_apex()
+    if v is None:
+        res.status[u] = "infeasible"
+        res.reason[u] = "the development does not turn (rho is a translation): no developed apex"
+        return None, None
+    res.apex_developed[u] = v
+    if np.any(frame.corner_angle > np.pi):
+        res.status[u] = "infeasible"
+        res.reason[u] = "a face has a reflex corner at this vertex: the straight crease on it " \
+            "would leave the face"
+        return None, None
+    U = frame.U
+    lengths = np.array([s.length for s in frame.sides])
+    target = U + depth * D
+    starts = [U + t * lengths.mean() * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
+    margin = tol.margin * lengths.min()
+    low = np.fmin(frame.lmax_start, frame.lmax_end).min()
+    if not low > 0:
+        res.status[u] = "infeasible"
+        res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
+        return None, None
+    failing = []
+    for n_samples, scale in ((9, 1.0), (33, 2.0), (65, 4.0)):
+        m = min(margin * scale, 0.25 * low)
+        cons = build_constraints(frame, v, sigma, n_samples, m)
+        sol = solve_apex(cons, target, starts)
+        if not sol.ok:
+            failing = sol.failing
+            break
+        check = validate_apex(frame, sol.apex, v, sigma)
+        if check.ok:
+            res.status[u] = "ok"
+            res.apex[u] = sol.apex
+            res.depth[u] = float((sol.apex - U) @ D)
+            res.margin[u] = check.margin
+            return sol.apex, v
+        failing = check.failing
+    res.status[u] = "infeasible"
+    res.reason[u] = "no apex meets every constraint: " + "; ".join(failing[:6])
+    if len(failing) > 6:
+        res.reason[u] += f"; and {len(failing) - 6} more"
+    return None, None
