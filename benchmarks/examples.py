@@ -34,9 +34,11 @@ def machine() -> str:
                     break
     except OSError:
         pass
-    return (f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores, {cpu}; "
-            f"Python {platform.python_version()}, numpy {np.__version__}, "
-            f"filletfold {filletfold.__version__}")
+    return (
+        f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores, {cpu}; "
+        f"Python {platform.python_version()}, numpy {np.__version__}, "
+        f"filletfold {filletfold.__version__}"
+    )
 
 
 def main(argv=None) -> int:
@@ -50,22 +52,25 @@ def main(argv=None) -> int:
     print(f"# machine: {machine()}")
     print(f"# command: {' '.join([os.path.basename(sys.executable), *sys.argv])}")
     print(f"# radius {args.radius}, depth {args.depth}, median of {args.repeat} runs")
-    head = (f"{'example':22s} {'V':>4s} {'ok':>4s} {'sad':>4s} {'inf':>4s} {'bnd':>4s} "
-            f"{'dev':>4s} {'pieces':>6s} {'mismatch':>9s} {'relative':>9s} {'time s':>7s}")
+    head = (
+        f"{'example':22s} {'V':>4s} {'ok':>4s} {'sad':>4s} {'inf':>4s} {'bnd':>4s} "
+        f"{'dev':>4s} {'pieces':>6s} {'mismatch':>9s} {'relative':>9s} {'time s':>7s}"
+    )
     print(head)
     for name in args.names or example_names():
         times = []
         for _ in range(args.repeat):
             t = time.perf_counter()
-            d = filletfold.round_mesh(name, radius=args.radius, depth=args.depth,
-                                      clamp=args.clamp)
+            d = filletfold.round_mesh(name, radius=args.radius, depth=args.depth, clamp=args.clamp)
             times.append(time.perf_counter() - t)
         c = d.status_counts()
         p = d.pattern
-        print(f"{name:22s} {d.mesh.n_vertices:4d} {c['ok']:4d} {c['saddle']:4d} "
-              f"{c['infeasible']:4d} {c['boundary']:4d} {c['developable']:4d} "
-              f"{p.n_pieces:6d} {edge_mismatch(p).max():9.2e} "
-              f"{relative_mismatch(p).max():9.2e} {statistics.median(times):7.3f}")
+        print(
+            f"{name:22s} {d.mesh.n_vertices:4d} {c['ok']:4d} {c['saddle']:4d} "
+            f"{c['infeasible']:4d} {c['boundary']:4d} {c['developable']:4d} "
+            f"{p.n_pieces:6d} {edge_mismatch(p).max():9.2e} "
+            f"{relative_mismatch(p).max():9.2e} {statistics.median(times):7.3f}"
+        )
     return 0
 
 

@@ -18,8 +18,7 @@ def test_examples_lists_the_builtins(capsys):
 
 def test_round_writes_the_design(tmp_path, capsys):
     out = tmp_path / "ico"
-    assert main(["round", "icosahedron", "-o", str(out), "--radius", "0.15", "--depth",
-                 "0.3"]) == 0
+    assert main(["round", "icosahedron", "-o", str(out), "--radius", "0.15", "--depth", "0.3"]) == 0
     text = capsys.readouterr().out
     assert "12 ok" in text and "wrote 4 files" in text
     report = json.loads((out / "report.json").read_text())
@@ -28,8 +27,9 @@ def test_round_writes_the_design(tmp_path, capsys):
 
 
 def test_relative_radius_and_depth(tmp_path):
-    assert main(["round", "cube", "--radius", "10%", "--depth", "60%", "-o",
-                 str(tmp_path / "c")]) == 0
+    assert (
+        main(["round", "cube", "--radius", "10%", "--depth", "60%", "-o", str(tmp_path / "c")]) == 0
+    )
     report = json.loads((tmp_path / "c" / "report.json").read_text())
     assert report["edges"][0]["radius"] == pytest.approx(0.1)
     assert report["vertices"][0]["depth_requested"] == pytest.approx(0.6)
@@ -45,8 +45,20 @@ def test_file_input_and_clamp(tmp_path):
 
     v, f = example_mesh("house")
     write_obj(tmp_path / "house.obj", v, f)
-    assert main(["round", str(tmp_path / "house.obj"), "--radius", "40%", "--clamp", "-o",
-                 str(tmp_path / "h")]) == 0
+    assert (
+        main(
+            [
+                "round",
+                str(tmp_path / "house.obj"),
+                "--radius",
+                "40%",
+                "--clamp",
+                "-o",
+                str(tmp_path / "h"),
+            ]
+        )
+        == 0
+    )
     assert (tmp_path / "h" / "design.fold").exists()
 
 

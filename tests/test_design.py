@@ -47,15 +47,21 @@ def check_ruling_lengths_are_isometric(d):
         if kind == "face":  # flat piece: every edge and diagonal
             pairs = [(a, b) for a in face for b in face if a < b]
         elif kind == "cone":  # rulings from the apex
-            pairs = [(a, b) for a, b in pairs
-                     if tuple(np.round(p.vertices_3d[a], 12)) in apex
-                     or tuple(np.round(p.vertices_3d[b], 12)) in apex]
+            pairs = [
+                (a, b)
+                for a, b in pairs
+                if tuple(np.round(p.vertices_3d[a], 12)) in apex
+                or tuple(np.round(p.vertices_3d[b], 12)) in apex
+            ]
         else:  # cylinder rulings run along the mesh edge
             a0, b0 = m.edges[int(idx)]
             t = m.vertices[b0] - m.vertices[a0]
             t /= np.linalg.norm(t)
-            pairs = [(a, b) for a, b in pairs
-                     if abs(abs((p.vertices_3d[b] - p.vertices_3d[a]) @ t) - e3(a, b)) < 1e-12]
+            pairs = [
+                (a, b)
+                for a, b in pairs
+                if abs(abs((p.vertices_3d[b] - p.vertices_3d[a]) @ t) - e3(a, b)) < 1e-12
+            ]
         for a, b in pairs:
             assert abs(e2(a, b) - e3(a, b)) < 1e-11 * m.mean_edge_length
             checked += 1
@@ -88,8 +94,9 @@ def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
     p = d.pattern
     cone_of = np.array([int(s.split()[1]) if s.startswith("cone") else -1 for s in p.face_patch])
     crease = np.isin(p.edge_assignment, ["M", "V"])
-    assert np.all(np.sign(p.edge_fold_angle[crease]) == np.where(
-        p.edge_assignment[crease] == "M", -1, 1))
+    assert np.all(
+        np.sign(p.edge_fold_angle[crease]) == np.where(p.edge_assignment[crease] == "M", -1, 1)
+    )
     for k in np.nonzero(crease)[0]:
         fa, fb = p.edge_faces[k]
         u = max(cone_of[fa], cone_of[fb])
@@ -143,12 +150,15 @@ def check_crease_loop_closes_around_every_cone(d):
         assert_allclose(r[0], r[1], rtol=1e-9)
 
 
-CHECKS = [check_contraction_everywhere, check_ruling_lengths_are_isometric,
-          check_pieces_lie_on_their_planes_and_cylinders,
-          check_creases_are_mountains_at_back_apices_valleys_at_front,
-          check_no_overlap_in_the_pattern,
-          check_faces_counter_clockwise_in_2d_and_front_facing_in_3d,
-          check_crease_loop_closes_around_every_cone]
+CHECKS = [
+    check_contraction_everywhere,
+    check_ruling_lengths_are_isometric,
+    check_pieces_lie_on_their_planes_and_cylinders,
+    check_creases_are_mountains_at_back_apices_valleys_at_front,
+    check_no_overlap_in_the_pattern,
+    check_faces_counter_clockwise_in_2d_and_front_facing_in_3d,
+    check_crease_loop_closes_around_every_cone,
+]
 
 
 @pytest.mark.parametrize("check", CHECKS, ids=lambda c: c.__name__[6:])
@@ -157,14 +167,22 @@ def test_invariants_on_every_example(example_design, check):
 
 
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(seed=st.integers(0, 10_000), share=st.floats(0.15, 0.7), depth=st.floats(0.1, 1.0),
-       samples=st.integers(3, 30))
+@given(
+    seed=st.integers(0, 10_000),
+    share=st.floats(0.15, 0.7),
+    depth=st.floats(0.1, 1.0),
+    samples=st.integers(3, 30),
+)
 def test_invariants_on_generated_meshes(seed, share, depth, samples):
     """Random convex polyhedra, radii, depths and samplings: every invariant holds."""
     v, f = random_convex(seed)
     m = filletfold.load_mesh((v, f))[0]
-    d = filletfold.round_mesh(m, radius=share * round_edges(m, 1e-3).uniform_limit,
-                              depth=depth * m.mean_edge_length, samples=samples)
+    d = filletfold.round_mesh(
+        m,
+        radius=share * round_edges(m, 1e-3).uniform_limit,
+        depth=depth * m.mean_edge_length,
+        samples=samples,
+    )
     for check in CHECKS:
         check(d)
 
@@ -234,8 +252,12 @@ def test_real_object_non_saddles_are_solved_or_reported():
 def test_export_writes_the_four_files(tmp_path):
     d = design_of("cube")
     files = d.export(tmp_path / "out")
-    assert sorted(f.name for f in files) == ["design.fold", "folded.obj", "pattern.svg",
-                                             "report.json"]
+    assert sorted(f.name for f in files) == [
+        "design.fold",
+        "folded.obj",
+        "pattern.svg",
+        "report.json",
+    ]
     fold = json.loads((tmp_path / "out" / "design.fold").read_text())
     report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert fold["frame_classes"] == ["creasePattern"]
@@ -252,13 +274,21 @@ def test_export_writes_the_four_files(tmp_path):
     assert all(v["status"] == "ok" for v in report["vertices"])
     for e in report["edges"]:
         assert set(e) >= {"vertices", "faces", "radius", "half_angle"}
-    assert set(report["vertices"][0]) >= {"kind", "status", "normal", "apex", "apex_2d", "depth",
-                                          "margin"}
+    assert set(report["vertices"][0]) >= {
+        "kind",
+        "status",
+        "normal",
+        "apex",
+        "apex_2d",
+        "depth",
+        "margin",
+    }
     # same design, same bytes
     d.export(tmp_path / "again")
     for f in files:
-        assert (tmp_path / "again" / f.name).read_bytes() == f.read_bytes() or f.name == \
-            "report.json"
+        assert (
+            tmp_path / "again" / f.name
+        ).read_bytes() == f.read_bytes() or f.name == "report.json"
 
 
 @pytest.mark.parametrize(

@@ -76,8 +76,11 @@ def test_uniform_limit_is_sharp():
     near = round_edges(m, 0.5 * (1 - 1e-6))
     lmax = min(np.nanmin(vertex_frame(m, near, u).lmax_start) for u in range(m.n_vertices))
     assert 0 < lmax < 1e-5
-    with pytest.raises(ParameterError, match=r"radius 0\.51 on edge \d+ \(vertices \d+-\d+\) "
-                       r"exceeds its limit 0\.5"):
+    with pytest.raises(
+        ParameterError,
+        match=r"radius 0\.51 on edge \d+ \(vertices \d+-\d+\) "
+        r"exceeds its limit 0\.5",
+    ):
         round_edges(m, 0.51)
 
 

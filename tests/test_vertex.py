@@ -206,8 +206,9 @@ def test_crease_through_T_gives_a_clean_module():
     fr = vertex_frame(m, rd, 0)
     v = fr.developed_apex()
     D = -fr.U / np.linalg.norm(fr.U)
-    sol = solve_apex(build_constraints(fr, v, -1, 9, 0.0), fr.U + 0.02 * D,
-                     [fr.U + t * D for t in (0.2, 0.5)])
+    sol = solve_apex(
+        build_constraints(fr, v, -1, 9, 0.0), fr.U + 0.02 * D, [fr.U + t * D for t in (0.2, 0.5)]
+    )
     l_end, _ = crease_length(fr, 0, sol.apex, v, np.array([fr.sides[0].arc]))
     assert_allclose(l_end[0], fr.lmax_end[0], rtol=1e-9)
     pieces = build_module(m, fr, face_piece_centres(m, rd), 24, sol.apex, v)

@@ -45,8 +45,12 @@ def _version(value: bool):
 
 @app.callback()
 def _root(
-    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
-                                          help="Print the version and exit.")] = False,
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_version, is_eager=True, help="Print the version and exit."
+        ),
+    ] = False,
 ):
     """filletfold: curved-crease edge rounding of polyhedral meshes."""
 
@@ -69,28 +73,57 @@ def _default_out(mesh: str) -> Path:
 
 @app.command("round")
 def round_cmd(
-    mesh: Annotated[str, typer.Argument(help="Mesh file (OBJ, OFF, PLY, STL, glTF/GLB) or the "
-                                             "name of a built-in example (see 'examples').")],
-    out: Annotated[Path | None, typer.Option("-o", "--out", help="Output folder "
-                                             "[default: out/<mesh name>].")] = None,
-    radius: Annotated[str, typer.Option("--radius", "-r", help="Rounding radius: a length, or "
-                                        "a percentage of the mean edge length ('10%').")]
-    = DEFAULT_RADIUS,
-    depth: Annotated[str, typer.Option("--depth", "-d", help="Apex depth along the vertex "
-                                       "normal: a length or a percentage of the mean edge "
-                                       "length.")] = DEFAULT_DEPTH,
-    samples: Annotated[int, typer.Option("--samples", "-n", min=3, help="Points per cylinder "
-                                         "arc.")] = DEFAULT_SAMPLES,
-    clamp: Annotated[bool, typer.Option("--clamp", help="Reduce each radius over its edge's "
-                                        "limit to 90% of the limit instead of stopping.")]
-    = False,
-    coplanar_tol: Annotated[float, typer.Option("--coplanar-tol", help="Merge neighbouring "
-                                                "faces within this angle (degrees).")]
-    = tol.coplanar_deg,
-    dry_run: Annotated[bool, typer.Option("--dry-run", help="Solve and print the summary, "
-                                          "write nothing.")] = False,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="Print only errors and the "
-                                        "output folder.")] = False,
+    mesh: Annotated[
+        str,
+        typer.Argument(
+            help="Mesh file (OBJ, OFF, PLY, STL, glTF/GLB) or the "
+            "name of a built-in example (see 'examples')."
+        ),
+    ],
+    out: Annotated[
+        Path | None, typer.Option("-o", "--out", help="Output folder [default: out/<mesh name>].")
+    ] = None,
+    radius: Annotated[
+        str,
+        typer.Option(
+            "--radius",
+            "-r",
+            help="Rounding radius: a length, or a percentage of the mean edge length ('10%').",
+        ),
+    ] = DEFAULT_RADIUS,
+    depth: Annotated[
+        str,
+        typer.Option(
+            "--depth",
+            "-d",
+            help="Apex depth along the vertex "
+            "normal: a length or a percentage of the mean edge "
+            "length.",
+        ),
+    ] = DEFAULT_DEPTH,
+    samples: Annotated[
+        int, typer.Option("--samples", "-n", min=3, help="Points per cylinder arc.")
+    ] = DEFAULT_SAMPLES,
+    clamp: Annotated[
+        bool,
+        typer.Option(
+            "--clamp",
+            help="Reduce each radius over its edge's "
+            "limit to 90% of the limit instead of stopping.",
+        ),
+    ] = False,
+    coplanar_tol: Annotated[
+        float,
+        typer.Option(
+            "--coplanar-tol", help="Merge neighbouring faces within this angle (degrees)."
+        ),
+    ] = tol.coplanar_deg,
+    dry_run: Annotated[
+        bool, typer.Option("--dry-run", help="Solve and print the summary, write nothing.")
+    ] = False,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="Print only errors and the output folder.")
+    ] = False,
 ):
     """Round every edge and vertex of MESH; write the design into the output folder.
 
@@ -99,8 +132,14 @@ def round_cmd(
     """
     target = out if out is not None else _default_out(mesh)
     try:
-        with Progress(TextColumn("{task.description}"), BarColumn(), TimeElapsedColumn(),
-                      console=err_console, transient=True, disable=quiet) as bar:
+        with Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            TimeElapsedColumn(),
+            console=err_console,
+            transient=True,
+            disable=quiet,
+        ) as bar:
             tasks = {}
 
             def progress(stage, done, total):
@@ -108,8 +147,15 @@ def round_cmd(
                     tasks[stage] = bar.add_task(stage, total=total)
                 bar.update(tasks[stage], completed=done)
 
-            design = round_mesh(mesh, radius=radius, depth=depth, samples=samples, clamp=clamp,
-                                coplanar_deg=coplanar_tol, progress=progress)
+            design = round_mesh(
+                mesh,
+                radius=radius,
+                depth=depth,
+                samples=samples,
+                clamp=clamp,
+                coplanar_deg=coplanar_tol,
+                progress=progress,
+            )
         if not quiet:
             console.print(design.summary(), highlight=False)
         if dry_run:

@@ -23,11 +23,9 @@ from .rounding import EdgeRounding, clamp_radii, round_edges
 from .tolerances import tol
 from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_vertex_apex
 
-
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
-
 
 
 def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:
@@ -178,8 +176,9 @@ def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
             if k == "default":
                 continue
             if not (0 <= int(k) < n):
-                raise ParameterError(f"depth given for vertex {k}, which does not exist",
-                                     name="depth")
+                raise ParameterError(
+                    f"depth given for vertex {k}, which does not exist", name="depth"
+                )
             out[int(k)] = float(parse_length(val, reference, "depth"))
         return out
     d = parse_length(depth, reference, "depth", count=n)
@@ -221,9 +220,16 @@ def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np
     return pattern, offsets
 
 
-def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int = DEFAULT_SAMPLES,
-               clamp: bool = False, coplanar_deg: float = tol.coplanar_deg,
-               progress=None) -> Design:
+def round_mesh(
+    mesh,
+    radius=DEFAULT_RADIUS,
+    depth=DEFAULT_DEPTH,
+    *,
+    samples: int = DEFAULT_SAMPLES,
+    clamp: bool = False,
+    coplanar_deg: float = tol.coplanar_deg,
+    progress=None,
+) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
     Parameters
@@ -269,8 +275,13 @@ def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
     pm, _ = load_mesh(mesh, coplanar_deg=coplanar_deg)
     timings["read"] = time.perf_counter() - t0
-    params = Parameters(radius=radius, depth=depth, samples=int(samples), clamp=bool(clamp),
-                        coplanar_deg=coplanar_deg)
+    params = Parameters(
+        radius=radius,
+        depth=depth,
+        samples=int(samples),
+        clamp=bool(clamp),
+        coplanar_deg=coplanar_deg,
+    )
     ref = pm.mean_edge_length
 
     t = time.perf_counter()
@@ -290,8 +301,9 @@ def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int
     t = time.perf_counter()
     solved = []
     for u, frame in enumerate(frames):
-        apex, v = (solve_vertex_apex(frame, float(depths[u]), res) if res.status[u] == ""
-                   else (None, None))
+        apex, v = (
+            solve_vertex_apex(frame, float(depths[u]), res) if res.status[u] == "" else (None, None)
+        )
         solved.append((frame, apex, v))
         if progress is not None:
             progress("apices", u + 1, pm.n_vertices)
@@ -309,5 +321,13 @@ def round_mesh(mesh, radius=DEFAULT_RADIUS, depth=DEFAULT_DEPTH, *, samples: int
             res.apex_2d[piece.vertex] = np.asarray(piece.points_2d[piece.apex_index]) + offsets[k]
     timings["surface"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
-    return Design(mesh=pm, params=params, rounding=rounding, vertices=res, pattern=pattern,
-                  pieces=pieces, timings=timings, source=source)
+    return Design(
+        mesh=pm,
+        params=params,
+        rounding=rounding,
+        vertices=res,
+        pattern=pattern,
+        pieces=pieces,
+        timings=timings,
+        source=source,
+    )

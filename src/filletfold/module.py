@@ -228,9 +228,15 @@ def hole_heights(frame: VertexFrame) -> np.ndarray:
     return 0.5 * lm
 
 
-def build_module(mesh: PolyMesh, frame: VertexFrame, centres: np.ndarray, n_samples: int,
-                 apex: np.ndarray | None = None, dev_apex: np.ndarray | None = None,
-                 runs=None) -> list[Piece]:
+def build_module(
+    mesh: PolyMesh,
+    frame: VertexFrame,
+    centres: np.ndarray,
+    n_samples: int,
+    apex: np.ndarray | None = None,
+    dev_apex: np.ndarray | None = None,
+    runs=None,
+) -> list[Piece]:
     """The flat piece(s) of one vertex.
 
     Parameters
@@ -255,8 +261,9 @@ def build_module(mesh: PolyMesh, frame: VertexFrame, centres: np.ndarray, n_samp
     """
     nf = len(frame.ring.faces)
     if runs is not None:
-        return [_build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)
-                for j0, j1 in runs]
+        return [
+            _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1) for j0, j1 in runs
+        ]
     pending = [(0, nf - 1)]
     pieces = []
     while pending:
@@ -338,10 +345,14 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
         if side.rounded:
             s, C, F, z = curves_of(i)
             m = frame.cyl_map[i]
-            bs = [piece.point(("side", i, "bs", k), apply(m, [s[k], 0.0]), C[k])
-                  for k in range(len(s))]
-            tp = [piece.point(("side", i, top_name, k), apply(m, [s[k], z[k]]), F[k])
-                  for k in range(len(s))]
+            bs = [
+                piece.point(("side", i, "bs", k), apply(m, [s[k], 0.0]), C[k])
+                for k in range(len(s))
+            ]
+            tp = [
+                piece.point(("side", i, top_name, k), apply(m, [s[k], z[k]]), F[k])
+                for k in range(len(s))
+            ]
             patch = f"cylinder {side.edge}"
             for k in range(len(s) - 1):
                 piece.face([bs[k], bs[k + 1], tp[k + 1], tp[k]], patch)
@@ -353,8 +364,9 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
         nxt = (i + 1) % ne
         b1, t1 = line_points(nxt, i, start=True, end_copy=(i == j1))
         fr = frame.face_frames[i]
-        c = piece.point(("centre", face), apply(frame.face_map[i], to_chart(fr, centres[face])),
-                        centres[face])
+        c = piece.point(
+            ("centre", face), apply(frame.face_map[i], to_chart(fr, centres[face])), centres[face]
+        )
         corner = [t0, b0, c, b1, t1]
         if apex is None and frame.corner_angle[i] > np.pi:
             # at a reflex corner the straight hole border would leave the face: go through T

@@ -43,18 +43,20 @@ def design_report(design) -> dict:
     for e, (a, b) in enumerate(mesh.edges):
         f, g = mesh.edge_faces[e]
         boundary = f < 0 or g < 0
-        edges.append({
-            "vertices": [int(a), int(b)],
-            "faces": None if boundary else [int(f), int(g)],
-            "length": float(mesh.edge_length[e]),
-            "radius": float(rd.radius[e]),
-            "half_angle": float(rd.half_angle[e]),
-            "assignment": "B" if boundary else ("M" if rd.kappa[e] > 0 else "V"),
-            "arc_length": float(rd.arc_length[e]),
-            "strip_width": float(rd.strip_width[e]),
-            "material_loss": float(rd.loss[e]),
-            "radius_limit": _num(rd.limit[e]),
-        })
+        edges.append(
+            {
+                "vertices": [int(a), int(b)],
+                "faces": None if boundary else [int(f), int(g)],
+                "length": float(mesh.edge_length[e]),
+                "radius": float(rd.radius[e]),
+                "half_angle": float(rd.half_angle[e]),
+                "assignment": "B" if boundary else ("M" if rd.kappa[e] > 0 else "V"),
+                "arc_length": float(rd.arc_length[e]),
+                "strip_width": float(rd.strip_width[e]),
+                "material_loss": float(rd.loss[e]),
+                "radius_limit": _num(rd.limit[e]),
+            }
+        )
     vertices = []
     for u in range(mesh.n_vertices):
         item = {
@@ -63,20 +65,22 @@ def design_report(design) -> dict:
         }
         if res.status[u] != "ok":
             item["reason"] = res.reason[u]
-        item.update({
-            "angle_sum": _num(res.angle_sum[u]),
-            "angle_defect": _num(res.defect[u]),
-            "solid_angle": _num(res.solid_angle[u]),
-            "sigma": int(res.sigma[u]) or None,
-            "normal": _vec(res.normal[u]),
-            "normal_bound": _num(res.normal_bound[u]),
-            "apex": _vec(res.apex[u]),
-            "apex_developed": _vec(res.apex_developed[u]),
-            "apex_2d": _vec(res.apex_2d[u]),
-            "depth_requested": _num(res.depth_requested[u]),
-            "depth": _num(res.depth[u]),
-            "margin": _num(res.margin[u]),
-        })
+        item.update(
+            {
+                "angle_sum": _num(res.angle_sum[u]),
+                "angle_defect": _num(res.defect[u]),
+                "solid_angle": _num(res.solid_angle[u]),
+                "sigma": int(res.sigma[u]) or None,
+                "normal": _vec(res.normal[u]),
+                "normal_bound": _num(res.normal_bound[u]),
+                "apex": _vec(res.apex[u]),
+                "apex_developed": _vec(res.apex_developed[u]),
+                "apex_2d": _vec(res.apex_2d[u]),
+                "depth_requested": _num(res.depth_requested[u]),
+                "depth": _num(res.depth[u]),
+                "margin": _num(res.margin[u]),
+            }
+        )
         vertices.append(item)
     counts = {k: int(np.sum(pat.edge_assignment == k)) for k in ("M", "V", "B", "F")}
     return {
@@ -130,9 +134,11 @@ def design_summary(design, max_listed: int = 8) -> str:
     lines = [
         f"mesh: {mesh.n_vertices} vertices, {mesh.n_edges} edges, {mesh.n_faces} faces "
         f"(mean edge {mesh.mean_edge_length:.4g})",
-        f"radius: {r.min():.4g}" + (f"-{r.max():.4g}" if len(r) and r.max() > r.min() else "")
-        + f" (largest uniform radius {design.rounding.uniform_limit:.4g})" if len(r) else
-        "radius: no interior edge",
+        f"radius: {r.min():.4g}"
+        + (f"-{r.max():.4g}" if len(r) and r.max() > r.min() else "")
+        + f" (largest uniform radius {design.rounding.uniform_limit:.4g})"
+        if len(r)
+        else "radius: no interior edge",
         f"vertices: {shown}",
     ]
     if len(depth):
@@ -167,8 +173,9 @@ def export_design(design, folder, *, title: str | None = None) -> list[Path]:
     """
     t = time.perf_counter()
     title = title or f"filletfold design of {design.source}"
-    doc = fold_document(design.pattern, title=title,
-                        description="Curved-crease rounded design: vertex modules")
+    doc = fold_document(
+        design.pattern, title=title, description="Curved-crease rounded design: vertex modules"
+    )
     files = {
         "design.fold": fold_json(doc),
         "folded.obj": folded_obj(design.pattern),

@@ -139,10 +139,18 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
             tg = np.where(rounded[g], tan_g[g], 0.0)
             # both crossings: along e (own) and along g (other), each  k * d_e <= m
             for k, m, ku, half in (
-                (cos / sin, 0.5 * length[e] - offset[g] / sin, (tg + te * cos) / sin,
-                 0.5 * length[e]),
-                (1.0 / sin, 0.5 * length[g] - offset[g] * cos / sin, (te + tg * cos) / sin,
-                 0.5 * length[g]),
+                (
+                    cos / sin,
+                    0.5 * length[e] - offset[g] / sin,
+                    (tg + te * cos) / sin,
+                    0.5 * length[e],
+                ),
+                (
+                    1.0 / sin,
+                    0.5 * length[g] - offset[g] * cos / sin,
+                    (te + tg * cos) / sin,
+                    0.5 * length[g],
+                ),
             ):
                 d_max = np.where(k > 0, m / k, np.where(m >= 0, np.inf, 0.0))
                 r_given = np.where(rounded[e], np.maximum(d_max, 0.0) / te, np.inf)
@@ -156,8 +164,9 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
     return limit, given, broken, float(limit.min(initial=np.inf))
 
 
-def clamp_radii(mesh: PolyMesh, edge_radius, *, share: float = 0.9,
-                flat_deg: float = tol.coplanar_deg) -> np.ndarray:
+def clamp_radii(
+    mesh: PolyMesh, edge_radius, *, share: float = 0.9, flat_deg: float = tol.coplanar_deg
+) -> np.ndarray:
     """Reduce requested radii to valid ones, edge by edge.
 
     Each edge keeps its request when valid; otherwise it gets ``share`` of its limit, and

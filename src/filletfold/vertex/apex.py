@@ -76,7 +76,7 @@ class ApexConstraints:
     def jacobian(self, V: np.ndarray) -> np.ndarray:
         """(n_rows, 3) derivative of :meth:`values`."""
         d = V - self.quad_c
-        gq = (-2 * self.quad_sign[:, None] * d + self.quad_coef[:, None] * self.quad_R)
+        gq = -2 * self.quad_sign[:, None] * d + self.quad_coef[:, None] * self.quad_R
         return np.vstack([gq / self.scale, self.lin_a])
 
     def describe(self, rows) -> list[str]:
@@ -89,8 +89,9 @@ class ApexConstraints:
         return seen
 
 
-def build_constraints(frame: VertexFrame, v: np.ndarray, sigma: int, n_samples: int,
-                      margin: float) -> ApexConstraints:
+def build_constraints(
+    frame: VertexFrame, v: np.ndarray, sigma: int, n_samples: int, margin: float
+) -> ApexConstraints:
     """Sample the sec. 3.2 constraints of a closed vertex.
 
     Parameters
@@ -207,11 +208,13 @@ def _max_slack(cons: ApexConstraints, x_init: np.ndarray) -> tuple[np.ndarray, f
         lambda x: -x[3] / L,
         np.concatenate([x_init, [g.min()]]),
         jac=lambda x: np.array([0, 0, 0, -1.0 / L]),
-        constraints=[{
-            "type": "ineq",
-            "fun": lambda x: cons.values(x[:3]) - x[3],
-            "jac": lambda x: np.hstack([cons.jacobian(x[:3]), -np.ones((len(g), 1))]),
-        }],
+        constraints=[
+            {
+                "type": "ineq",
+                "fun": lambda x: cons.values(x[:3]) - x[3],
+                "jac": lambda x: np.hstack([cons.jacobian(x[:3]), -np.ones((len(g), 1))]),
+            }
+        ],
         bounds=[(None, None)] * 3 + [(None, L)],
         method="SLSQP",
         options={"ftol": 1e-14, "maxiter": 500},
@@ -315,8 +318,9 @@ def crease_length(frame: VertexFrame, i: int, V: np.ndarray, v: np.ndarray, s: n
     return 0.5 * num / dn, float(dn)
 
 
-def validate_apex(frame: VertexFrame, V: np.ndarray, v: np.ndarray, sigma: int,
-                  n_samples: int = 257) -> ApexCheck:
+def validate_apex(
+    frame: VertexFrame, V: np.ndarray, v: np.ndarray, sigma: int, n_samples: int = 257
+) -> ApexCheck:
     """Check every condition densely along every arc, without margin.
 
     Conditions: ``Dn > 0``; ``l(s) >= 0``; ``l <= l_max`` at both ends; ``sigma (V - C) . N > 0``
@@ -334,7 +338,8 @@ def validate_apex(frame: VertexFrame, V: np.ndarray, v: np.ndarray, sigma: int,
             "patch": dn,
             "l_min": l.min() if dn > 0 else -np.inf,
             "l_max": min(frame.lmax_start[i] - l[0], frame.lmax_end[i] - l[-1])
-            if dn > 0 else -np.inf,
+            if dn > 0
+            else -np.inf,
             "nonint": float(np.min(sigma * np.einsum("ij,ij->i", V - C, N))),
         }
         for k, val in checks.items():

@@ -209,15 +209,19 @@ class VertexFrame:
     @staticmethod
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
         tan = side.tangent([s])[0]
-        lin = np.array(
-            [[tan @ frame[1], side.R @ frame[1]], [tan @ frame[2], side.R @ frame[2]]]
-        )
+        lin = np.array([[tan @ frame[1], side.R @ frame[1]], [tan @ frame[2], side.R @ frame[2]]])
         p = to_chart(frame, side.base([s])[0])[0]
         return rigid(lin, p - lin @ np.array([s, 0.0]))
 
 
-def build_side(mesh: PolyMesh, rounding: EdgeRounding, u: int, e: int, n_prev: np.ndarray | None,
-               n_next: np.ndarray | None) -> Side:
+def build_side(
+    mesh: PolyMesh,
+    rounding: EdgeRounding,
+    u: int,
+    e: int,
+    n_prev: np.ndarray | None,
+    n_next: np.ndarray | None,
+) -> Side:
     """The side of edge ``e`` seen from vertex ``u``.
 
     ``n_prev`` and ``n_next`` are the front normals of the ring faces before and after the edge
@@ -233,8 +237,16 @@ def build_side(mesh: PolyMesh, rounding: EdgeRounding, u: int, e: int, n_prev: n
         return Side(edge=int(e), rounded=False, R=R, M=M, length=length)
     r = float(rounding.radius[e])
     if r <= 0:  # flat edge between coplanar faces: a cylinder of radius 0
-        return Side(edge=int(e), rounded=True, R=R, M=M, length=length, O=M, N0=n_prev,
-                    B=np.cross(R, n_prev))
+        return Side(
+            edge=int(e),
+            rounded=True,
+            R=R,
+            M=M,
+            length=length,
+            O=M,
+            N0=n_prev,
+            B=np.cross(R, n_prev),
+        )
     B = n_next - (n_next @ n_prev) * n_prev
     B /= np.linalg.norm(B)
     return Side(
@@ -299,9 +311,19 @@ def vertex_frame(mesh: PolyMesh, rounding: EdgeRounding, u: int) -> VertexFrame:
         T_end[i] = p1 + z1 * s1.R
         T_start[j] = p2 + z2 * s2.R
     frame = VertexFrame(
-        vertex=u, ring=ring, U=U, sides=sides, face_frames=frames, cyl_map=[None] * ne,
-        face_map=[None] * nf, rho=None, lmax_start=lmax_start, lmax_end=lmax_end,
-        T_start=T_start, T_end=T_end, corner_angle=corner_angle,
+        vertex=u,
+        ring=ring,
+        U=U,
+        sides=sides,
+        face_frames=frames,
+        cyl_map=[None] * ne,
+        face_map=[None] * nf,
+        rho=None,
+        lmax_start=lmax_start,
+        lmax_end=lmax_end,
+        T_start=T_start,
+        T_end=T_end,
+        corner_angle=corner_angle,
     )
     if ring.closed:
         current = np.eye(3)  # tau = f_{n-1}

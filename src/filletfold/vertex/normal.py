@@ -42,10 +42,16 @@ def max_min_direction(u: np.ndarray) -> tuple[np.ndarray, float]:
         x0,
         jac=lambda x: np.array([0.0, 0.0, 0.0, -1.0]),
         constraints=[
-            {"type": "ineq", "fun": lambda x: u @ x[:3] - x[3],
-             "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))])},
-            {"type": "ineq", "fun": lambda x: 1.0 - x[:3] @ x[:3],
-             "jac": lambda x: np.concatenate([-2 * x[:3], [0.0]])},
+            {
+                "type": "ineq",
+                "fun": lambda x: u @ x[:3] - x[3],
+                "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))]),
+            },
+            {
+                "type": "ineq",
+                "fun": lambda x: 1.0 - x[:3] @ x[:3],
+                "jac": lambda x: np.concatenate([-2 * x[:3], [0.0]]),
+            },
         ],
         method="SLSQP",
         options={"ftol": 1e-15, "maxiter": 200},
@@ -65,10 +71,16 @@ def max_min_direction(u: np.ndarray) -> tuple[np.ndarray, float]:
         np.concatenate([start, [np.min(u @ start)]]),
         jac=lambda x: np.array([0.0, 0.0, 0.0, -1.0]),
         constraints=[
-            {"type": "ineq", "fun": lambda x: u @ x[:3] - x[3],
-             "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))])},
-            {"type": "eq", "fun": lambda x: np.array([x[:3] @ x[:3] - 1.0]),
-             "jac": lambda x: np.concatenate([2 * x[:3], [0.0]])[None]},
+            {
+                "type": "ineq",
+                "fun": lambda x: u @ x[:3] - x[3],
+                "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))]),
+            },
+            {
+                "type": "eq",
+                "fun": lambda x: np.array([x[:3] @ x[:3] - 1.0]),
+                "jac": lambda x: np.concatenate([2 * x[:3], [0.0]])[None],
+            },
         ],
         method="SLSQP",
         options={"ftol": 1e-15, "maxiter": 200},

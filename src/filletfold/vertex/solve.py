@@ -69,18 +69,27 @@ class VertexResult:
     def empty(cls, n: int) -> VertexResult:
         nan = np.full(n, np.nan)
         return cls(
-            kind=[""] * n, status=[""] * n, reason=[None] * n, angle_sum=nan.copy(),
-            defect=nan.copy(), solid_angle=nan.copy(), normal=np.full((n, 3), np.nan),
-            normal_bound=nan.copy(), sigma=np.zeros(n, dtype=np.int64),
-            depth_requested=nan.copy(), depth=nan.copy(), apex=np.full((n, 3), np.nan),
-            apex_developed=np.full((n, 2), np.nan), apex_2d=np.full((n, 2), np.nan),
+            kind=[""] * n,
+            status=[""] * n,
+            reason=[None] * n,
+            angle_sum=nan.copy(),
+            defect=nan.copy(),
+            solid_angle=nan.copy(),
+            normal=np.full((n, 3), np.nan),
+            normal_bound=nan.copy(),
+            sigma=np.zeros(n, dtype=np.int64),
+            depth_requested=nan.copy(),
+            depth=nan.copy(),
+            apex=np.full((n, 3), np.nan),
+            apex_developed=np.full((n, 2), np.nan),
+            apex_2d=np.full((n, 2), np.nan),
             margin=nan.copy(),
         )
 
 
-
-def classify_vertex(mesh: PolyMesh, rounding: EdgeRounding, u: int,
-                    res: VertexResult) -> VertexFrame:
+def classify_vertex(
+    mesh: PolyMesh, rounding: EdgeRounding, u: int, res: VertexResult
+) -> VertexFrame:
     """Build vertex ``u``'s frame, classify it and find its normal (sec. 2.5, 3.1).
 
     Fills ``res`` at ``u``: angle sum, defect, solid angle, normal, bound, sigma, kind, and the
@@ -105,20 +114,25 @@ def classify_vertex(mesh: PolyMesh, rounding: EdgeRounding, u: int,
     res.normal[u], res.normal_bound[u], res.sigma[u] = D, b, sigma
     if is_developable(res.angle_sum[u]):
         res.kind[u] = res.status[u] = "developable"
-        res.reason[u] = ("developable vertex (angle sum 2 pi): its development closes; it needs "
-                         "consistent material loss (not solved here)")
+        res.reason[u] = (
+            "developable vertex (angle sum 2 pi): its development closes; it needs "
+            "consistent material loss (not solved here)"
+        )
         return frame
     if b <= tol.normal_bound:
         res.kind[u] = res.status[u] = "saddle"
-        res.reason[u] = (f"saddle vertex: no plane through it has all its faces on one side "
-                         f"(max-min bound {b:.3g} <= 0); no cone possible")
+        res.reason[u] = (
+            f"saddle vertex: no plane through it has all its faces on one side "
+            f"(max-min bound {b:.3g} <= 0); no cone possible"
+        )
         return frame
     res.kind[u] = "cone"
     return frame
 
 
-def solve_vertex_apex(frame: VertexFrame, depth: float,
-                      res: VertexResult) -> tuple[np.ndarray | None, np.ndarray | None]:
+def solve_vertex_apex(
+    frame: VertexFrame, depth: float, res: VertexResult
+) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Developed and spatial apex of a cone vertex (sec. 2.4, 3.2), validated densely.
 
     Sets ``res.status`` to ``ok`` (with apex, depth used and margin) or ``infeasible`` (with
@@ -141,8 +155,10 @@ def solve_vertex_apex(frame: VertexFrame, depth: float,
     res.apex_developed[u] = v
     if np.any(frame.corner_angle > np.pi):
         res.status[u] = "infeasible"
-        res.reason[u] = "a face has a reflex corner at this vertex: the straight crease on it " \
+        res.reason[u] = (
+            "a face has a reflex corner at this vertex: the straight crease on it "
             "would leave the face"
+        )
         return None, None
     U = frame.U
     lengths = np.array([s.length for s in frame.sides])
