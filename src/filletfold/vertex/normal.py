@@ -36,27 +36,7 @@ def max_min_direction(u: np.ndarray) -> tuple[np.ndarray, float]:
     mean = u.mean(axis=0)
     n = np.linalg.norm(mean)
     d0 = mean / n if n > 1e-12 else u[0]
-    x0 = np.concatenate([d0, [np.min(u @ d0)]])
-    res = minimize(
-        lambda x: -x[3],
-        x0,
-        jac=lambda x: np.array([0.0, 0.0, 0.0, -1.0]),
-        constraints=[
-            {
-                "type": "ineq",
-                "fun": lambda x: u @ x[:3] - x[3],
-                "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))]),
-            },
-            {
-                "type": "ineq",
-                "fun": lambda x: 1.0 - x[:3] @ x[:3],
-                "jac": lambda x: np.concatenate([-2 * x[:3], [0.0]]),
-            },
-        ],
-        method="SLSQP",
-        options={"ftol": 1e-15, "maxiter": 200},
-    )
-    d = res.x[:3]
+    d = _max_min_slsqp(u, d0, on_sphere=False)
     nd = np.linalg.norm(d)
     d = d / nd if nd > 1e-12 else d0
     b = float(np.min(u @ d))
@@ -66,9 +46,30 @@ def max_min_direction(u: np.ndarray) -> tuple[np.ndarray, float]:
     # (negative) max-min on the sphere from the best of a dense set of directions
     grid = _fibonacci_sphere(2000)
     start = grid[np.argmax((grid @ u.T).min(axis=1))]
+    d = _max_min_slsqp(u, start, on_sphere=True)
+    cands = [start, d / np.linalg.norm(d)]
+    vals = [float(np.min(u @ c)) for c in cands]
+    k = int(np.argmax(vals))
+    return cands[k], vals[k]
+
+
+def _max_min_slsqp(u: np.ndarray, d0: np.ndarray, *, on_sphere: bool) -> np.ndarray:
+    """SLSQP for ``max b`` s.t. ``u @ D >= b`` and ``|D| <= 1`` (or ``|D| = 1``); returns D."""
+    if on_sphere:
+        norm = {
+            "type": "eq",
+            "fun": lambda x: np.array([x[:3] @ x[:3] - 1.0]),
+            "jac": lambda x: np.concatenate([2 * x[:3], [0.0]])[None],
+        }
+    else:
+        norm = {
+            "type": "ineq",
+            "fun": lambda x: 1.0 - x[:3] @ x[:3],
+            "jac": lambda x: np.concatenate([-2 * x[:3], [0.0]]),
+        }
     res = minimize(
         lambda x: -x[3],
-        np.concatenate([start, [np.min(u @ start)]]),
+        np.concatenate([d0, [np.min(u @ d0)]]),
         jac=lambda x: np.array([0.0, 0.0, 0.0, -1.0]),
         constraints=[
             {
@@ -76,19 +77,12 @@ def max_min_direction(u: np.ndarray) -> tuple[np.ndarray, float]:
                 "fun": lambda x: u @ x[:3] - x[3],
                 "jac": lambda x: np.hstack([u, -np.ones((len(u), 1))]),
             },
-            {
-                "type": "eq",
-                "fun": lambda x: np.array([x[:3] @ x[:3] - 1.0]),
-                "jac": lambda x: np.concatenate([2 * x[:3], [0.0]])[None],
-            },
+            norm,
         ],
         method="SLSQP",
         options={"ftol": 1e-15, "maxiter": 200},
     )
-    cands = [start, res.x[:3] / np.linalg.norm(res.x[:3])]
-    vals = [float(np.min(u @ c)) for c in cands]
-    k = int(np.argmax(vals))
-    return cands[k], vals[k]
+    return res.x[:3]
 
 
 def _fibonacci_sphere(n: int) -> np.ndarray:
