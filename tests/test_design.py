@@ -320,3 +320,36 @@ def test_per_vertex_depth():
     assert_allclose(d.vertices.depth_requested[3], 0.5)
     assert_allclose(d.vertices.depth[3], 0.5, atol=1e-9)
     assert_allclose(np.delete(d.vertices.depth, 3), 0.3, atol=1e-9)
+
+
+def s_prism():
+    """A prism over an S-shaped polygon: no point of the S sees all of it."""
+    s = np.array(
+        [
+            [0, 0],
+            [3, 0],
+            [3, 3],
+            [1, 3],
+            [1, 4],
+            [3, 4],
+            [3, 5],
+            [0, 5],
+            [0, 2],
+            [2, 2],
+            [2, 1],
+            [0, 1],
+        ],
+        dtype=float,
+    )
+    n = len(s)
+    v = np.vstack([np.c_[s, np.zeros(n)], np.c_[s, np.ones(n)]])
+    faces = [list(range(n))[::-1], list(range(n, 2 * n))]
+    faces += [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    return v, faces
+
+
+def test_face_that_is_not_star_shaped_is_named():
+    from filletfold.errors import MeshError
+
+    with pytest.raises(MeshError, match=r"face \d+ is not star-shaped"):
+        filletfold.round_mesh(s_prism(), radius=0.05)

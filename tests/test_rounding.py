@@ -124,3 +124,18 @@ def test_flat_edges_are_not_rounded():
 def test_bad_radius(radius, match):
     with pytest.raises(ParameterError, match=match):
         round_edges(mesh("cube"), radius)
+
+
+@pytest.mark.parametrize("name", ["cube", "dimpled-cube", "random-convex"])
+def test_tangent_lines_lie_on_both_faces_at_half_the_strip_width(name):
+    m = mesh(name)
+    rd = round_edges(m, 0.1)
+    for e in np.nonzero(~m.is_boundary_edge)[0]:
+        mid = m.vertices[m.edges[e]].mean(axis=0)
+        for k in (0, 1):
+            f = m.edge_faces[e, k]
+            t = rd.tangent_point[e, k]
+            assert abs((t - m.vertices[m.faces[f][0]]) @ m.face_normal[f]) < 1e-12
+            assert_allclose(np.linalg.norm(t - mid), rd.strip_width[e] / 2, rtol=1e-12)
+            q = t - rd.axis_point[e]
+            assert_allclose(np.linalg.norm(q), rd.radius[e], rtol=1e-12)

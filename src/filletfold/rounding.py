@@ -218,6 +218,10 @@ class EdgeRounding:
         ``w = A - a``.
     axis_point : (n_edges, 3) float
         ``O``, the axis point in the midpoint cross-section (edge midpoint at boundary edges).
+    tangent_point : (n_edges, 2, 3) float
+        Where the cylinder touches face ``edge_faces[e, 0]`` and ``edge_faces[e, 1]`` in the
+        midpoint cross-section; the tangent lines are these points plus multiples of the edge
+        direction (the edge midpoint at boundary and flat edges).
     limit : (n_edges,) float
         Largest valid radius per edge when its neighbours are rounded alike (see
         :func:`radius_limits`).
@@ -232,6 +236,7 @@ class EdgeRounding:
     strip_width: np.ndarray
     loss: np.ndarray
     axis_point: np.ndarray
+    tangent_point: np.ndarray
     limit: np.ndarray
     uniform_limit: float
 
@@ -298,6 +303,10 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
     nsum /= np.linalg.norm(nsum, axis=1)[:, None]
     shift = kappa[rounded] * r[rounded] / np.cos(gamma[rounded])
     axis[rounded] = mid[rounded] - shift[:, None] * nsum
+    tangent = np.repeat(mid[:, None], 2, axis=1)
+    for k in (0, 1):
+        n = mesh.face_normal[ef[rounded, k]]
+        tangent[rounded, k] = axis[rounded] + (kappa[rounded] * r[rounded])[:, None] * n
     gamma = np.where(flat, 0.0, gamma)
     arc = 2 * r * gamma
     strip = 2 * r * np.tan(gamma)
@@ -309,6 +318,7 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
         strip_width=strip,
         loss=loss_from_radius(r, gamma),
         axis_point=axis,
+        tangent_point=tangent,
         limit=limit,
         uniform_limit=uniform,
     )
