@@ -39,45 +39,74 @@ KINDS = {
 
 @dataclass
 class ApexConstraints:
-    """Sampled sec. 3.2 constraints of one vertex as arrays, ``g(V) >= 0`` in length units.
+    """Sampled sec. 3.2 constraints of one vertex as arrays, ``g(x) >= 0`` in length units.
+
+    The variables ``x`` are the spatial apex ``V`` (3,) for an open development, or ``V`` and
+    the developed apex ``v`` (5,) for a closed one (``v_fixed is None``).
+
+    Rows of the first kind depend on both apices through the crease length of eq. (1):
+    ``(sign num - coef Dn) / scale + const`` with ``num = |v_i - c|^2 - |V - C|^2`` and
+    ``Dn = (v_i)_y - (V - M) . R``, where ``v_i = Q v + t`` is the developed apex in the
+    cylinder's chart and ``c = (s, 0)``. Rows of the second kind are linear in ``V``:
+    ``lin_a @ V + lin_b``.
 
     Attributes
     ----------
     scale : float
-        Length used to scale quadratic constraints (mean incident edge length).
-    quad_* : arrays over quadratic rows (``l`` lower and upper bounds)
-    lin_a : (k, 3) float, lin_b : (k,) float
-        Linear rows ``lin_a @ V + lin_b``.
-    kind, edge : (n_rows,) str / int
+        Length used to scale quadratic rows (mean incident edge length).
+    v_fixed : (2,) float or None
+    kind, element : list of str
         What each row is (see ``KINDS``) and the mesh edge or face it belongs to.
     """
 
     scale: float
-    quad_c: np.ndarray  # (q, 3) centre C(s)
+    v_fixed: np.ndarray | None
+    quad_c: np.ndarray  # (q, 3) base point C(s)
     quad_R: np.ndarray  # (q, 3)
     quad_M: np.ndarray  # (q, 3)
-    quad_q: np.ndarray  # (q,) |v - c(s)|^2
-    quad_vy: np.ndarray  # (q,) developed height of v in the cylinder chart
+    quad_Q: np.ndarray  # (q, 2, 2) rotation of v into the cylinder chart
+    quad_t: np.ndarray  # (q, 2) translation of v into the cylinder chart
+    quad_s: np.ndarray  # (q,) arc parameter: c = (s, 0)
     quad_coef: np.ndarray  # (q,) multiplier of Dn
-    quad_sign: np.ndarray  # (q,) +1 for num - 2 m Dn, -1 for 2 Dn (lmax - m) - num
+    quad_sign: np.ndarray  # (q,) multiplier of num
+    quad_const: np.ndarray  # (q,)
     lin_a: np.ndarray
     lin_b: np.ndarray
     kind: list = field(default_factory=list)
     element: list = field(default_factory=list)
 
-    def values(self, V: np.ndarray) -> np.ndarray:
-        """(n_rows,) constraint values at apex ``V``."""
-        d = V - self.quad_c
-        num = self.quad_q - np.einsum("ij,ij->i", d, d)
-        dn = self.quad_vy - np.einsum("ij,ij->i", V - self.quad_M, self.quad_R)
-        quad = self.quad_sign * num - self.quad_coef * dn
-        return np.concatenate([quad / self.scale, self.lin_a @ V + self.lin_b])
+    @property
+    def n_vars(self) -> int:
+        return 3 if self.v_fixed is not None else 5
 
-    def jacobian(self, V: np.ndarray) -> np.ndarray:
-        """(n_rows, 3) derivative of :meth:`values`."""
+    def _split(self, x):
+        V = x[:3]
+        v = self.v_fixed if self.v_fixed is not None else x[3:5]
+        vi = np.einsum("qij,j->qi", self.quad_Q, v) + self.quad_t
+        return V, vi
+
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """(n_rows,) constraint values at ``x``."""
+        V, vi = self._split(x)
         d = V - self.quad_c
-        gq = -2 * self.quad_sign[:, None] * d + self.quad_coef[:, None] * self.quad_R
-        return np.vstack([gq / self.scale, self.lin_a])
+        num = (vi[:, 0] - self.quad_s) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", d, d)
+        dn = vi[:, 1] - np.einsum("ij,ij->i", V - self.quad_M, self.quad_R)
+        quad = (self.quad_sign * num - self.quad_coef * dn) / self.scale + self.quad_const
+        return np.concatenate([quad, self.lin_a @ V + self.lin_b])
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        """(n_rows, n_vars) derivative of :meth:`values`."""
+        V, vi = self._split(x)
+        d = V - self.quad_c
+        gV = -2 * self.quad_sign[:, None] * d + self.quad_coef[:, None] * self.quad_R
+        lin = self.lin_a
+        if self.v_fixed is None:
+            r = vi - np.stack([self.quad_s, np.zeros_like(self.quad_s)], axis=1)
+            gv = 2 * self.quad_sign[:, None] * np.einsum("qji,qj->qi", self.quad_Q, r)
+            gv -= self.quad_coef[:, None] * self.quad_Q[:, 1, :]
+            gV = np.hstack([gV, gv])
+            lin = np.hstack([lin, np.zeros((len(lin), 2))])
+        return np.vstack([gV / self.scale, lin])
 
     def describe(self, rows) -> list[str]:
         """Human-readable names of constraint rows, one per distinct (kind, element)."""
@@ -90,58 +119,56 @@ class ApexConstraints:
 
 
 def build_constraints(
-    frame: VertexFrame, v: np.ndarray, sigma: int, n_samples: int, margin: float
+    frame: VertexFrame, v: np.ndarray | None, sigma: int, n_samples: int, margin: float
 ) -> ApexConstraints:
-    """Sample the sec. 3.2 constraints of a closed vertex.
+    """Sample the sec. 3.2 constraints of a closed-ring vertex.
 
     Parameters
     ----------
     frame : VertexFrame
-    v : (2,) float
-        Developed apex in the common frame.
+    v : (2,) float or None
+        Developed apex in the common frame, or None to make it a variable (closed
+        development, sec. 3).
     sigma : int
     n_samples : int
         Samples per arc (>= 3, both ends included).
     margin : float
         Safety margin ``m`` (length).
     """
-    qc, qR, qM, qq, qvy, qcoef, qsign, kind, elem = ([] for _ in range(9))
-    la, lb, lkind, lelem = [], [], [], []
     scale = float(np.mean([s.length for s in frame.sides]))
+    quad = {k: [] for k in ("c", "R", "M", "Q", "t", "s", "coef", "sign", "const")}
+    kind, elem = [], []
+    la, lb, lkind, lelem = [], [], [], []
+
+    def add(C, side, Q, t, s, coef, sign, const, k, e):
+        n = len(s)
+        quad["c"].append(C)
+        quad["R"].append(np.repeat(side.R[None], n, 0))
+        quad["M"].append(np.repeat(side.M[None], n, 0))
+        quad["Q"].append(np.repeat(Q[None], n, 0))
+        quad["t"].append(np.repeat(t[None], n, 0))
+        quad["s"].append(s)
+        quad["coef"].append(np.full(n, coef))
+        quad["sign"].append(np.full(n, sign))
+        quad["const"].append(np.full(n, const))
+        kind.extend([k] * n)
+        elem.extend([e] * n)
+
     for i, side in enumerate(frame.sides):
         e = f"edge {side.edge}"
-        vi = apply(invert(frame.cyl_map[i]), v)[0]
+        inv = invert(frame.cyl_map[i])
+        Q, t = inv[:2, :2], inv[:2, 2]
         k_s = n_samples if side.arc > 0 else 1
         s = np.linspace(0.0, side.arc, k_s)
         C = side.base(s)
         N = side.normal(s)
-        q = (vi[0] - s) ** 2 + vi[1] ** 2
-        # l >= m at every sample
-        qc.append(C)
-        qR.append(np.repeat(side.R[None], k_s, 0))
-        qM.append(np.repeat(side.M[None], k_s, 0))
-        qq.append(q)
-        qvy.append(np.full(k_s, vi[1]))
-        qcoef.append(np.full(k_s, 2 * margin))
-        qsign.append(np.ones(k_s))
-        kind += ["l_min"] * k_s
-        elem += [e] * k_s
-        # l <= l_max - m at both ends
+        # l >= m at every sample:  num - 2 m Dn >= 0
+        add(C, side, Q, t, s, 2 * margin, 1.0, 0.0, "l_min", e)
+        # l <= l_max - m at both ends:  2 Dn (l_max - m) - num >= 0
         for idx, lmax in ((0, frame.lmax_start[i]), (-1, frame.lmax_end[i])):
-            qc.append(C[[idx]])
-            qR.append(side.R[None])
-            qM.append(side.M[None])
-            qq.append(q[[idx]])
-            qvy.append(np.array([vi[1]]))
-            qcoef.append(np.array([-2 * (lmax - margin)]))
-            qsign.append(np.array([-1.0]))
-            kind.append("l_max")
-            elem.append(e)
-        # valid patch: vy - (V - M) . R >= m
-        la.append(-side.R[None])
-        lb.append(np.array([vi[1] + side.M @ side.R - margin]))
-        lkind.append("patch")
-        lelem.append(e)
+            add(C[[idx]], side, Q, t, s[[idx]], -2 * (lmax - margin), -1.0, 0.0, "l_max", e)
+        # valid patch: Dn - m >= 0
+        add(C[[0]], side, Q, t, s[[0]], -scale, 0.0, -margin, "patch", e)
         # non-intersection along the arc
         la.append(sigma * N)
         lb.append(-sigma * np.einsum("ij,ij->i", N, C) - margin)
@@ -156,22 +183,28 @@ def build_constraints(
         lb.append(np.array([-sigma * ne @ frame.T_start[i] - margin]))
         lkind.append("chord")
         lelem.append(e)
-    normals = [frame.face_frames[i][1:] for i in range(len(frame.ring.faces))]
     for i, f in enumerate(frame.ring.faces):
-        n = np.cross(normals[i][0], normals[i][1])
+        n = np.cross(frame.face_frames[i][1], frame.face_frames[i][2])
         la.append(sigma * n[None])
         lb.append(np.array([-sigma * n @ frame.T_end[i] - margin]))
         lkind.append("face")
         lelem.append(f"face {int(f)}")
+    cat = {
+        k: (np.vstack(v_) if k in ("c", "R", "M", "t") else np.concatenate(v_))
+        for k, v_ in quad.items()
+    }
     return ApexConstraints(
         scale=scale,
-        quad_c=np.vstack(qc),
-        quad_R=np.vstack(qR),
-        quad_M=np.vstack(qM),
-        quad_q=np.concatenate(qq),
-        quad_vy=np.concatenate(qvy),
-        quad_coef=np.concatenate(qcoef),
-        quad_sign=np.concatenate(qsign),
+        v_fixed=None if v is None else np.asarray(v, dtype=float),
+        quad_c=cat["c"],
+        quad_R=cat["R"],
+        quad_M=cat["M"],
+        quad_Q=cat["Q"],
+        quad_t=cat["t"],
+        quad_s=cat["s"],
+        quad_coef=cat["coef"],
+        quad_sign=cat["sign"],
+        quad_const=cat["const"],
         lin_a=np.vstack(la),
         lin_b=np.concatenate(lb),
         kind=kind + lkind,
@@ -186,43 +219,57 @@ class ApexSolution:
     Attributes
     ----------
     ok : bool
-    apex : (3,) float
-        The apex (the best point found, also when not ok).
+    x : (3,) or (5,) float
+        The variables (the best point found, also when not ok): the spatial apex, then the
+        developed apex for a closed development.
     failing : list of str
         Constraints that cannot be met (when not ok).
     at_target : bool
-        True when ``P`` itself was feasible.
+        True when the target itself was feasible.
     """
 
     ok: bool
-    apex: np.ndarray
+    x: np.ndarray
     failing: list
     at_target: bool
+
+    @property
+    def apex(self) -> np.ndarray:
+        """(3,) float: the spatial apex V."""
+        return self.x[:3]
+
+    @property
+    def developed(self) -> np.ndarray | None:
+        """(2,) float: the developed apex v when it was a variable, else None."""
+        return self.x[3:5] if len(self.x) == 5 else None
 
 
 def _max_slack(cons: ApexConstraints, x_init: np.ndarray) -> tuple[np.ndarray, float]:
     """Maximise the smallest constraint value from ``x_init``; return the point and value."""
     L = cons.scale
+    n = cons.n_vars
     g = cons.values(x_init)
+    grad = np.zeros(n + 1)
+    grad[-1] = -1.0 / L
     res = minimize(
-        lambda x: -x[3] / L,
+        lambda x: -x[-1] / L,
         np.concatenate([x_init, [g.min()]]),
-        jac=lambda x: np.array([0, 0, 0, -1.0 / L]),
+        jac=lambda x: grad,
         constraints=[
             {
                 "type": "ineq",
-                "fun": lambda x: cons.values(x[:3]) - x[3],
-                "jac": lambda x: np.hstack([cons.jacobian(x[:3]), -np.ones((len(g), 1))]),
+                "fun": lambda x: cons.values(x[:n]) - x[-1],
+                "jac": lambda x: np.hstack([cons.jacobian(x[:n]), -np.ones((len(g), 1))]),
             }
         ],
-        bounds=[(None, None)] * 3 + [(None, L)],
+        bounds=[(None, None)] * n + [(None, L)],
         method="SLSQP",
         options={"ftol": 1e-14, "maxiter": 500},
     )
-    t = float(cons.values(res.x[:3]).min())
+    t = float(cons.values(res.x[:n]).min())
     if not np.isfinite(t) or t < g.min():
         return x_init, float(g.min())
-    return res.x[:3], t
+    return res.x[:n], t
 
 
 def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSolution:
@@ -231,9 +278,10 @@ def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSo
     Parameters
     ----------
     cons : ApexConstraints
-    target : (3,) float
-        ``P = U + d D``.
-    starts : sequence of (3,) float, optional
+    target : (3,) or (5,) float
+        ``P = U + d D``, followed by the target ``p`` of the developed apex when it is a
+        variable (closed development: the objective is ``|V - P|^2 + |v - p|^2``).
+    starts : sequence of (3,) or (5,) float, optional
         Further starting points for the feasibility phase, tried in order when the phase
         started at ``target`` does not reach a feasible point.
 
@@ -261,9 +309,9 @@ def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSo
         return ApexSolution(False, start, cons.describe(rows), False)
     # phase 2: closest feasible point to the target
     res = minimize(
-        lambda V: ((V - target) @ (V - target)) / L**2,
+        lambda x: ((x - target) @ (x - target)) / L**2,
         start,
-        jac=lambda V: 2 * (V - target) / L**2,
+        jac=lambda x: 2 * (x - target) / L**2,
         constraints=[{"type": "ineq", "fun": cons.values, "jac": cons.jacobian}],
         method="SLSQP",
         options={"ftol": 1e-15, "maxiter": 500},

@@ -1,0 +1,269 @@
+"""Consistent material loss: the linear programme of paper sec. 4.2-4.3, solved with HiGHS.
+
+Rounding an edge removes a strip of material of width ``w = A - a`` (sec. 4.1). Around every
+interior vertex, walking perpendicular to the incident edges by their losses must close up
+(sec. 4.2): then the rounded surface of a developable input folds from one uncut sheet.
+
+Variables: one width ``u_h >= b`` per half-edge ``h`` (edge ``e`` seen from face ``f``): the part of
+``e``'s loss taken from face ``f``, so ``w_e = u_(e,f) + u_(e,g)``. In the sector of face ``f`` at
+vertex U, between edges ``e`` and ``e'`` with angle ``alpha``, the corner of the contracting cycle
+lies at distance ``u_(e,f)`` from ``e`` and ``u_(e',f)`` from ``e'``; it projects onto ``e`` at
+``x = (u_(e',f) + u_(e,f) cos(alpha)) / sin(alpha)`` from U. The cycle's side across ``e`` is
+perpendicular to ``e`` when both sectors beside ``e`` give the same ``x`` -- the paper's equality
+``(w_i^+ + w_i^- cos a_i) / sin a_i = (w_j^- + w_j^+ cos a_j) / sin a_j``, which checks out
+against the geometry of fig. 15.
+
+Correction to sec. 4.3 (METHOD-NOTES 10): the paper gives each sector its own ``w_i^{+/-}``, so a
+half-edge would have independent widths at its two ends and the region between the two cycles
+would be a trapezoid, not the rectangle of fig. 13. Here a half-edge has one width, shared by
+both of its ends, so every region is a rectangle and contracting it gives a consistent sheet.
+
+The paper leaves the "maximal rounding width" undefined. Here every face corner must keep its
+tangent-line crossing T within ``share`` of each edge's half length (the radius limit of
+:func:`filletfold.rounding.radius_limits`, with room left for the crease), and optionally
+``w_e <= max_loss``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linprog
+
+from .errors import ParameterError
+from .mesh.polymesh import PolyMesh
+from .rounding import edge_dihedral, radius_from_loss, tan_minus_angle
+from .tolerances import tol
+
+
+@dataclass
+class MaterialLoss:
+    """Result of the material-loss linear programme.
+
+    Attributes
+    ----------
+    ok : bool
+        True when the programme is feasible with ``b > 0``.
+    bound : float
+        The optimal ``b`` (smallest half-edge width).
+    halfedge_width : (n_halfedges,) float
+        ``u_h`` per mesh half-edge (0 at boundary and flat edges).
+    edge_loss : (n_edges,) float
+        ``w_e``, the material loss per edge.
+    edge_radius : (n_edges,) float
+        The radius that causes that loss (0 where not rounded).
+    closure : (n_vertices,) float
+        Largest violation of the cycle equalities at each interior vertex (0 elsewhere).
+    tight : list of str
+        Inequalities that hold with equality at the optimum.
+    binding : list of str
+        When not ok: the vertices and edges that keep ``b`` from being positive.
+    message : str
+    """
+
+    ok: bool
+    bound: float
+    halfedge_width: np.ndarray
+    edge_loss: np.ndarray
+    edge_radius: np.ndarray
+    closure: np.ndarray
+    tight: list
+    binding: list
+    message: str
+
+
+def _corner_rows(mesh: PolyMesh):
+    """Projection coefficients of every face corner onto its two edges.
+
+    Returns
+    -------
+    h_out, h_in : (n_halfedges,) int
+        At the corner of half-edge ``h_out`` (its tail), the outgoing and incoming half-edge.
+    alpha : (n_halfedges,) float
+        Corner angle.
+    """
+    prev = np.empty(len(mesh.halfedge_from), dtype=np.int64)
+    for fi in range(mesh.n_faces):
+        s, e = mesh.face_start[fi], mesh.face_start[fi + 1]
+        prev[s:e] = np.roll(np.arange(s, e), 1)
+    return np.arange(len(prev)), prev, mesh.corner_angles()
+
+
+def cycle_equalities(mesh: PolyMesh, interior: np.ndarray):
+    """The cycle equalities ``x_(e,f)(U) = x_(e,g)(U)`` as a dense matrix over half-edges.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    interior : (n_vertices,) bool
+        Vertices that get an equality per incident edge.
+
+    Returns
+    -------
+    A : (n_rows, n_halfedges) float
+    rows : list of (int, int)
+        ``(vertex, edge)`` of each row.
+    """
+    h_out, h_in, alpha = _corner_rows(mesh)
+    sin, cos = np.sin(alpha), np.cos(alpha)
+    n_h = len(h_out)
+    # x along the edge of h_out: (u[h_in] + u[h_out] cos) / sin; along h_in's edge: symmetric
+    exprs: dict[tuple[int, int], list[np.ndarray]] = {}
+    for h in range(n_h):
+        u = int(mesh.halfedge_from[h])
+        if not interior[u]:
+            continue
+        for own, other in ((h_out[h], h_in[h]), (h_in[h], h_out[h])):
+            row = np.zeros(n_h)
+            row[own] += cos[h] / sin[h]
+            row[other] += 1.0 / sin[h]
+            exprs.setdefault((u, int(mesh.halfedge_edge[own])), []).append(row)
+    rows, mat = [], []
+    for key in sorted(exprs):
+        pair = exprs[key]
+        if len(pair) == 2:
+            rows.append(key)
+            mat.append(pair[0] - pair[1])
+    return (np.array(mat) if mat else np.zeros((0, n_h))), rows
+
+
+def solve_material_loss(
+    mesh: PolyMesh,
+    *,
+    max_loss: float | None = None,
+    share: float = 0.8,
+    flat_deg: float = tol.coplanar_deg,
+) -> MaterialLoss:
+    """Consistent material loss per edge by the sec. 4.3 linear programme (HiGHS).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    max_loss : float, optional
+        Upper bound on every edge's loss ``w_e`` (absolute length).
+    share : float
+        Every tangent-line crossing T must stay within ``share`` of each edge's half length from
+        the corner, in (0, 1).
+    flat_deg : float
+        Edges flatter than this (degrees) are not rounded.
+
+    Returns
+    -------
+    MaterialLoss
+    """
+    if not 0 < share < 1:
+        raise ParameterError(f"share must be in (0, 1), got {share!r}", name="share")
+    if max_loss is not None and not (np.isfinite(max_loss) and max_loss > 0):
+        raise ParameterError(
+            f"max loss must be a positive length, got {max_loss!r}", name="max_loss"
+        )
+    gamma, _ = edge_dihedral(mesh)
+    rounded = ~mesh.is_boundary_edge & (2 * gamma >= np.radians(flat_deg))
+    n_h = len(mesh.halfedge_from)
+    he_edge = mesh.halfedge_edge
+    var = rounded[he_edge]  # half-edges with a free width
+    interior = ~mesh.is_boundary_vertex
+    A_eq, rows = cycle_equalities(mesh, interior)
+
+    # offsets d_e = A_e / 2 = k_e w_e of the tangent lines, linear in the loss
+    k = np.where(rounded, np.tan(gamma) / (2 * np.where(rounded, tan_minus_angle(gamma), 1.0)), 0.0)
+    loss_of_edge = np.zeros((mesh.n_edges, n_h))
+    loss_of_edge[he_edge, np.arange(n_h)] = 1.0  # w_e = sum of its half-edge widths
+    h_out, h_in, alpha = _corner_rows(mesh)
+    sin, cos = np.sin(alpha), np.cos(alpha)
+    L = mesh.edge_length
+    ub_rows, ub_rhs, ub_names = [], [], []
+    for h in range(n_h):
+        if sin[h] <= 0:
+            continue  # reflex corner: the crossing lies behind the corner
+        e_o, e_i = he_edge[h_out[h]], he_edge[h_in[h]]
+        for own, other in ((e_o, e_i), (e_i, e_o)):
+            if not rounded[own]:
+                continue
+            row = (k[other] * loss_of_edge[other] + k[own] * cos[h] * loss_of_edge[own]) / sin[h]
+            ub_rows.append(row)
+            ub_rhs.append(share * 0.5 * L[own])
+            ub_names.append(
+                f"tangent-line crossing at vertex {mesh.halfedge_from[h]} on face "
+                f"{mesh.halfedge_face[h]} at {share:g} of edge {own}'s half length"
+            )
+    if max_loss is not None:
+        for e in np.nonzero(rounded)[0]:
+            ub_rows.append(loss_of_edge[e])
+            ub_rhs.append(max_loss)
+            ub_names.append(f"edge {e} at the maximal loss {max_loss:g}")
+    # b <= u_h for free half-edges:  b - u_h <= 0
+    n_x = n_h + 1
+    A_ub = [np.append(r, 0.0) for r in ub_rows]
+    b_ub = list(ub_rhs)
+    for h in np.nonzero(var)[0]:
+        row = np.zeros(n_x)
+        row[h] = -1.0
+        row[-1] = 1.0
+        A_ub.append(row)
+        b_ub.append(0.0)
+    n_width_rows = int(var.sum())
+    A_eq_x = np.hstack([A_eq, np.zeros((len(A_eq), 1))])
+    c = np.zeros(n_x)
+    c[-1] = -1.0
+    bounds = [(0.0, None) if v else (0.0, 0.0) for v in var] + [(None, None)]
+    res = linprog(
+        c,
+        A_ub=np.array(A_ub) if A_ub else None,
+        b_ub=np.array(b_ub) if b_ub else None,
+        A_eq=A_eq_x if len(A_eq_x) else None,
+        b_eq=np.zeros(len(A_eq_x)) if len(A_eq_x) else None,
+        bounds=bounds,
+        method="highs",
+    )
+    if res.status != 0 or res.x is None:
+        return MaterialLoss(
+            False,
+            0.0,
+            np.zeros(n_h),
+            np.zeros(mesh.n_edges),
+            np.zeros(mesh.n_edges),
+            np.zeros(mesh.n_vertices),
+            [],
+            [],
+            f"the material-loss programme failed: {res.message}",
+        )
+    u = res.x[:n_h].copy()
+    b = float(res.x[-1])
+    # polish: remove the solver's equality residual (minimal-norm correction on free widths)
+    if len(A_eq):
+        sub = A_eq[:, var]
+        corr, *_ = np.linalg.lstsq(sub, A_eq @ u, rcond=None)
+        u[var] -= corr
+    u = np.where(var, u, 0.0)
+    closure = np.zeros(mesh.n_vertices)
+    if len(A_eq):
+        resid = np.abs(A_eq @ u)
+        for (vtx, _), r in zip(rows, resid, strict=True):
+            closure[vtx] = max(closure[vtx], r)
+    w = loss_of_edge @ u
+    radius = np.where(rounded & (w > 0), radius_from_loss(w, np.where(rounded, gamma, 1.0)), 0.0)
+    slack = np.array(b_ub) - np.array(A_ub) @ res.x if A_ub else np.zeros(0)
+    scale = float(L.mean())
+    tight = [ub_names[i] for i in range(len(ub_names)) if slack[i] <= 1e-9 * scale]
+    n_b_tight = int(np.sum(slack[len(ub_names) : len(ub_names) + n_width_rows] <= 1e-9 * scale))
+    if n_b_tight:
+        tight.append(f"{n_b_tight} half-edge width(s) at the bound b")
+    ok = b > 1e-12 * scale
+    binding = []
+    if not ok:
+        marg = getattr(res, "eqlin", None)
+        if marg is not None and len(rows):
+            strong = np.nonzero(np.abs(marg.marginals) > 1e-9)[0]
+            verts = sorted({rows[i][0] for i in strong})
+            edges = sorted({rows[i][1] for i in strong})
+            binding = [f"vertices {verts}", f"edges {edges}"]
+        message = (
+            "no consistent material loss with every rounded edge positive (b = "
+            f"{b:.3g} <= 0): the cycle equalities force some widths to zero"
+            + (f"; binding: {binding[0]}, {binding[1]}" if binding else "")
+        )
+    else:
+        message = f"consistent material loss found: b = {b:.6g}"
+    return MaterialLoss(ok, b, u, w, radius, closure, tight, binding, message)
