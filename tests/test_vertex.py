@@ -163,7 +163,7 @@ def test_random_convex_polyhedra_every_solved_apex_is_valid(seed, share, depth):
         assert check.ok, check.failing
 
 
-def folded_degree4_vertex(a=(1.2, 1.9), t=0.6):
+def folded_degree4_vertex(a=(1.0, 2.0), t=0.3):
     """Four triangles around one interior vertex whose angles sum to 2 pi, folded in 3D."""
     a1, a2 = a
     a3, a4 = np.pi - a1, np.pi - a2  # Kawasaki-like choice; the sum is 2 pi

@@ -13,13 +13,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, SolverError
 from .layout import shelf_layout
+from .material_loss import MaterialLoss, solve_material_loss
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
 from .module import Piece, build_module, face_piece_centres
 from .pattern import CreasePattern
 from .rounding import EdgeRounding, clamp_radii, round_edges
+from .sheet import glue_pieces
 from .tolerances import tol
 from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_vertex_apex
 
@@ -84,6 +86,12 @@ class Parameters:
         Points per cylinder arc.
     clamp : bool
         Whether radii over their limit were reduced to fit.
+    material_loss : bool
+        Whether radii came from the consistent-material-loss programme.
+    max_loss : float, str or None
+        Cap on each edge's loss.
+    layout : str
+        Layout asked for.
     coplanar_deg : float
         Neighbouring faces closer than this angle are merged on input.
     """
@@ -92,6 +100,9 @@ class Parameters:
     depth: object = DEFAULT_DEPTH
     samples: int = DEFAULT_SAMPLES
     clamp: bool = False
+    material_loss: bool = False
+    max_loss: object = None
+    layout: str = "auto"
     coplanar_deg: float = tol.coplanar_deg
 
     def as_dict(self) -> dict:
@@ -103,6 +114,9 @@ class Parameters:
             "depth": plain(self.depth),
             "samples": self.samples,
             "clamp": self.clamp,
+            "material_loss": self.material_loss,
+            "max_loss": plain(self.max_loss) if self.max_loss is not None else None,
+            "layout": self.layout,
             "coplanar_deg": self.coplanar_deg,
         }
 
@@ -123,6 +137,12 @@ class Design:
         Seconds per stage.
     source : str
         What the mesh came from (path or example name).
+    material_loss : MaterialLoss or None
+        The consistent-material-loss solution, when radii came from it.
+    layout : str
+        ``"modules"`` (one piece per vertex) or ``"sheet"`` (one glued sheet).
+    layout_note : str
+        Why the sheet could not be made, when it was tried and not made.
     """
 
     mesh: PolyMesh
@@ -133,6 +153,9 @@ class Design:
     pieces: list
     timings: dict = field(default_factory=dict)
     source: str = ""
+    material_loss: MaterialLoss | None = None
+    layout: str = "modules"
+    layout_note: str = ""
 
     @property
     def vertex_status(self) -> list:
@@ -227,6 +250,9 @@ def round_mesh(
     *,
     samples: int = DEFAULT_SAMPLES,
     clamp: bool = False,
+    material_loss: bool = False,
+    max_loss=None,
+    layout: str = "auto",
     coplanar_deg: float = tol.coplanar_deg,
     progress=None,
 ) -> Design:
@@ -247,6 +273,18 @@ def round_mesh(
     clamp : bool
         Reduce radii over their edge's limit to 90% of it (see
         :func:`filletfold.rounding.clamp_radii`) instead of raising.
+    material_loss : bool
+        Choose every edge's radius from the consistent-material-loss linear programme (sec. 4,
+        :func:`filletfold.material_loss.solve_material_loss`); ``radius`` is then ignored.
+        On a developable input the rounded development of every interior vertex closes, so the
+        design folds from one uncut sheet.
+    max_loss : float or str, optional
+        Upper bound on each edge's material loss (a length or a percentage of the mean edge
+        length), with ``material_loss``.
+    layout : {"auto", "modules", "sheet"}
+        ``"modules"``: one piece per vertex, side by side. ``"sheet"``: all modules glued into
+        one sheet (needs every vertex's development to close; raises otherwise). ``"auto"``:
+        the sheet when it can be made, else modules.
     coplanar_deg : float
         Merge neighbouring faces whose normals differ by less than this (degrees).
     progress : callable, optional
@@ -262,11 +300,19 @@ def round_mesh(
         Unreadable or invalid mesh.
     ParameterError
         Invalid radius, depth or samples (a radius over an edge's limit names the edge).
+    SolverError
+        With ``material_loss``: the programme has no solution with positive losses (the
+        message names the binding vertices and edges); with ``layout="sheet"``: the modules do
+        not fit into one sheet.
     """
     timings = {}
     t0 = time.perf_counter()
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
         raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
+    if layout not in ("auto", "modules", "sheet"):
+        raise ParameterError(
+            f"layout must be 'auto', 'modules' or 'sheet', got {layout!r}", name="layout"
+        )
     if not (np.isfinite(coplanar_deg) and 0 <= coplanar_deg < 90):
         raise ParameterError(
             f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
@@ -280,14 +326,25 @@ def round_mesh(
         depth=depth,
         samples=int(samples),
         clamp=bool(clamp),
+        material_loss=bool(material_loss),
+        max_loss=max_loss,
+        layout=layout,
         coplanar_deg=coplanar_deg,
     )
     ref = pm.mean_edge_length
 
     t = time.perf_counter()
-    r = parse_length(radius, ref, "radius", count=pm.n_edges)
-    if clamp:
-        r = clamp_radii(pm, r, flat_deg=coplanar_deg)
+    loss = None
+    if material_loss:
+        cap = None if max_loss is None else float(parse_length(max_loss, ref, "max loss"))
+        loss = solve_material_loss(pm, max_loss=cap, flat_deg=coplanar_deg)
+        if not loss.ok:
+            raise SolverError(loss.message)
+        r = loss.edge_radius
+    else:
+        r = parse_length(radius, ref, "radius", count=pm.n_edges)
+        if clamp:
+            r = clamp_radii(pm, r, flat_deg=coplanar_deg)
     rounding = round_edges(pm, r, flat_deg=coplanar_deg)
     timings["rounding"] = time.perf_counter() - t
     depths = _resolve_depth(depth, ref, pm.n_vertices)
@@ -315,10 +372,25 @@ def round_mesh(
         pieces.extend(build_module(pm, frame, centres, int(samples), apex, v))
         if progress is not None:
             progress("surface", u + 1, pm.n_vertices)
+    layout_used, layout_note = "modules", ""
+    if layout != "modules" and (material_loss or layout == "sheet"):
+        sheet, placement, layout_note = glue_pieces(pieces, 1e-9 * ref)
+        if sheet is not None:
+            for piece, m in zip(pieces, placement, strict=True):
+                if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):
+                    p = np.asarray(piece.points_2d[piece.apex_index])
+                    res.apex_2d[piece.vertex] = m[:2, :2] @ p + m[:2, 2]
+            pieces, layout_used = [sheet], "sheet"
+        elif layout == "sheet":
+            raise SolverError(f"the modules do not form one sheet: {layout_note}")
     pattern, offsets = assemble_pattern(pieces, gap=0.1 * ref)
-    for k, piece in enumerate(pieces):
-        if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):
-            res.apex_2d[piece.vertex] = np.asarray(piece.points_2d[piece.apex_index]) + offsets[k]
+    if layout_used == "modules":
+        for k, piece in enumerate(pieces):
+            if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):
+                p = np.asarray(piece.points_2d[piece.apex_index])
+                res.apex_2d[piece.vertex] = p + offsets[k]
+    else:
+        res.apex_2d += offsets[0]
     timings["surface"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     return Design(
@@ -330,4 +402,7 @@ def round_mesh(
         pieces=pieces,
         timings=timings,
         source=source,
+        material_loss=loss,
+        layout=layout_used,
+        layout_note=layout_note,
     )

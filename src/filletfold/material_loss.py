@@ -18,6 +18,9 @@ half-edge would have independent widths at its two ends and the region between t
 would be a trapezoid, not the rectangle of fig. 13. Here a half-edge has one width, shared by
 both of its ends, so every region is a rectangle and contracting it gives a consistent sheet.
 
+The programme maximises ``b``; among its solutions the one with the smallest total loss is
+kept (a second linear programme), so the widths stay near ``b`` instead of at their caps.
+
 The paper leaves the "maximal rounding width" undefined. Here every face corner must keep its
 tangent-line crossing T within ``share`` of each edge's half length (the radius limit of
 :func:`filletfold.rounding.radius_limits`, with room left for the crease), and optionally
@@ -208,15 +211,24 @@ def solve_material_loss(
     c = np.zeros(n_x)
     c[-1] = -1.0
     bounds = [(0.0, None) if v else (0.0, 0.0) for v in var] + [(None, None)]
-    res = linprog(
-        c,
-        A_ub=np.array(A_ub) if A_ub else None,
-        b_ub=np.array(b_ub) if b_ub else None,
-        A_eq=A_eq_x if len(A_eq_x) else None,
-        b_eq=np.zeros(len(A_eq_x)) if len(A_eq_x) else None,
-        bounds=bounds,
-        method="highs",
-    )
+    lp = {
+        "A_ub": np.array(A_ub) if A_ub else None,
+        "b_ub": np.array(b_ub) if b_ub else None,
+        "A_eq": A_eq_x if len(A_eq_x) else None,
+        "b_eq": np.zeros(len(A_eq_x)) if len(A_eq_x) else None,
+        "method": "highs",
+    }
+    res = linprog(c, bounds=bounds, **lp)
+    if res.status == 0 and res.x[-1] > 0:
+        # stage 2: among the solutions with every width >= b*, the smallest total loss; the
+        # optimum of stage 1 leaves all widths but the smallest free, often at their caps
+        b_star = float(res.x[-1])
+        cost = np.append(var.astype(float), 0.0)
+        bounds2 = [*bounds[:-1], (b_star * (1 - 1e-9), b_star * (1 - 1e-9))]
+        res2 = linprog(cost, bounds=bounds2, **lp)
+        if res2.status == 0:
+            res2.x[-1] = b_star
+            res = res2
     if res.status != 0 or res.x is None:
         return MaterialLoss(
             False,

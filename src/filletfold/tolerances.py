@@ -31,6 +31,9 @@ class Tolerances:
         The max-min vertex-normal bound ``b`` must exceed this for a cone to exist.
     margin : float
         Safety margin of the sampled apex constraints, as a share of the shortest incident edge.
+    closure : float
+        A developable vertex's rounded development closes when the gap of ``rho`` is below
+        ``closure * mean incident edge length``.
     validate : float
         Slack allowed when the solved apex is validated densely, relative to the local edge length.
     """
@@ -43,6 +46,7 @@ class Tolerances:
     developable: float = 1e-7
     normal_bound: float = 1e-9
     margin: float = 5e-3
+    closure: float = 1e-9
     validate: float = 1e-9
 
 

@@ -113,11 +113,17 @@ def classify_vertex(
     D, b, sigma = vertex_normal(edge_dirs, mesh.face_normal[ring.faces])
     res.normal[u], res.normal_bound[u], res.sigma[u] = D, b, sigma
     if is_developable(res.angle_sum[u]):
-        res.kind[u] = res.status[u] = "developable"
-        res.reason[u] = (
-            "developable vertex (angle sum 2 pi): its development closes; it needs "
-            "consistent material loss (not solved here)"
-        )
+        res.kind[u] = "developable"
+        gap = float(np.linalg.norm(frame.rho[:2, 2]))
+        scale = float(np.mean([s.length for s in frame.sides]))
+        if gap > tol.closure * scale or b <= tol.normal_bound:
+            res.status[u] = "developable"
+            res.reason[u] = (
+                "developable vertex (angle sum 2 pi) whose rounded development does not close "
+                f"(gap {gap:.3g}): it needs consistent material loss (--material-loss)"
+                if b > tol.normal_bound
+                else "developable vertex (angle sum 2 pi) with no vertex normal"
+            )
         return frame
     if b <= tol.normal_bound:
         res.kind[u] = res.status[u] = "saddle"
@@ -128,6 +134,25 @@ def classify_vertex(
         return frame
     res.kind[u] = "cone"
     return frame
+
+
+def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
+    """Where the central rulings of two consecutive developed cylinders cross (sec. 3.2).
+
+    The initial developed apex ``p`` of a closed development. Returns (2,) float in the
+    vertex's common frame, or None when every consecutive pair is parallel.
+    """
+    lines = []
+    for i, side in enumerate(frame.sides):
+        if side.arc > 0:
+            m = frame.cyl_map[i]
+            lines.append((m[:2, :2] @ [0.5 * side.arc, 0.0] + m[:2, 2], m[:2, :2] @ [0.0, 1.0]))
+    for (p1, d1), (p2, d2) in zip(lines, lines[1:] + lines[:1], strict=True):
+        a = np.stack([d1, -d2], axis=1)
+        if abs(np.linalg.det(a)) > 1e-6:
+            z = np.linalg.solve(a, p2 - p1)
+            return p1 + z[0] * d1
+    return None
 
 
 def solve_vertex_apex(
@@ -147,10 +172,15 @@ def solve_vertex_apex(
     u = frame.vertex
     res.depth_requested[u] = depth
     D, sigma = res.normal[u], int(res.sigma[u])
-    v = frame.developed_apex()
+    closed = res.kind[u] == "developable"  # rho is the identity: v is a variable (sec. 3)
+    v = central_rulings_crossing(frame) if closed else frame.developed_apex()
     if v is None:
         res.status[u] = "infeasible"
-        res.reason[u] = "the development does not turn (rho is a translation): no developed apex"
+        res.reason[u] = (
+            "no developed apex: the central rulings of the developed cylinders are parallel"
+            if closed
+            else "the development does not turn (rho is a translation): no developed apex"
+        )
         return None, None
     res.apex_developed[u] = v
     if np.any(frame.corner_angle > np.pi):
@@ -164,6 +194,9 @@ def solve_vertex_apex(
     lengths = np.array([s.length for s in frame.sides])
     target = U + depth * D
     starts = [U + t * lengths.mean() * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
+    if closed:
+        target = np.concatenate([target, v])
+        starts = [np.concatenate([x, v]) for x in starts]
     margin = tol.margin * lengths.min()
     low = np.fmin(frame.lmax_start, frame.lmax_end).min()
     if not low > 0:
@@ -173,18 +206,20 @@ def solve_vertex_apex(
     failing = []
     for n_samples, scale in ((9, 1.0), (33, 2.0), (65, 4.0)):
         m = min(margin * scale, 0.25 * low)
-        cons = build_constraints(frame, v, sigma, n_samples, m)
+        cons = build_constraints(frame, None if closed else v, sigma, n_samples, m)
         sol = solve_apex(cons, target, starts)
         if not sol.ok:
             failing = sol.failing
             break
-        check = validate_apex(frame, sol.apex, v, sigma)
+        v_sol = sol.developed if closed else v
+        check = validate_apex(frame, sol.apex, v_sol, sigma)
         if check.ok:
             res.status[u] = "ok"
             res.apex[u] = sol.apex
+            res.apex_developed[u] = v_sol
             res.depth[u] = float((sol.apex - U) @ D)
             res.margin[u] = check.margin
-            return sol.apex, v
+            return sol.apex, v_sol
         failing = check.failing
     res.status[u] = "infeasible"
     res.reason[u] = "no apex meets every constraint: " + "; ".join(failing[:6])

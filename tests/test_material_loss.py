@@ -1,0 +1,85 @@
+"""Consistent material loss (paper sec. 4): the linear programme, closed developments, one sheet."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import filletfold
+from filletfold.errors import ParameterError, SolverError
+from filletfold.material_loss import cycle_equalities, solve_material_loss
+from filletfold.mesh import load_mesh
+from filletfold.rounding import edge_dihedral, loss_from_radius, round_edges
+from filletfold.vertex.frame import vertex_frame
+
+from .test_design import CHECKS
+from .test_vertex import folded_degree4_vertex
+
+
+def cut_edges(pattern) -> int:
+    """B edges whose folded segment is also another B edge: a seam cut through the sheet."""
+    b = pattern.edges[pattern.edge_assignment == "B"]
+    keys = [tuple(sorted(tuple(pattern.vertices_3d[i].round(9)) for i in e)) for e in b]
+    return len(keys) - len(set(keys))
+
+
+@pytest.mark.parametrize("name", ["icosahedron", "cube", "dimpled-cube"])
+def test_closing_conditions_and_radii(name):
+    m = load_mesh(name)[0]
+    ml = solve_material_loss(m)
+    assert ml.ok and ml.bound > 0
+    A, rows = cycle_equalities(m, ~m.is_boundary_vertex)
+    assert np.abs(A @ ml.halfedge_width).max() < 1e-14
+    assert len(rows) == 2 * m.n_edges  # one equality per (vertex, incident edge)
+    gamma, _ = edge_dihedral(m)
+    assert_allclose(loss_from_radius(ml.edge_radius, gamma), ml.edge_loss, rtol=1e-12)
+    assert np.all(ml.halfedge_width >= ml.bound * (1 - 1e-6))
+    # the radii are valid roundings
+    round_edges(m, ml.edge_radius)
+
+
+def test_regular_solid_gets_uniform_loss():
+    ml = solve_material_loss(load_mesh("icosahedron")[0])
+    assert_allclose(ml.edge_loss, ml.edge_loss[0], rtol=1e-9)
+
+
+def test_max_loss_caps_every_edge():
+    m = load_mesh("cube")[0]
+    ml = solve_material_loss(m, max_loss=0.05)
+    assert ml.ok and ml.edge_loss.max() <= 0.05 * (1 + 1e-9)
+    assert any("maximal loss" in t for t in ml.tight)
+
+
+def test_no_positive_solution_names_what_binds():
+    with pytest.raises(SolverError, match=r"no consistent material loss .* binding: vertices"):
+        filletfold.round_mesh("random-convex", material_loss=True)
+
+
+def test_bad_max_loss():
+    with pytest.raises(ParameterError, match="max loss must be a positive length"):
+        solve_material_loss(load_mesh("cube")[0], max_loss=-1.0)
+
+
+def test_developable_vertex_closes_and_folds_from_one_sheet():
+    v, f = folded_degree4_vertex()
+    d = filletfold.round_mesh((v, f), material_loss=True)
+    m = d.mesh
+    u = int(np.argmin(np.linalg.norm(m.vertices, axis=1)))
+    # rho is the identity: the rounded development closes (sec. 2.4, 4)
+    fr = vertex_frame(m, d.rounding, u)
+    assert_allclose(fr.rho, np.eye(3), atol=1e-12)
+    assert d.vertices.kind[u] == "developable" and d.vertices.status[u] == "ok"
+    assert d.layout == "sheet" and d.pattern.n_pieces == 1
+    assert cut_edges(d.pattern) == 0
+    for check in CHECKS:
+        check(d)
+
+
+def test_without_material_loss_the_developable_vertex_is_reported():
+    v, f = folded_degree4_vertex()
+    d = filletfold.round_mesh((v, f), radius="2%")
+    u = int(np.argmin(np.linalg.norm(d.mesh.vertices, axis=1)))
+    assert d.vertices.status[u] == "developable"
+    assert "--material-loss" in d.vertices.reason[u]
+    assert d.layout == "modules"
