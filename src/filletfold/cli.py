@@ -112,6 +112,31 @@ def round_cmd(
             "limit to 90% of the limit instead of stopping.",
         ),
     ] = False,
+    material_loss: Annotated[
+        bool,
+        typer.Option(
+            "--material-loss",
+            help="Choose every radius from the consistent-material-loss linear programme "
+            "(paper sec. 4): a developable input then folds from one uncut sheet. --radius is "
+            "ignored.",
+        ),
+    ] = False,
+    max_loss: Annotated[
+        str | None,
+        typer.Option(
+            "--max-loss",
+            help="With --material-loss: cap on each edge's material loss (a length or a "
+            "percentage of the mean edge length).",
+        ),
+    ] = None,
+    layout: Annotated[
+        str,
+        typer.Option(
+            "--layout",
+            help="'modules' (one piece per vertex), 'sheet' (all glued into one sheet; fails "
+            "if they do not fit) or 'auto' (the sheet when possible).",
+        ),
+    ] = "auto",
     coplanar_tol: Annotated[
         float,
         typer.Option(
@@ -153,6 +178,9 @@ def round_cmd(
                 depth=depth,
                 samples=samples,
                 clamp=clamp,
+                material_loss=material_loss,
+                max_loss=max_loss,
+                layout=layout,
                 coplanar_deg=coplanar_tol,
                 progress=progress,
             )

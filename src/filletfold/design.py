@@ -374,7 +374,20 @@ def round_mesh(
             progress("surface", u + 1, pm.n_vertices)
     layout_used, layout_note = "modules", ""
     if layout != "modules" and (material_loss or layout == "sheet"):
-        sheet, placement, layout_note = glue_pieces(pieces, 1e-9 * ref)
+        not_closed = [
+            u for u, f in enumerate(frames) if f.ring.closed and res.kind[u] != "developable"
+        ]
+        if not_closed:
+            listed = ", ".join(map(str, not_closed[:8])) + (", ..." if len(not_closed) > 8 else "")
+            sheet, layout_note = (
+                None,
+                (
+                    f"the input is not developable at {len(not_closed)} vertices ({listed}): their "
+                    "developments do not close, so their modules keep a cut"
+                ),
+            )
+        else:
+            sheet, placement, layout_note = glue_pieces(pieces, 1e-9 * ref)
         if sheet is not None:
             for piece, m in zip(pieces, placement, strict=True):
                 if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):

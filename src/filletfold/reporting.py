@@ -104,7 +104,21 @@ def design_report(design) -> dict:
             "max_edge_mismatch": float(edge_mismatch(pat).max(initial=0.0)),
             "max_relative_edge_mismatch": float(relative_mismatch(pat).max(initial=0.0)),
         },
+        "layout": {"kind": design.layout, "note": design.layout_note or None},
+        "material_loss": _loss_report(design.material_loss),
         "timings": {k: float(v) for k, v in design.timings.items()},
+    }
+
+
+def _loss_report(loss) -> dict | None:
+    if loss is None:
+        return None
+    return {
+        "ok": bool(loss.ok),
+        "bound": float(loss.bound),
+        "max_closure_residual": float(loss.closure.max(initial=0.0)),
+        "tight": list(loss.tight),
+        "message": loss.message,
     }
 
 
@@ -141,15 +155,25 @@ def design_summary(design, max_listed: int = 8) -> str:
         else "radius: no interior edge",
         f"vertices: {shown}",
     ]
+    if design.material_loss is not None:
+        ml = design.material_loss
+        w = ml.edge_loss[ml.edge_loss > 0]
+        lines.append(
+            f"material loss: b = {ml.bound:.4g}, loss {w.min():.4g}-{w.max():.4g} per edge, "
+            f"{len(ml.tight)} tight constraint group(s)"
+        )
     if len(depth):
         lines.append(f"apex depth used: {depth.min():.4g}-{depth.max():.4g}")
     lines.append(
-        f"pattern: {pat.n_pieces} pieces, {len(pat.faces)} faces, "
+        f"pattern: {pat.n_pieces} piece{'s' if pat.n_pieces != 1 else ''} ({design.layout}), "
+        f"{len(pat.faces)} faces, "
         f"{int(np.sum(pat.edge_assignment == 'M'))} mountain / "
         f"{int(np.sum(pat.edge_assignment == 'V'))} valley crease segments, "
         f"max edge mismatch {edge_mismatch(pat).max(initial=0.0):.2e} "
         f"(relative {relative_mismatch(pat).max(initial=0.0):.2e})"
     )
+    if design.layout_note:
+        lines.append(f"  no single sheet: {design.layout_note}")
     flagged = [u for u, st in enumerate(design.vertices.status) if st not in ("ok", "boundary")]
     for u in flagged[:max_listed]:
         reason = design.vertices.reason[u]
