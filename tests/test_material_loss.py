@@ -83,3 +83,46 @@ def test_without_material_loss_the_developable_vertex_is_reported():
     assert d.vertices.status[u] == "developable"
     assert "--material-loss" in d.vertices.reason[u]
     assert d.layout == "modules"
+
+
+def rotational_dome(n=8, rings=4, radius=2.0):
+    """A conical mesh: planar quads along meridians and parallels of a sphere cap."""
+    phis = np.linspace(0.25, 1.2, rings + 1)
+    t = 2 * np.pi * np.arange(n) / n
+    v = np.array(
+        [
+            [radius * np.sin(p) * np.cos(a), radius * np.sin(p) * np.sin(a), radius * np.cos(p)]
+            for p in phis
+            for a in t
+        ]
+    )
+    f = [
+        [i * n + k, (i + 1) * n + k, (i + 1) * n + (k + 1) % n, i * n + (k + 1) % n]
+        for i in range(rings)
+        for k in range(n)
+    ]
+    return v, f
+
+
+def test_conical_mesh_is_detected_and_rounded_by_face_offset():
+    from filletfold.conical import is_conical, vertex_cone_axes
+
+    m = load_mesh(rotational_dome())[0]
+    assert is_conical(m)
+    assert not is_conical(load_mesh("blob")[0])
+    d = filletfold.round_mesh(m, material_loss=True)
+    assert d.report()["material_loss"]["method"].startswith("conical")
+    inner = ~m.is_boundary_vertex
+    assert all(s == "ok" for s, i in zip(d.vertices.status, inner, strict=True) if i)
+    assert d.material_loss.closure.max() < 1e-14
+    # the vertex normal is the cone axis, on the apex side
+    axis, _ = vertex_cone_axes(m)
+    for u in np.nonzero(inner)[0]:
+        assert_allclose(d.vertices.normal[u], d.vertices.sigma[u] * axis[u], atol=1e-12)
+    # loss w = 2 delta tan(gamma) on every rounded edge: one offset for all
+    gamma, _ = edge_dihedral(m)
+    r = d.rounding.radius > 0
+    delta = d.material_loss.edge_loss[r] / (2 * np.tan(gamma[r]))
+    assert_allclose(delta, delta[0], rtol=1e-12)
+    for check in CHECKS:
+        check(d)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .conical import conical_material_loss, is_conical, vertex_cone_axes
 from .errors import ParameterError, SolverError
 from .layout import shelf_layout
 from .material_loss import MaterialLoss, solve_material_loss
@@ -208,6 +209,24 @@ def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
 
 
+def use_cone_axes(mesh: PolyMesh, frames: list, res: VertexResult) -> None:
+    """Make each cone vertex's normal its cone axis (conical meshes, sec. 4.4)."""
+    axis, _ = vertex_cone_axes(mesh)
+    for u, frame in enumerate(frames):
+        if res.kind[u] != "cone" or not np.all(np.isfinite(axis[u])):
+            continue
+        D = res.sigma[u] * axis[u]
+        dirs = np.vstack(
+            [
+                -np.array([s.R for s in frame.sides]),
+                res.sigma[u] * mesh.face_normal[frame.ring.faces],
+            ]
+        )
+        bound = float((dirs @ D).min())
+        if bound > tol.normal_bound:
+            res.normal[u], res.normal_bound[u] = D, bound
+
+
 def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np.ndarray]:
     """Lay pieces out side by side and merge them into one crease pattern.
 
@@ -334,10 +353,17 @@ def round_mesh(
     ref = pm.mean_edge_length
 
     t = time.perf_counter()
-    loss = None
+    loss, conical = None, False
     if material_loss:
         cap = None if max_loss is None else float(parse_length(max_loss, ref, "max loss"))
-        loss = solve_material_loss(pm, max_loss=cap, flat_deg=coplanar_deg)
+        developable = np.all(
+            np.abs(pm.vertex_angle_sum[~pm.is_boundary_vertex] - 2 * np.pi) < tol.developable
+        )
+        conical = not developable and is_conical(pm)
+        if conical:
+            loss, _ = conical_material_loss(pm, max_loss=cap, flat_deg=coplanar_deg)
+        else:
+            loss = solve_material_loss(pm, max_loss=cap, flat_deg=coplanar_deg)
         if not loss.ok:
             raise SolverError(loss.message)
         r = loss.edge_radius
@@ -353,6 +379,8 @@ def round_mesh(
     t = time.perf_counter()
     res = VertexResult.empty(pm.n_vertices)
     frames = [classify_vertex(pm, rounding, u, res) for u in range(pm.n_vertices)]
+    if material_loss and conical:
+        use_cone_axes(pm, frames, res)
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()

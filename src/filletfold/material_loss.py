@@ -135,7 +135,7 @@ def solve_material_loss(
     mesh: PolyMesh,
     *,
     max_loss: float | None = None,
-    share: float = 0.8,
+    share: float = 0.3,
     flat_deg: float = tol.coplanar_deg,
 ) -> MaterialLoss:
     """Consistent material loss per edge by the sec. 4.3 linear programme (HiGHS).

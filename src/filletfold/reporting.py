@@ -114,6 +114,9 @@ def _loss_report(loss) -> dict | None:
     if loss is None:
         return None
     return {
+        "method": "conical face offset (sec. 4.4)"
+        if loss.message.startswith("conical")
+        else "linear programme (sec. 4.3)",
         "ok": bool(loss.ok),
         "bound": float(loss.bound),
         "max_closure_residual": float(loss.closure.max(initial=0.0)),
