@@ -83,3 +83,22 @@ def test_unreadable_file(tmp_path, capsys):
     bad.write_text("v 0 0 0\nf 1 2 banana\n")
     assert main(["round", str(bad), "-o", str(tmp_path / "o")]) == 2
     assert "bad.obj" in capsys.readouterr().err
+
+
+def test_material_loss_reports_the_programme(tmp_path, capsys):
+    assert (
+        main(["round", "cube", "--material-loss", "--max-loss", "5%", "-o", str(tmp_path / "c")])
+        == 0
+    )
+    out = " ".join(capsys.readouterr().out.split())
+    assert "material loss: b =" in out and "not developable at 8 vertices" in out
+    report = json.loads((tmp_path / "c" / "report.json").read_text())
+    assert report["material_loss"]["ok"] is True and report["material_loss"]["bound"] > 0
+    assert report["layout"]["kind"] == "modules"
+    assert max(e["material_loss"] for e in report["edges"]) <= 0.05 + 1e-9
+
+
+def test_material_loss_without_solution_is_an_error(capsys, tmp_path):
+    assert main(["round", "random-convex", "--material-loss", "-o", str(tmp_path / "o")]) == 2
+    assert "no consistent material loss" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
