@@ -126,3 +126,18 @@ def test_conical_mesh_is_detected_and_rounded_by_face_offset():
     assert_allclose(delta, delta[0], rtol=1e-12)
     for check in CHECKS:
         check(d)
+
+
+def test_development_of_a_developable_mesh():
+    from filletfold.develop import develop_faces
+    from filletfold.errors import MeshError
+
+    m = load_mesh(folded_degree4_vertex())[0]
+    flat = develop_faces(m)
+    for f, face in enumerate(m.faces):  # every face congruent to its unfolding
+        p3 = m.vertices[face]
+        d3 = np.linalg.norm(p3[:, None] - p3[None], axis=-1)
+        d2 = np.linalg.norm(flat[f][:, None] - flat[f][None], axis=-1)
+        assert_allclose(d2, d3, atol=1e-12)
+    with pytest.raises(MeshError, match="not developable: vertex"):
+        develop_faces(load_mesh("cube")[0])
