@@ -67,6 +67,7 @@ def conical_material_loss(
     mesh: PolyMesh,
     *,
     max_loss: float | None = None,
+    max_radius=None,
     share: float = 0.3,
     flat_deg: float = tol.coplanar_deg,
 ) -> tuple[MaterialLoss, float]:
@@ -77,6 +78,8 @@ def conical_material_loss(
     mesh : PolyMesh
     max_loss : float, optional
         Cap on every edge's loss.
+    max_radius : float or (n_edges,) float, optional
+        Cap on every edge's radius.
     share : float
         Every tangent-line crossing T stays within ``share`` of each edge's half length.
 
@@ -109,6 +112,12 @@ def conical_material_loss(
             delta = min(delta, float(np.min(share * 0.5 * L[own][ok] / k[ok])))
     if max_loss is not None and w1.max() > 0:
         delta = min(delta, max_loss / float(w1.max()))
+    if max_radius is not None:
+        r1 = np.where(rounded, w1 / (2 * tm), 0.0)  # radius per unit offset
+        cap = np.broadcast_to(np.asarray(max_radius, dtype=float), r1.shape)
+        pos = r1 > 0
+        if pos.any():
+            delta = min(delta, float(np.min(cap[pos] / r1[pos])))
     if not np.isfinite(delta):
         delta = 0.0
     w = np.where(rounded, delta * w1, 0.0)
@@ -132,7 +141,7 @@ def conical_material_loss(
         closure=closure,
         tight=[
             f"face offset delta = {delta:.6g} (largest with every tangent-line crossing T "
-            f"within {share:g} of the half edge{' and the loss cap' if max_loss else ''})"
+            f"within {share:g} of the half edge and the caps)"
         ],
         binding=[],
         message=(

@@ -294,7 +294,8 @@ def round_mesh(
         :func:`filletfold.rounding.clamp_radii`) instead of raising.
     material_loss : bool
         Choose every edge's radius from the consistent-material-loss linear programme (sec. 4,
-        :func:`filletfold.material_loss.solve_material_loss`); ``radius`` is then ignored.
+        :func:`filletfold.material_loss.solve_material_loss`); ``radius`` is then the largest
+        radius any edge may get.
         On a developable input the rounded development of every interior vertex closes, so the
         design folds from one uncut sheet.
     max_loss : float or str, optional
@@ -360,10 +361,13 @@ def round_mesh(
             np.abs(pm.vertex_angle_sum[~pm.is_boundary_vertex] - 2 * np.pi) < tol.developable
         )
         conical = not developable and is_conical(pm)
+        r_cap = parse_length(radius, ref, "radius", count=pm.n_edges)
         if conical:
-            loss, _ = conical_material_loss(pm, max_loss=cap, flat_deg=coplanar_deg)
+            loss, _ = conical_material_loss(
+                pm, max_loss=cap, max_radius=r_cap, flat_deg=coplanar_deg
+            )
         else:
-            loss = solve_material_loss(pm, max_loss=cap, flat_deg=coplanar_deg)
+            loss = solve_material_loss(pm, max_loss=cap, max_radius=r_cap, flat_deg=coplanar_deg)
         if not loss.ok:
             raise SolverError(loss.message)
         r = loss.edge_radius

@@ -135,6 +135,7 @@ def solve_material_loss(
     mesh: PolyMesh,
     *,
     max_loss: float | None = None,
+    max_radius=None,
     share: float = 0.3,
     flat_deg: float = tol.coplanar_deg,
 ) -> MaterialLoss:
@@ -145,6 +146,10 @@ def solve_material_loss(
     mesh : PolyMesh
     max_loss : float, optional
         Upper bound on every edge's loss ``w_e`` (absolute length).
+    max_radius : float or (n_edges,) float, optional
+        Upper bound on every edge's resulting radius (a loss cap
+        ``w_e <= 2 r_max (tan(gamma) - gamma)``); keeps edges with a small dihedral angle,
+        whose radius grows like ``w / gamma^3``, from rounding too wide.
     share : float
         Every tangent-line crossing T must stay within ``share`` of each edge's half length from
         the corner, in (0, 1).
@@ -196,6 +201,15 @@ def solve_material_loss(
             ub_rows.append(loss_of_edge[e])
             ub_rhs.append(max_loss)
             ub_names.append(f"edge {e} at the maximal loss {max_loss:g}")
+    if max_radius is not None:
+        r_cap = np.broadcast_to(np.asarray(max_radius, dtype=float), (mesh.n_edges,))
+        if not np.all(np.isfinite(r_cap[rounded]) & (r_cap[rounded] > 0)):
+            raise ParameterError("max radius must be a positive length", name="max_radius")
+        cap = 2 * r_cap * np.where(rounded, tan_minus_angle(np.where(rounded, gamma, 1.0)), 0)
+        for e in np.nonzero(rounded)[0]:
+            ub_rows.append(loss_of_edge[e])
+            ub_rhs.append(cap[e])
+            ub_names.append(("maximal radius", f"edge {e}"))
     # b <= u_h for free half-edges:  b - u_h <= 0
     n_x = n_h + 1
     A_ub = [np.append(r, 0.0) for r in ub_rows]
