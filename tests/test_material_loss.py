@@ -141,3 +141,68 @@ def test_development_of_a_developable_mesh():
         assert_allclose(d2, d3, atol=1e-12)
     with pytest.raises(MeshError, match="not developable: vertex"):
         develop_faces(load_mesh("cube")[0])
+
+
+def check_sheet_is_the_input_shrunk_by_the_losses(d):
+    """Across every rounded edge the two face pieces come closer by exactly the edge's loss.
+
+    In the input's flat development the piece centres of the faces f, g beside edge e differ by
+    ``c_g - c_f``; in the sheet by ``c_g - c_f - w_e n_e`` (``n_e`` the edge normal from f to g).
+    """
+    from scipy.spatial import cKDTree
+
+    from filletfold.develop import develop_faces
+    from filletfold.module import face_piece_centres
+
+    m, p = d.mesh, d.pattern
+    flat = develop_faces(m)
+    centres = face_piece_centres(m, d.rounding)
+    where = {}
+    tree = cKDTree(p.vertices_3d)
+    for f in range(m.n_faces):
+        # centre in the input's development: fit the face's rigid map 3D plane -> 2D
+        face = m.faces[f]
+        p3 = m.vertices[face] - m.vertices[face[0]]
+        e1 = p3[1] / np.linalg.norm(p3[1])
+        e2 = np.cross(m.face_normal[f], e1)
+        local = np.stack([p3 @ e1, p3 @ e2], axis=1)
+        q = flat[f] - flat[f][0]
+        rot = np.linalg.lstsq(local, q, rcond=None)[0]
+        c = centres[f] - m.vertices[face[0]]
+        dist, k = tree.query(centres[f])
+        assert dist < 1e-9
+        where[f] = (np.array([c @ e1, c @ e2]) @ rot + flat[f][0], p.vertices_2d[k])
+    worst = 0.0
+    for e in np.nonzero(d.rounding.radius > 0)[0]:
+        f, g = m.edge_faces[e]
+        a, b = m.edges[e]
+        ia = int(np.nonzero(m.faces[f] == a)[0][0])
+        ib = int(np.nonzero(m.faces[f] == b)[0][0])
+        t = flat[f][ib] - flat[f][ia]
+        n = np.array([t[1], -t[0]]) / np.linalg.norm(t)  # right of a -> b in f: toward g
+        expect = np.linalg.norm(where[g][0] - where[f][0] - d.material_loss.edge_loss[e] * n)
+        got = np.linalg.norm(where[g][1] - where[f][1])
+        worst = max(worst, abs(got - expect))
+    assert worst < 1e-9 * m.mean_edge_length
+
+
+TESSELLATIONS = ["miura", "chicken-wire", "yoshimura", "resch"]
+
+
+@pytest.mark.parametrize("name", TESSELLATIONS)
+def test_tessellation_folds_from_one_uncut_sheet(name):
+    d = filletfold.round_mesh(name, material_loss=True)
+    assert d.material_loss.ok and d.material_loss.bound > 0
+    assert d.material_loss.closure.max() < 1e-14
+    interior = ~d.mesh.is_boundary_vertex
+    assert all(d.vertices.status[u] == "ok" for u in np.nonzero(interior)[0])
+    assert d.layout == "sheet" and d.pattern.n_pieces == 1
+    assert cut_edges(d.pattern) == 0
+    # the radii reproduce the losses
+    gamma, _ = edge_dihedral(d.mesh)
+    assert_allclose(
+        loss_from_radius(d.rounding.radius, gamma), d.material_loss.edge_loss, atol=1e-15
+    )
+    for check in CHECKS:
+        check(d)
+    check_sheet_is_the_input_shrunk_by_the_losses(d)

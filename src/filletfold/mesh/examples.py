@@ -3,6 +3,10 @@
 Every example has edges of length about 1 (the Platonic solids exactly 1, centred at the
 origin) and faces counter-clockwise seen from outside. ``EXAMPLES`` maps each name to an
 :class:`Example`; :func:`example_mesh` builds one.
+
+Some examples take parameters, written after a colon: ``"miura:4x3,angle=65,fold=0.6"``. A bare
+first token ``AxB`` is the ``cells`` parameter; the others are ``name=value``. The folded
+tessellations (:mod:`filletfold.mesh.tessellations`) are parametrised this way.
 """
 
 from __future__ import annotations
@@ -14,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from ..errors import MeshReadError
+from ..errors import MeshReadError, ParameterError
+from . import tessellations
 
 _PHI = (1.0 + np.sqrt(5.0)) / 2.0
 
@@ -29,15 +34,20 @@ class Example:
     description : str
     kinds : tuple of str
         Tags among ``"platonic"``, ``"convex"``, ``"non-convex"``, ``"saddle"``, ``"closed"``,
-        ``"open"``, ``"triangles"``, ``"polygons"``, ``"genus-1"``.
+        ``"open"``, ``"triangles"``, ``"quads"``, ``"polygons"``, ``"genus-1"``,
+        ``"developable"``, ``"tessellation"``, ``"conical"``.
     builder : callable
-        ``builder() -> (vertices (n, 3) float, faces list of (k,) int)``.
+        ``builder(**params) -> (vertices (n, 3) float, faces list of (k,) int)``.
+    params : tuple of str
+        Names of the keyword parameters ``builder`` accepts (empty: none). ``"cells"`` takes a
+        pair of ints written ``AxB``; every other parameter a float.
     """
 
     name: str
     description: str
     kinds: tuple[str, ...]
-    builder: Callable[[], tuple[np.ndarray, list[np.ndarray]]]
+    builder: Callable[..., tuple[np.ndarray, list[np.ndarray]]]
+    params: tuple[str, ...] = ()
 
     @property
     def closed(self) -> bool:
@@ -386,6 +396,54 @@ EXAMPLES: dict[str, Example] = {
             ("non-convex", "saddle", "open", "triangles"),
             _saddle_patch,
         ),
+        Example(
+            "miura",
+            "folded Miura-ori, unit-side parallelograms (closed form). Parameters: cells AxB "
+            "(A along the straight creases x B along the zigzags, default 4x4), angle = sector "
+            "angle in degrees (30..85, default 65), fold (0.05..0.95, default 0.5; 0 flat, "
+            "1 folded flat)",
+            ("developable", "tessellation", "open", "quads"),
+            tessellations.miura,
+            ("cells", "angle", "fold"),
+        ),
+        Example(
+            "chicken-wire",
+            "folded chicken-wire pattern: rows of isosceles trapezoids in anti-phase, curling "
+            "into a corrugated vault (closed form). Parameters: cells AxB (A trapezoids per "
+            "row x B rows, default 4x4), fold (0.05..0.95, default 0.5)",
+            ("developable", "tessellation", "open", "quads"),
+            tessellations.chicken_wire,
+            ("cells", "fold"),
+        ),
+        Example(
+            "yoshimura",
+            "folded Yoshimura diamond pattern, an arch of antiprism bands (closed form). "
+            "Parameters: cells AxB (A horizontal edges per row x B rows, default 5x4), fold "
+            "(0.05..0.95, default 0.5)",
+            ("developable", "tessellation", "open", "triangles"),
+            tessellations.yoshimura,
+            ("cells", "fold"),
+        ),
+        Example(
+            "resch",
+            "Ron Resch's triangle tessellation, partly folded: hexagonal star tucks sunk "
+            "under twisted triangle tops (numerical solve of the edge lengths). Parameters: "
+            "cells AxB (stars along the two lattice directions, 1..6, default 3x3), fold "
+            "(0.4..0.8, default 0.5; star depth as a share of the fully tucked depth)",
+            ("developable", "tessellation", "open", "triangles"),
+            tessellations.resch,
+            ("cells", "fold"),
+        ),
+        Example(
+            "conical-dome",
+            "conical mesh of a dome cap: planar quads on meridians and parallels, one cap "
+            "polygon; not developable. Parameters: cells AxB (A around x B rings, default 8x4), "
+            "opening = polar angle of the rim in degrees (10..150, default 60), height = "
+            "vertical stretch (0.2..5, default 1)",
+            ("convex", "conical", "open", "polygons"),
+            tessellations.conical_dome,
+            ("cells", "opening", "height"),
+        ),
     ]
 }
 
@@ -395,17 +453,83 @@ def example_names() -> list[str]:
     return list(EXAMPLES)
 
 
+def _split_spec(name: str) -> tuple[str, str]:
+    """``"miura:4x3,fold=0.6"`` -> ``("miura", "4x3,fold=0.6")``."""
+    base, _, params = str(name).partition(":")
+    return base.strip().lower().replace("_", "-").replace(" ", "-"), params.strip()
+
+
 def find_example(name: str) -> Example | None:
-    """The example called ``name`` (case-insensitive, ``_`` or space for ``-``), or None."""
-    key = name.strip().lower().replace("_", "-").replace(" ", "-")
-    return EXAMPLES.get(key)
+    """The example called ``name`` (case-insensitive, ``_`` or space for ``-``), or None.
+
+    Parameters after a colon are ignored here (see :func:`example_mesh`).
+    """
+    return EXAMPLES.get(_split_spec(name)[0])
 
 
 def unknown_example_message(name: str) -> str:
     """``"did you mean ..."`` plus the list of names, for error messages about ``name``."""
-    hint = difflib.get_close_matches(str(name).strip().lower(), example_names(), n=1)
+    hint = difflib.get_close_matches(_split_spec(name)[0], example_names(), n=1)
     did = f"did you mean '{hint[0]}'? " if hint else ""
     return f"{did}built-in examples: {', '.join(example_names())}"
+
+
+def _accepted(example: Example) -> str:
+    if not example.params:
+        return f"'{example.name}' takes no parameters"
+    return f"'{example.name}' accepts: {', '.join(example.params)} (cells as AxB, e.g. 4x3)"
+
+
+def parse_example_params(example: Example, text: str) -> dict[str, object]:
+    """Parse the parameter text of an example spec (the part after the colon).
+
+    Parameters
+    ----------
+    example : Example
+    text : str
+        Comma-separated ``name=value`` items; a first item without ``=`` is ``cells``.
+        ``cells`` is written ``AxB`` (two ints), other values are floats.
+
+    Returns
+    -------
+    dict
+        Keyword arguments for ``example.builder``.
+
+    Raises
+    ------
+    MeshReadError
+        An unknown or repeated parameter name, or a value that does not parse (the message
+        lists the accepted parameters).
+    """
+    params: dict[str, object] = {}
+    items = [t.strip() for t in text.split(",")] if text else []
+    for k, item in enumerate(items):
+        if "=" in item:
+            key, _, value = item.partition("=")
+            key, value = key.strip().lower(), value.strip()
+        elif k == 0:
+            key, value = "cells", item
+        else:
+            raise MeshReadError(
+                f"example parameter {item!r} needs a name (name=value); {_accepted(example)}"
+            )
+        if key not in example.params:
+            raise MeshReadError(f"unknown example parameter {key!r}; {_accepted(example)}")
+        if key in params:
+            raise MeshReadError(f"example parameter {key!r} given twice; {_accepted(example)}")
+        try:
+            if key == "cells":
+                a, b = value.lower().split("x")
+                params[key] = (int(a), int(b))
+            else:
+                params[key] = float(value)
+        except ValueError:
+            form = "AxB with integers A and B" if key == "cells" else "a number"
+            raise MeshReadError(
+                f"bad value {value!r} for example parameter {key!r}: expected {form}; "
+                f"{_accepted(example)}"
+            ) from None
+    return params
 
 
 def example_mesh(name: str) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -414,21 +538,27 @@ def example_mesh(name: str) -> tuple[np.ndarray, list[np.ndarray]]:
     Parameters
     ----------
     name : str
-        One of :func:`example_names`.
+        One of :func:`example_names`, optionally with parameters after a colon, e.g.
+        ``"miura:4x3,angle=65,fold=0.6"`` (see :func:`parse_example_params`).
 
     Returns
     -------
     vertices : (n_vertices, 3) float64
     faces : list of (k,) int64
-        Counter-clockwise seen from outside.
+        Counter-clockwise seen from outside (from the front, for open sheets).
 
     Raises
     ------
     MeshReadError
-        ``name`` is not a built-in example (the message lists them).
+        ``name`` is not a built-in example (the message lists them), or its parameters are
+        unknown, malformed or out of range (the message lists the accepted ones).
     """
     example = find_example(name) if isinstance(name, str) else None
     if example is None:
         raise MeshReadError(f"no built-in example named {name!r}; {unknown_example_message(name)}")
-    v, faces = example.builder()
+    params = parse_example_params(example, _split_spec(name)[1])
+    try:
+        v, faces = example.builder(**params)
+    except ParameterError as exc:
+        raise MeshReadError(f"example {name!r}: {exc}; {_accepted(example)}") from exc
     return np.array(v, dtype=np.float64), [np.asarray(f, dtype=np.int64).copy() for f in faces]
