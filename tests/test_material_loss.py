@@ -19,9 +19,7 @@ from .test_vertex import folded_degree4_vertex
 
 def cut_edges(pattern) -> int:
     """B edges whose folded segment is also another B edge: a seam cut through the sheet."""
-    b = pattern.edges[pattern.edge_assignment == "B"]
-    keys = [tuple(sorted(tuple(pattern.vertices_3d[i].round(9)) for i in e)) for e in b]
-    return len(keys) - len(set(keys))
+    return int(pattern.cut_mask().sum())
 
 
 @pytest.mark.parametrize("name", ["icosahedron", "cube", "dimpled-cube"])
@@ -206,3 +204,20 @@ def test_tessellation_folds_from_one_uncut_sheet(name):
     for check in CHECKS:
         check(d)
     check_sheet_is_the_input_shrunk_by_the_losses(d)
+
+
+def test_miura_from_an_obj_file(tmp_path):
+    from filletfold.mesh import example_mesh, write_obj
+
+    v, f = example_mesh("miura:5x4,fold=0.6")
+    write_obj(tmp_path / "miura.obj", v, f)
+    d = filletfold.round_mesh(str(tmp_path / "miura.obj"), material_loss=True)
+    assert d.layout == "sheet" and d.pattern.n_pieces == 1 and cut_edges(d.pattern) == 0
+    assert d.status_counts()["ok"] == int((~d.mesh.is_boundary_vertex).sum())
+    check_sheet_is_the_input_shrunk_by_the_losses(d)
+
+
+def test_loss_limit_per_edge_is_reported():
+    rep = filletfold.round_mesh("cube").report()
+    e = rep["edges"][0]
+    assert_allclose(e["material_loss_limit"], loss_from_radius(e["radius_limit"], np.pi / 4))

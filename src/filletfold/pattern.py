@@ -68,6 +68,20 @@ class CreasePattern:
     def n_pieces(self) -> int:
         return len(self.piece_vertex)
 
+    def cut_mask(self, decimals: int = 9) -> np.ndarray:
+        """(m,) bool: border edges that are cuts, i.e. seams: their folded segment is the
+        folded segment of another border edge too (the two sides of one cut).
+
+        Border edges that are not cuts lie on the outline of the sheet.
+        """
+        b = np.nonzero(self.edge_assignment == "B")[0]
+        ends = np.round(self.vertices_3d[self.edges[b]], decimals)  # (k, 2, 3)
+        ends = np.sort(ends.view([("", ends.dtype)] * 3).reshape(len(b), 2), axis=1)
+        _, inv, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+        mask = np.zeros(len(self.edges), dtype=bool)
+        mask[b] = counts[inv.ravel()] > 1
+        return mask
+
     def face_normal_3d(self) -> np.ndarray:
         """(n_faces, 3) float: unit front normals of the folded faces (Newell's method)."""
         a, b, start = self._halfedges()

@@ -9,6 +9,7 @@ import numpy as np
 
 from . import __version__
 from .export import fold_document, fold_json, folded_obj, pattern_svg, report_json, write_outputs
+from .rounding import loss_from_radius
 
 OUTPUT_FILES = ("design.fold", "report.json", "folded.obj", "pattern.svg")
 
@@ -55,6 +56,9 @@ def design_report(design) -> dict:
                 "strip_width": float(rd.strip_width[e]),
                 "material_loss": float(rd.loss[e]),
                 "radius_limit": _num(rd.limit[e]),
+                "material_loss_limit": _num(loss_from_radius(rd.limit[e], rd.half_angle[e]))
+                if rd.half_angle[e] > 0
+                else None,
             }
         )
     vertices = []
@@ -98,6 +102,7 @@ def design_report(design) -> dict:
         "vertices": vertices,
         "pattern": {
             "pieces": int(pat.n_pieces),
+            "cut_edges": int(pat.cut_mask().sum()),
             "vertices": len(pat.vertices_2d),
             "faces": len(pat.faces),
             "edges": counts,
