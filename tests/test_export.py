@@ -417,7 +417,7 @@ def test_svg_scale_bar_and_legend():
     )
     assert float(rect.get("y")) > drawing_bottom
     legend = " ".join(t.text for t in _group(root, "legend").iter(SVG_NS + "text"))
-    for word in ("mountain", "valley", "cut"):
+    for word in ("mountain", "valley", "border / cut"):
         assert word in legend
 
 

@@ -26,7 +26,7 @@ ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#ddddd
 #: Group id and legend label of each edge assignment, in drawing order (bottom first).
 _GROUPS = (
     ("F", "flat", "flat"),
-    ("B", "border", "cut"),
+    ("B", "border", "border / cut"),
     ("V", "valley", "valley"),
     ("M", "mountain", "mountain"),
 )
