@@ -9,6 +9,7 @@ from numpy.testing import assert_allclose
 from filletfold.errors import MeshReadError, ParameterError
 from filletfold.mesh import EXAMPLES, PolyMesh, example_mesh, example_names, load_mesh
 from filletfold.mesh import tessellations as tess
+from filletfold.mesh.intersect import crossing_triangle_pairs
 
 DEVELOPABLE = [n for n in example_names() if "developable" in EXAMPLES[n].kinds]
 SPECS = [
@@ -50,39 +51,8 @@ def planarity(mesh: PolyMesh) -> float:
     return worst
 
 
-def segment_hits_triangle(s0, s1, t):
-    """(n,) bool: segment ``s0[i] s1[i]`` meets triangle ``t[i]`` (Moller-Trumbore)."""
-    d = s1 - s0
-    e1, e2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
-    h = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, h)
-    ok = np.abs(det) > 1e-12
-    det = np.where(ok, det, 1.0)
-    s = s0 - t[:, 0]
-    u = np.einsum("ij,ij->i", s, h) / det
-    q = np.cross(s, e1)
-    w = np.einsum("ij,ij->i", d, q) / det
-    along = np.einsum("ij,ij->i", e2, q) / det
-    eps = 1e-9
-    inside = (u >= -eps) & (w >= -eps) & (u + w <= 1 + eps)
-    return ok & inside & (along >= -eps) & (along <= 1 + eps)
-
-
 def crossing_pairs(mesh: PolyMesh) -> int:
-    """Pairs of vertex-disjoint triangles of the fanned faces that intersect."""
-    tri = np.array([[f[0], f[k], f[k + 1]] for f in mesh.faces for k in range(1, len(f) - 1)])
-    p = mesh.vertices[tri]
-    lo, hi = p.min(axis=1), p.max(axis=1)
-    i, j = np.triu_indices(len(tri), 1)
-    near = (lo[i] <= hi[j]).all(axis=1) & (lo[j] <= hi[i]).all(axis=1)
-    i, j = i[near], j[near]
-    apart = ~(tri[i][:, :, None] == tri[j][:, None, :]).any(axis=(1, 2))
-    i, j = i[apart], j[apart]
-    hit = np.zeros(len(i), dtype=bool)
-    for a, b in ((i, j), (j, i)):
-        for k in range(3):
-            hit |= segment_hits_triangle(p[a, k], p[a, (k + 1) % 3], p[b])
-    return int(hit.sum())
+    return crossing_triangle_pairs(mesh.vertices, mesh.faces)
 
 
 def face_angle_lists(mesh: PolyMesh) -> list[np.ndarray]:
@@ -283,3 +253,12 @@ def test_spec_is_forgiving_and_deterministic():
     v3, _ = example_mesh("resch:2x2")
     v3[:] = 0
     assert np.abs(example_mesh("resch:2x2")[0]).max() > 0  # the cached solve is not shared
+
+
+def test_crossing_triangle_pairs_sees_a_crossing():
+    v = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0], [0.5, 0.5, -1], [0.5, 0.5, 1], [3, 3, 0.0]])
+    assert crossing_triangle_pairs(v, [[0, 1, 2], [3, 4, 5]]) == 1
+    assert crossing_triangle_pairs(v, [[0, 1, 2]]) == 0
+    far = v.copy()
+    far[3:, 0] += 10
+    assert crossing_triangle_pairs(far, [[0, 1, 2], [3, 4, 5]]) == 0

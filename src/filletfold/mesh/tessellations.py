@@ -28,6 +28,7 @@ from scipy.sparse import coo_matrix, identity, vstack
 from scipy.spatial import cKDTree
 
 from ..errors import ParameterError, SolverError
+from .intersect import crossing_triangle_pairs
 
 __all__ = ["chicken_wire", "conical_dome", "miura", "resch", "yoshimura"]
 
@@ -345,7 +346,7 @@ def resch(cells=(3, 3), fold: float = 0.5):
     m, n = _cells(cells, high=6)
     t = _in_range(fold, "fold", 0.4, 0.8)
     v, faces = _resch_folded(m, n, round(t, 12))
-    if _crossing_triangle_pairs(v, faces):
+    if crossing_triangle_pairs(v, faces):
         raise ParameterError(
             f"resch {m}x{n} with fold={t:g} passes through itself (the folded sheet curls); "
             "use fewer cells or a smaller fold",
@@ -552,40 +553,3 @@ def _project_lengths(x: np.ndarray, edges: np.ndarray, length: np.ndarray) -> np
     if np.abs(r).max() > 1e-12:
         raise SolverError(f"the folded Resch pattern misses an edge length by {np.abs(r).max():g}")
     return x
-
-
-def _crossing_triangle_pairs(v: np.ndarray, faces) -> int:
-    """Number of pairs of vertex-disjoint triangles (faces fanned) that intersect."""
-    tri = np.array([[f[0], f[k], f[k + 1]] for f in faces for k in range(1, len(f) - 1)])
-    p = v[tri]
-    lo, hi = p.min(axis=1), p.max(axis=1)
-    i, j = np.triu_indices(len(tri), 1)
-    near = (lo[i] <= hi[j]).all(axis=1) & (lo[j] <= hi[i]).all(axis=1)
-    i, j = i[near], j[near]
-    apart = ~(tri[i][:, :, None] == tri[j][:, None, :]).any(axis=(1, 2))
-    i, j = i[apart], j[apart]
-    hit = np.zeros(len(i), dtype=bool)
-    for a, b in ((i, j), (j, i)):
-        for k in range(3):
-            hit |= _segment_hits_triangle(p[a, k], p[a, (k + 1) % 3], p[b])
-    return int(hit.sum())
-
-
-def _segment_hits_triangle(s0: np.ndarray, s1: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """(n,) bool: segment ``s0[i] s1[i]`` meets triangle ``t[i]`` (Moller-Trumbore)."""
-    d = s1 - s0
-    e1 = t[:, 1] - t[:, 0]
-    e2 = t[:, 2] - t[:, 0]
-    h = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, h)
-    ok = np.abs(det) > 1e-12
-    det = np.where(ok, det, 1.0)
-    s = s0 - t[:, 0]
-    u = np.einsum("ij,ij->i", s, h) / det
-    q = np.cross(s, e1)
-    w = np.einsum("ij,ij->i", d, q) / det
-    along = np.einsum("ij,ij->i", e2, q) / det
-    eps = 1e-9
-    return (
-        ok & (u >= -eps) & (w >= -eps) & (u + w <= 1 + eps) & (along >= -eps) & (along <= 1 + eps)
-    )
