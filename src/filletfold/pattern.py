@@ -15,6 +15,53 @@ from .tolerances import tol
 
 
 @dataclass
+class Label:
+    """A text placed on the flat layout (part numbers, glue-tab matches, fold angles).
+
+    Attributes
+    ----------
+    position : (2,) float
+        Anchor (centre of the text) in pattern coordinates.
+    text : str
+    angle : float
+        Direction of the text baseline, degrees counter-clockwise from +x.
+    height : float
+        Text height in pattern length units.
+    kind : str
+        ``"part"``, ``"tab"`` (the matching label of a glue seam) or ``"angle"``.
+    """
+
+    position: np.ndarray
+    text: str
+    angle: float = 0.0
+    height: float = 0.05
+    kind: str = "part"
+
+
+@dataclass
+class Annotations:
+    """What a cut file shows besides the pattern's own edges.
+
+    Attributes
+    ----------
+    tabs : list of (k, 2) float
+        Glue-tab outlines (closed polygons, counter-clockwise) in pattern coordinates; each is
+        cut along its outline except the side it shares with its piece, which is folded.
+    tab_hinges : list of (2, 2) float
+        For each tab, the segment it shares with its piece (folded, not cut).
+    labels : list of Label
+    sheets : (n_sheets, 4) float
+        ``(xmin, ymin, xmax, ymax)`` of each sheet of material, in pattern coordinates (empty
+        when the pieces were not placed on sheets).
+    """
+
+    tabs: list = field(default_factory=list)
+    tab_hinges: list = field(default_factory=list)
+    labels: list = field(default_factory=list)
+    sheets: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+
+
+@dataclass
 class CreasePattern:
     """Flat pieces, folded positions, and crease data.
 
@@ -43,6 +90,8 @@ class CreasePattern:
         B and F.
     edge_faces : (m, 2) int
         The one or two faces beside each edge (-1 where there is none).
+    annotations : Annotations
+        Glue tabs, labels and sheet outlines for the cut files (empty by default).
     """
 
     vertices_2d: np.ndarray
@@ -55,6 +104,7 @@ class CreasePattern:
     edge_assignment: np.ndarray = field(default=None)
     edge_fold_angle: np.ndarray = field(default=None)
     edge_faces: np.ndarray = field(default=None)
+    annotations: Annotations = field(default_factory=Annotations)
 
     def __post_init__(self):
         self.vertices_2d = np.asarray(self.vertices_2d, dtype=np.float64).reshape(-1, 2)
