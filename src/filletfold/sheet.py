@@ -10,24 +10,9 @@ coincident points are then merged, so shared borders become ordinary facet edges
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .module import Piece
-
-
-def _rigid_fit(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
-    """3x3 homogeneous rotation + translation taking points ``src`` (k, 2) onto ``dst``."""
-    cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    h = (src - cs).T @ (dst - cd)
-    u, _, vt = np.linalg.svd(h)
-    r = (u @ vt).T
-    if np.linalg.det(r) < 0:  # a reflection cannot glue orientation-preserving pieces
-        vt[-1] *= -1
-        r = (u @ vt).T
-    m = np.eye(3)
-    m[:2, :2] = r
-    m[:2, 2] = cd - r @ cs
-    return m
+from .net import merge_pieces, rigid_fit, shared_points
 
 
 def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, str]:
@@ -49,18 +34,7 @@ def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, st
         Why gluing failed (empty on success).
     """
     arrays = [p.arrays() for p in pieces]
-    owner = np.concatenate([np.full(len(a[0]), k) for k, a in enumerate(arrays)])
-    local = np.concatenate([np.arange(len(a[0])) for a in arrays])
-    p3 = np.vstack([a[1] for a in arrays])
-    tree = cKDTree(p3)
-    pairs = tree.query_pairs(eps, output_type="ndarray")
-    pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
-    # shared points between every two pieces
-    shared: dict[tuple[int, int], list[tuple[int, int]]] = {}
-    for a, b in pairs:
-        ka, kb = int(owner[a]), int(owner[b])
-        shared.setdefault((ka, kb), []).append((int(local[a]), int(local[b])))
-        shared.setdefault((kb, ka), []).append((int(local[b]), int(local[a])))
+    shared = shared_points(pieces, eps)
     placed = {0: np.eye(3)}
     queue = [0]
     while queue:
@@ -71,7 +45,7 @@ def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, st
             src = arrays[kb][0][[j for _, j in matches]]
             dst = arrays[ka][0][[i for i, _ in matches]]
             dst = dst @ placed[ka][:2, :2].T + placed[ka][:2, 2]
-            m = _rigid_fit(src, dst)
+            m = rigid_fit(src, dst)
             err = np.abs(src @ m[:2, :2].T + m[:2, 2] - dst).max()
             if err > eps:
                 return (
@@ -94,14 +68,5 @@ def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, st
                 f"(vertices {[pieces[k].vertex for k in missing[:10]]})"
             ),
         )
-    sheet = Piece(vertex=-1)
-    for k, piece in enumerate(pieces):
-        p2, q3 = arrays[k]
-        p2 = p2 @ placed[k][:2, :2].T + placed[k][:2, 2]
-        base = len(sheet.points_2d)
-        sheet.points_2d.extend(p2)
-        sheet.points_3d.extend(q3)
-        sheet.faces.extend([[i + base for i in f] for f in piece.faces])
-        sheet.patches.extend(piece.patches)
-    sheet.merge_coincident(eps)
-    return sheet, [placed[k] for k in range(len(pieces))], ""
+    placement = [placed[k] for k in range(len(pieces))]
+    return merge_pieces(pieces, placement, eps), placement, ""

@@ -272,7 +272,9 @@ def _line_crossing(p1, d1, p2, d2):
     return float(z[0]), float(z[1])
 
 
-def vertex_frame(mesh: PolyMesh, rounding: EdgeRounding, u: int) -> VertexFrame:
+def vertex_frame(
+    mesh: PolyMesh, rounding: EdgeRounding, u: int, start_edge: int | None = None
+) -> VertexFrame:
     """Build the sides, T points and development of vertex ``u``.
 
     Parameters
@@ -280,12 +282,26 @@ def vertex_frame(mesh: PolyMesh, rounding: EdgeRounding, u: int) -> VertexFrame:
     mesh : PolyMesh
     rounding : EdgeRounding
     u : int
+    start_edge : int, optional
+        For a closed ring: the incident edge to list first. The development is cut along the
+        start of its cylinder, so this chooses where the module's angle-defect cut runs.
 
     Returns
     -------
     VertexFrame
     """
     ring = mesh.vertex_ring(u)
+    if ring.closed and start_edge is not None:
+        hit = np.nonzero(ring.edges == start_edge)[0]
+        if len(hit):
+            k = int(hit[0])
+            ring = VertexRing(
+                vertex=ring.vertex,
+                edges=np.roll(ring.edges, -k),
+                faces=np.roll(ring.faces, -k),
+                neighbors=np.roll(ring.neighbors, -k),
+                closed=True,
+            )
     U = mesh.vertices[u]
     nf = len(ring.faces)
     ne = len(ring.edges)

@@ -88,18 +88,20 @@ class VertexResult:
 
 
 def classify_vertex(
-    mesh: PolyMesh, rounding: EdgeRounding, u: int, res: VertexResult
+    mesh: PolyMesh, rounding: EdgeRounding, u: int, res: VertexResult, start_edge: int | None = None
 ) -> VertexFrame:
     """Build vertex ``u``'s frame, classify it and find its normal (sec. 2.5, 3.1).
 
     Fills ``res`` at ``u``: angle sum, defect, solid angle, normal, bound, sigma, kind, and the
     status for every vertex that cannot get a cone (``status`` stays ``""`` otherwise).
+    ``start_edge`` chooses the incident edge along which the module is cut (see
+    :func:`~filletfold.vertex.frame.vertex_frame`).
 
     Returns
     -------
     VertexFrame
     """
-    frame = vertex_frame(mesh, rounding, u)
+    frame = vertex_frame(mesh, rounding, u, start_edge)
     ring = frame.ring
     res.angle_sum[u] = mesh.vertex_angle_sum[u]
     res.defect[u] = 2 * np.pi - res.angle_sum[u]

@@ -1,0 +1,270 @@
+"""Polylines for cut files: pattern edges chained into paths, tab outlines split at their hinge.
+
+Cutting machines and CAD programs want a curved crease as one path, not as hundreds of short
+segments. :func:`edge_chains` joins edges of one kind end to end through every vertex where
+exactly two of them meet; :func:`chain_is_smooth` decides whether a path may be written as a
+spline through its points; :func:`tab_cut_paths` gives the part of each glue-tab outline that is
+cut (all of it except the hinge it shares with its piece).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..pattern import Annotations, CreasePattern
+
+__all__ = [
+    "SPLINE_MAX_SPACING_RATIO",
+    "SPLINE_MAX_TURN_DEG",
+    "SPLINE_MIN_POINTS",
+    "annotation_points",
+    "chain_is_smooth",
+    "edge_chains",
+    "edge_layer_masks",
+    "pattern_extent",
+    "polyline_length",
+    "tab_cut_paths",
+]
+
+#: A chain becomes a spline only with at least this many points (shorter ones stay polylines).
+SPLINE_MIN_POINTS = 7
+#: Largest turning angle (degrees) between consecutive segments of a spline-smooth chain. A
+#: spline through points of a curve that turns ``d`` radians per segment differs in length from
+#: the polyline by about ``d**2 / 24`` relative: 8 degrees keeps that under 1e-3.
+SPLINE_MAX_TURN_DEG = 8.0
+#: Largest ratio of the lengths of two consecutive segments of a spline-smooth chain (uneven
+#: spacing makes interpolating splines overshoot).
+SPLINE_MAX_SPACING_RATIO = 3.0
+#: Relative tolerance (of the outline size) for matching a tab's hinge to its outline edges.
+_HINGE_RTOL = 1e-7
+
+
+def edge_layer_masks(pattern: CreasePattern, *, flat_edges: bool = False) -> dict:
+    """Which pattern edges go on which cut-file layer.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    flat_edges : bool
+        Include the ``"FLAT"`` layer (``F`` edges).
+
+    Returns
+    -------
+    dict of str to (m,) bool
+        ``"CUT"`` (``B`` edges), ``"MOUNTAIN"`` (``M``), ``"VALLEY"`` (``V``) and, with
+        ``flat_edges``, ``"FLAT"`` (``F``), in that order.
+    """
+    assign = np.asarray(pattern.edge_assignment)
+    masks = {"CUT": assign == "B", "MOUNTAIN": assign == "M", "VALLEY": assign == "V"}
+    if flat_edges:
+        masks["FLAT"] = assign == "F"
+    return masks
+
+
+def edge_chains(edges: np.ndarray, mask: np.ndarray | None = None) -> list[tuple[np.ndarray, bool]]:
+    """Join edges end to end into maximal paths through vertices of degree two.
+
+    A vertex where one, three or more of the selected edges meet ends every path through it;
+    a vertex where exactly two meet is passed through. Loops of degree-two vertices become
+    closed paths. The order is deterministic: open paths start at their lowest end vertex (in
+    order of that vertex, then of the first edge), closed ones at their lowest-numbered edge.
+
+    Parameters
+    ----------
+    edges : (m, 2) int
+        Pattern edges.
+    mask : (m,) bool, optional
+        The edges to chain (default all).
+
+    Returns
+    -------
+    list of ((k,) int, bool)
+        The vertex indices of each path and whether it is closed (then the first vertex is not
+        repeated at the end). Every selected edge is in exactly one path.
+    """
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    ids = np.arange(len(edges)) if mask is None else np.flatnonzero(mask)
+    if len(ids) == 0:
+        return []
+    adjacency: dict[int, list[int]] = {}
+    for e in ids:
+        a, b = edges[e]
+        adjacency.setdefault(int(a), []).append(int(e))
+        adjacency.setdefault(int(b), []).append(int(e))
+    used = set()
+    chains = []
+
+    def walk(start: int, first_edge: int) -> tuple[list[int], bool]:
+        path = [start]
+        v, e = start, first_edge
+        while True:
+            used.add(e)
+            a, b = edges[e]
+            v = int(b) if a == v else int(a)
+            if v == start:
+                return path, True
+            path.append(v)
+            nxt = [f for f in adjacency[v] if f not in used]
+            if len(adjacency[v]) != 2 or not nxt:
+                return path, False
+            e = nxt[0]
+
+    for v in sorted(adjacency):
+        if len(adjacency[v]) == 2:
+            continue
+        for e in adjacency[v]:
+            if e not in used:
+                path, closed = walk(v, e)
+                chains.append((np.array(path, dtype=np.int64), closed))
+    for e in ids:
+        if int(e) not in used:
+            path, closed = walk(int(edges[e, 0]), int(e))
+            chains.append((np.array(path, dtype=np.int64), closed))
+    return chains
+
+
+def polyline_length(points: np.ndarray, closed: bool = False) -> float:
+    """Length of a polyline.
+
+    Parameters
+    ----------
+    points : (k, d) float
+    closed : bool
+        Add the segment from the last point back to the first.
+
+    Returns
+    -------
+    float
+    """
+    p = np.asarray(points, dtype=np.float64)
+    if closed and len(p) > 1:
+        p = np.vstack([p, p[:1]])
+    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
+
+def chain_is_smooth(points: np.ndarray, closed: bool = False) -> bool:
+    """Whether a path may be written as a spline through its points.
+
+    The rule: at least :data:`SPLINE_MIN_POINTS` points, no zero-length segment, every turning
+    angle between consecutive segments at most :data:`SPLINE_MAX_TURN_DEG` degrees (including
+    the closing corner of a closed path), and consecutive segment lengths within a factor
+    :data:`SPLINE_MAX_SPACING_RATIO` of each other.
+
+    Parameters
+    ----------
+    points : (k, 2) float
+    closed : bool
+
+    Returns
+    -------
+    bool
+    """
+    p = np.asarray(points, dtype=np.float64)
+    if len(p) < SPLINE_MIN_POINTS:
+        return False
+    if closed:
+        p = np.vstack([p, p[:2]])
+    d = np.diff(p, axis=0)
+    length = np.linalg.norm(d, axis=1)
+    if not (length > 0).all():
+        return False
+    ratio = length[1:] / length[:-1]
+    if ratio.max() > SPLINE_MAX_SPACING_RATIO or ratio.min() < 1.0 / SPLINE_MAX_SPACING_RATIO:
+        return False
+    u = d / length[:, None]
+    cos = np.clip(np.einsum("ij,ij->i", u[1:], u[:-1]), -1.0, 1.0)
+    return bool(np.degrees(np.arccos(cos)).max() <= SPLINE_MAX_TURN_DEG)
+
+
+def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
+    """The cut part of each glue-tab outline: the outline without its hinge.
+
+    An outline edge whose two ends lie on the tab's hinge segment is the hinge (folded, not
+    cut); the remaining edges form one open path. When no edge matches the hinge (or there is no
+    hinge for the tab), the whole outline is cut as a closed path.
+
+    Parameters
+    ----------
+    annotations : Annotations
+
+    Returns
+    -------
+    list of ((k, 2) float, bool)
+        One path per tab: its points and whether it is closed.
+    """
+    out = []
+    hinges = list(annotations.tab_hinges)
+    for t, tab in enumerate(annotations.tabs):
+        p = np.asarray(tab, dtype=np.float64).reshape(-1, 2)
+        if len(p) > 1 and np.array_equal(p[0], p[-1]):
+            p = p[:-1]
+        hinge = np.asarray(hinges[t], dtype=np.float64).reshape(2, 2) if t < len(hinges) else None
+        if hinge is None or len(p) < 2:
+            out.append((p, True))
+            continue
+        size = max(float(np.ptp(p, axis=0).max()), 1.0)
+        on_hinge = _on_segment(p, hinge, _HINGE_RTOL * size)
+        is_hinge_edge = on_hinge & np.roll(on_hinge, -1)  # edge i -> i + 1
+        if not is_hinge_edge.any() or is_hinge_edge.all():
+            out.append((p, True))
+            continue
+        # start right after the last hinge edge, walk the non-hinge edges
+        k = len(p)
+        start = (int(np.flatnonzero(is_hinge_edge)[-1]) + 1) % k
+        order = [(start + i) % k for i in range(k + 1)]
+        pieces, current = [], [p[order[0]]]
+        for i in range(k):
+            a = order[i]
+            if is_hinge_edge[a]:
+                if len(current) > 1:
+                    pieces.append(np.array(current))
+                current = [p[order[i + 1]]]
+            else:
+                current.append(p[order[i + 1]])
+        if len(current) > 1:
+            pieces.append(np.array(current))
+        out.extend((piece, False) for piece in pieces)
+    return out
+
+
+def _on_segment(p: np.ndarray, seg: np.ndarray, eps: float) -> np.ndarray:
+    """(k,) bool: points of ``p`` (k, 2) within ``eps`` of the segment ``seg`` (2, 2)."""
+    a, b = seg
+    d = b - a
+    dd = float(d @ d)
+    t = np.clip(((p - a) @ d) / dd, 0.0, 1.0) if dd > 0 else np.zeros(len(p))
+    return np.linalg.norm(p - (a + t[:, None] * d), axis=1) <= eps
+
+
+def annotation_points(annotations: Annotations) -> np.ndarray:
+    """(k, 2) float: every point of the annotations (tab corners, hinge ends, label anchors,
+    sheet corners), for bounding boxes."""
+    pts = [np.zeros((0, 2))]
+    pts += [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in annotations.tabs]
+    pts += [np.asarray(h, dtype=np.float64).reshape(-1, 2) for h in annotations.tab_hinges]
+    pts += [np.asarray(lb.position, dtype=np.float64).reshape(1, 2) for lb in annotations.labels]
+    sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
+    pts += [sheets[:, :2], sheets[:, 2:]]
+    return np.vstack(pts)
+
+
+def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
+    """Bounding box of the pattern and its annotations in pattern coordinates.
+
+    Label text is counted by its anchor and an estimate of its width.
+
+    Returns
+    -------
+    lo, hi : (2,) float
+        ``(0, 0)`` and ``(1, 1)`` for an empty pattern.
+    """
+    pts = [pattern.vertices_2d, annotation_points(pattern.annotations)]
+    for lb in pattern.annotations.labels:
+        half = 0.5 * float(lb.height) * max(len(lb.text), 1) * 0.6
+        c = np.asarray(lb.position, dtype=np.float64).reshape(2)
+        pts.append(np.array([c - half, c + half]))
+    allp = np.vstack(pts)
+    if len(allp) == 0:
+        return np.zeros(2), np.ones(2)
+    return allp.min(axis=0), allp.max(axis=0)
+
