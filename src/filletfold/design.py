@@ -15,20 +15,24 @@ import numpy as np
 
 from .conical import conical_material_loss, is_conical, vertex_cone_axes
 from .errors import ParameterError, SolverError
+from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
 from .layout import shelf_layout
 from .material_loss import MaterialLoss, solve_material_loss
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
-from .module import Piece, build_module, face_piece_centres
+from .module import Piece, build_module, face_piece_centres, piece_area
 from .pattern import CreasePattern
 from .rounding import EdgeRounding, clamp_radii, round_edges
 from .sheet import glue_pieces
+from .tabs import add_tabs_and_labels
 from .tolerances import tol
 from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_vertex_apex
 
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
+#: Height of a glue tab, as a share of the mean edge length.
+TAB_HEIGHT = 0.04
 
 
 def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:
@@ -144,6 +148,9 @@ class Design:
         ``"modules"`` (one piece per vertex) or ``"sheet"`` (one glued sheet).
     layout_note : str
         Why the sheet could not be made, when it was tried and not made.
+    fabrication : dict
+        Counts of cut borders, glue tabs placed, tabs at a reduced height, and cut borders
+        left without a tab.
     """
 
     mesh: PolyMesh
@@ -157,6 +164,7 @@ class Design:
     material_loss: MaterialLoss | None = None
     layout: str = "modules"
     layout_note: str = ""
+    fabrication: dict = field(default_factory=dict)
 
     @property
     def vertex_status(self) -> list:
@@ -227,23 +235,32 @@ def use_cone_axes(mesh: PolyMesh, frames: list, res: VertexResult) -> None:
             res.normal[u], res.normal_bound[u] = D, bound
 
 
-def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np.ndarray]:
-    """Lay pieces out side by side and merge them into one crease pattern.
+def shelf_offsets(pieces: list[Piece], gap: float) -> np.ndarray:
+    """(n_pieces, 2) translations laying pieces side by side in rows."""
+    boxes = []
+    for piece in pieces:
+        p2, _ = piece.arrays()
+        boxes.append([*p2.min(axis=0), *p2.max(axis=0)])
+    return shelf_layout(np.array(boxes), gap)
+
+
+def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
+    """Merge translated pieces into one crease pattern.
+
+    Parameters
+    ----------
+    pieces : list of Piece
+    offsets : (n_pieces, 2) float
+        Translation of each piece.
 
     Returns
     -------
-    pattern : CreasePattern
-    offsets : (n_pieces, 2) float
-        Translation applied to each piece.
+    CreasePattern
     """
-    boxes = []
-    arrays = [p.arrays() for p in pieces]
-    for p2, _ in arrays:
-        boxes.append([*p2.min(axis=0), *p2.max(axis=0)])
-    offsets = shelf_layout(np.array(boxes), gap)
     v2, v3, faces, patches, face_piece = [], [], [], [], []
     base = 0
-    for k, (piece, (p2, p3)) in enumerate(zip(pieces, arrays, strict=True)):
+    for k, piece in enumerate(pieces):
+        p2, p3 = piece.arrays()
         v2.append(p2 + offsets[k])
         v3.append(p3)
         for f, patch in zip(piece.faces, piece.patches, strict=True):
@@ -251,7 +268,7 @@ def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np
             patches.append(patch)
             face_piece.append(k)
         base += len(p2)
-    pattern = CreasePattern(
+    return CreasePattern(
         vertices_2d=np.vstack(v2) if v2 else np.zeros((0, 2)),
         vertices_3d=np.vstack(v3) if v3 else np.zeros((0, 3)),
         faces=faces,
@@ -259,7 +276,20 @@ def assemble_pattern(pieces: list[Piece], gap: float) -> tuple[CreasePattern, np
         face_piece=np.array(face_piece, dtype=np.int64),
         piece_vertex=np.array([p.vertex for p in pieces], dtype=np.int64),
     )
-    return pattern, offsets
+
+
+def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
+    """Set ``res.apex_2d``: where each solved apex lies in the pattern's layout."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(pattern.vertices_3d)
+    for u in np.nonzero(np.isfinite(res.apex[:, 0]))[0]:
+        cone = [i for i, s in enumerate(pattern.face_patch) if s == f"cone {u}"]
+        if not cone:
+            continue
+        dist, k = tree.query(res.apex[u])
+        if dist < 1e-9 * (1 + np.abs(res.apex[u]).max()):
+            res.apex_2d[u] = pattern.vertices_2d[k]
 
 
 def round_mesh(
@@ -272,6 +302,10 @@ def round_mesh(
     material_loss: bool = False,
     max_loss=None,
     layout: str = "auto",
+    sheet: str | None = None,
+    units: str = "mm",
+    scale: float = 1.0,
+    tabs: bool = True,
     coplanar_deg: float = tol.coplanar_deg,
     progress=None,
 ) -> Design:
@@ -301,10 +335,20 @@ def round_mesh(
     max_loss : float or str, optional
         Upper bound on each edge's material loss (a length or a percentage of the mean edge
         length), with ``material_loss``.
-    layout : {"auto", "modules", "sheet"}
-        ``"modules"``: one piece per vertex, side by side. ``"sheet"``: all modules glued into
-        one sheet (needs every vertex's development to close; raises otherwise). ``"auto"``:
-        the sheet when it can be made, else modules.
+    layout : {"auto", "modules", "net", "sheet"}
+        ``"modules"``: one piece per vertex, side by side. ``"net"``: modules joined into as
+        few non-overlapping pieces as found (each cone keeps its cut). ``"sheet"``: all modules
+        glued into one uncut sheet (needs every vertex's development to close; raises
+        otherwise). ``"auto"``: the sheet when it can be made (with ``material_loss``), nets
+        when a ``sheet`` size is given, else modules.
+    sheet : str, optional
+        Size of the material sheets (``"A4"``, ``"A3"``, ``"A2"``, ``"A1"``, ``"Letter"``,
+        ``"Legal"`` or ``"WIDTHxHEIGHT"`` in mm): nets are split to fit and the pieces are
+        placed on as few sheets as found.
+    units, scale : str, float
+        One pattern unit is ``scale`` ``units`` on the sheet (``units`` in mm, cm, m, in).
+    tabs : bool
+        Add a glue tab and two matching labels to every cut border, and part numbers.
     coplanar_deg : float
         Merge neighbouring faces whose normals differ by less than this (degrees).
     progress : callable, optional
@@ -329,9 +373,9 @@ def round_mesh(
     t0 = time.perf_counter()
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
         raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
-    if layout not in ("auto", "modules", "sheet"):
+    if layout not in ("auto", "modules", "net", "sheet"):
         raise ParameterError(
-            f"layout must be 'auto', 'modules' or 'sheet', got {layout!r}", name="layout"
+            f"layout must be 'auto', 'modules', 'net' or 'sheet', got {layout!r}", name="layout"
         )
     if not (np.isfinite(coplanar_deg) and 0 <= coplanar_deg < 90):
         raise ParameterError(
@@ -391,7 +435,9 @@ def round_mesh(
     solved = []
     for u, frame in enumerate(frames):
         apex, v = (
-            solve_vertex_apex(frame, float(depths[u]), res) if res.status[u] == "" else (None, None)
+            solve_vertex_apex(frame, float(depths[u]), res, centres)
+            if res.status[u] == ""
+            else (None, None)
         )
         solved.append((frame, apex, v))
         if progress is not None:
@@ -405,13 +451,14 @@ def round_mesh(
         if progress is not None:
             progress("surface", u + 1, pm.n_vertices)
     layout_used, layout_note = "modules", ""
-    if layout != "modules" and (material_loss or layout == "sheet"):
+    eps = 1e-9 * ref
+    if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
         not_closed = [
             u for u, f in enumerate(frames) if f.ring.closed and res.kind[u] != "developable"
         ]
         if not_closed:
             listed = ", ".join(map(str, not_closed[:8])) + (", ..." if len(not_closed) > 8 else "")
-            sheet, layout_note = (
+            glued, layout_note = (
                 None,
                 (
                     f"the input is not developable at {len(not_closed)} vertices ({listed}): their "
@@ -419,23 +466,58 @@ def round_mesh(
                 ),
             )
         else:
-            sheet, placement, layout_note = glue_pieces(pieces, 1e-9 * ref)
-        if sheet is not None:
-            for piece, m in zip(pieces, placement, strict=True):
-                if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):
-                    p = np.asarray(piece.points_2d[piece.apex_index])
-                    res.apex_2d[piece.vertex] = m[:2, :2] @ p + m[:2, 2]
-            pieces, layout_used = [sheet], "sheet"
+            glued, _, layout_note = glue_pieces(pieces, eps)
+        if glued is not None:
+            pieces, layout_used = [glued], "sheet"
         elif layout == "sheet":
             raise SolverError(f"the modules do not form one sheet: {layout_note}")
-    pattern, offsets = assemble_pattern(pieces, gap=0.1 * ref)
-    if layout_used == "modules":
-        for k, piece in enumerate(pieces):
-            if piece.apex_index is not None and np.isnan(res.apex_2d[piece.vertex, 0]):
-                p = np.asarray(piece.points_2d[piece.apex_index])
-                res.apex_2d[piece.vertex] = p + offsets[k]
+    tab_h = TAB_HEIGHT * ref if tabs else 0.0
+    gap = 0.1 * ref + 2.5 * tab_h
+    sheet_box = room = None
+    if sheet is not None:
+        sheet_box = sheet_in_pattern_units(sheet, units, scale)
+        margin = 2 * (gap + tab_h)
+        room = (sheet_box[0] - margin, sheet_box[1] - margin)
+        if min(room) <= 0:
+            raise ParameterError(
+                f"the sheet {sheet} at scale {scale:g} {units} per unit is too small for any piece",
+                name="sheet",
+            )
+    if layout == "net" or (layout == "auto" and layout_used == "modules" and sheet is not None):
+        pieces = net_pieces(
+            pm,
+            rounding,
+            pieces,
+            solved,
+            centres,
+            int(samples),
+            eps,
+            sheet=room,
+        )
+        layout_used = "net"
+    if sheet is not None:
+        pieces = [orient(piece) for piece in pieces]
+        offsets, boxes, sheet_of = pack_on_sheets(pieces, sheet_box, gap)
+        pattern = assemble_pattern(pieces, offsets)
+        pattern.annotations.sheets = boxes
+        area = np.array([piece_area(piece) for piece in pieces])
+        sheet_area = sheet_box[0] * sheet_box[1]
+        sheet_stats = {
+            "sheets": len(boxes),
+            "sheet_size": [float(max(sheet_box)), float(min(sheet_box))],
+            "pieces_per_sheet": np.bincount(sheet_of, minlength=len(boxes)).tolist(),
+            "material_use": (
+                np.bincount(sheet_of, weights=area, minlength=len(boxes)) / sheet_area
+            ).tolist(),
+        }
     else:
-        res.apex_2d += offsets[0]
+        pattern = assemble_pattern(pieces, shelf_offsets(pieces, gap))
+    fab = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
+    if tabs:
+        fab = add_tabs_and_labels(pattern, tab_h)
+    if sheet is not None:
+        fab.update(sheet_stats)
+    locate_apices(pattern, res)
     timings["surface"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     return Design(
@@ -450,4 +532,5 @@ def round_mesh(
         material_loss=loss,
         layout=layout_used,
         layout_note=layout_note,
+        fabrication=fab,
     )

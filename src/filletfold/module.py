@@ -140,6 +140,12 @@ class Piece:
         return union < total * (1 - rel)
 
 
+def piece_area(piece: Piece) -> float:
+    """Area of a flat piece (sum of its faces' areas)."""
+    p2, _ = piece.arrays()
+    return float(shapely.area(face_polygons(p2, piece.faces)).sum())
+
+
 def face_polygons(points_2d: np.ndarray, faces) -> np.ndarray:
     """(n_faces,) shapely Polygons of faces given as index lists into ``points_2d`` (k, 2)."""
     sizes = np.array([len(f) for f in faces])

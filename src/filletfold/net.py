@@ -86,7 +86,7 @@ def _fits(shape, sheet) -> bool:
     return sides[0] <= min(sheet) and sides[1] <= max(sheet)
 
 
-def cut_edges_for_nets(mesh) -> np.ndarray:
+def cut_edges_for_nets(mesh, root: int | None = None) -> np.ndarray:
     """For every vertex, the incident edge its module is cut along, so that one net can form.
 
     Modules are glued across the edges of a spanning tree of the mesh's vertices (a
@@ -95,6 +95,12 @@ def cut_edges_for_nets(mesh) -> np.ndarray:
     cone's angle-defect cut running into one of its own seams, the cut graph is a tree: the
     surface minus the cuts is one disk. Each vertex is therefore cut along an incident edge
     that is not in the glue tree (if it has none, along any edge: its net splits there).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    root : int, optional
+        Root of the glue tree (default: the vertex nearest the centroid).
 
     Returns
     -------
@@ -108,7 +114,9 @@ def cut_edges_for_nets(mesh) -> np.ndarray:
     a, b = mesh.edges[:, 0], mesh.edges[:, 1]
     w = mesh.edge_length
     g = coo_matrix((np.r_[w, w], (np.r_[a, b], np.r_[b, a])), shape=(n, n)).tocsr()
-    root = int(np.argmin(np.linalg.norm(mesh.vertices - mesh.vertices.mean(axis=0), axis=1)))
+    if root is None:
+        centre = mesh.vertices.mean(axis=0)
+        root = int(np.argmin(np.linalg.norm(mesh.vertices - centre, axis=1)))
     _, pred = shortest_path(g, indices=root, return_predecessors=True)
     edge_of = {(int(x), int(y)): e for e, (x, y) in enumerate(mesh.edges)}
     glue = np.zeros(mesh.n_edges, dtype=bool)

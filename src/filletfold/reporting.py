@@ -8,10 +8,12 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .export import fold_document, fold_json, folded_obj, pattern_svg, report_json, write_outputs
+from .export import report_json, write_outputs
+from .export.cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .rounding import loss_from_radius
 
-OUTPUT_FILES = ("design.fold", "report.json", "folded.obj", "pattern.svg")
+#: The files :func:`export_design` writes by default.
+OUTPUT_FILES = output_names(DEFAULT_FORMATS)
 
 
 def _num(x):
@@ -110,9 +112,18 @@ def design_report(design) -> dict:
             "max_relative_edge_mismatch": float(relative_mismatch(pat).max(initial=0.0)),
         },
         "layout": {"kind": design.layout, "note": design.layout_note or None},
+        "fabrication": _fabrication_report(design),
         "material_loss": _loss_report(design.material_loss),
         "timings": {k: float(v) for k, v in design.timings.items()},
     }
+
+
+def _fabrication_report(design) -> dict:
+    """Pieces, glue tabs, and (with sheets) pieces per sheet and material use."""
+    out = {"pieces": int(design.pattern.n_pieces)}
+    for k, v in design.fabrication.items():
+        out[k] = v if isinstance(v, list) else int(v)
+    return out
 
 
 def _loss_report(loss) -> dict | None:
@@ -182,6 +193,15 @@ def design_summary(design, max_listed: int = 8) -> str:
     )
     if design.layout_note:
         lines.append(f"  no single sheet: {design.layout_note}")
+    fab = design.fabrication
+    if fab.get("cut_borders"):
+        lines.append(
+            f"glue tabs: {fab['tabs']} of {fab['cut_borders']} cut borders"
+            + (f" ({fab['tabs_reduced']} at reduced height)" if fab["tabs_reduced"] else "")
+            + (f", {fab['untabbed']} with labels only (no room)" if fab["untabbed"] else "")
+        )
+    if len(pat.annotations.sheets):
+        lines.append(f"sheets: {len(pat.annotations.sheets)}")
     flagged = [u for u, st in enumerate(design.vertices.status) if st not in ("ok", "boundary")]
     for u in flagged[:max_listed]:
         reason = design.vertices.reason[u]
@@ -194,25 +214,54 @@ def design_summary(design, max_listed: int = 8) -> str:
     return "\n".join(lines)
 
 
-def export_design(design, folder, *, title: str | None = None) -> list[Path]:
+def export_design(
+    design,
+    folder,
+    *,
+    title: str | None = None,
+    formats=DEFAULT_FORMATS,
+    units: str = "",
+    scale: float | None = None,
+    page: str = "A4",
+) -> list[Path]:
     """Write the design's files into ``folder`` atomically (all of them or none).
 
-    Files: ``design.fold``, ``report.json``, ``folded.obj``, ``pattern.svg``.
+    Parameters
+    ----------
+    design : Design
+    folder : str or os.PathLike
+    title : str, optional
+        FOLD ``file_title`` (default ``"filletfold design of <source>"``).
+    formats : str or iterable of str
+        Output formats (see :mod:`filletfold.export.cutfiles`): by default ``fold``, ``json``,
+        ``obj`` and ``svg``, i.e. ``design.fold``, ``report.json``, ``folded.obj`` and
+        ``pattern.svg``; ``"all"`` adds ``pattern.dxf``, ``pattern.pdf``, ``pattern.png`` and
+        ``preview.png``.
+    units, scale, page
+        Real size of the cut files and PDF page (see
+        :func:`~filletfold.export.cutfiles.cut_files`).
 
     Returns
     -------
     list of Path
+        The files written.
     """
     t = time.perf_counter()
+    formats = parse_formats(formats)
     title = title or f"filletfold design of {design.source}"
-    doc = fold_document(
-        design.pattern, title=title, description="Curved-crease rounded design: vertex modules"
-    )
-    files = {
-        "design.fold": fold_json(doc),
-        "folded.obj": folded_obj(design.pattern),
-        "pattern.svg": pattern_svg(design.pattern),
-    }
+    pattern_formats = [f for f in formats if f != "json"]
+    files = {}
+    if pattern_formats:
+        files = cut_files(
+            design.pattern,
+            pattern_formats,
+            units=units,
+            scale=scale,
+            page=page,
+            title=title,
+            description="Curved-crease rounded design: vertex modules",
+        )
     design.timings["export"] = time.perf_counter() - t
-    files["report.json"] = report_json(design_report(design))
-    return write_outputs(folder, {k: files[k] for k in OUTPUT_FILES})
+    if "json" in formats:
+        files["report.json"] = report_json(design_report(design))
+    return write_outputs(folder, {k: files[k] for k in output_names(formats)})

@@ -34,6 +34,7 @@ KINDS = {
     "nonint": "cone self-intersects the cylinder (non-intersection, eq. 2)",
     "chord": "apex on the wrong side of the cylinder's chord plane",
     "face": "apex on the wrong side of a face",
+    "centre": "the straight crease passes the face piece's centre",
 }
 
 
@@ -367,12 +368,19 @@ def crease_length(frame: VertexFrame, i: int, V: np.ndarray, v: np.ndarray, s: n
 
 
 def validate_apex(
-    frame: VertexFrame, V: np.ndarray, v: np.ndarray, sigma: int, n_samples: int = 257
+    frame: VertexFrame,
+    V: np.ndarray,
+    v: np.ndarray,
+    sigma: int,
+    n_samples: int = 257,
+    centres: np.ndarray | None = None,
 ) -> ApexCheck:
     """Check every condition densely along every arc, without margin.
 
     Conditions: ``Dn > 0``; ``l(s) >= 0``; ``l <= l_max`` at both ends; ``sigma (V - C) . N > 0``
-    along the arc; ``sigma (V - T) . N_f > 0`` for every face.
+    along the arc; ``sigma (V - T) . N_f > 0`` for every face; and, given the face pieces'
+    ``centres`` ((n_faces, 3) float), the straight crease on every face runs between the
+    corner T and the centre, so the vertex's share of the face stays a simple polygon.
     """
     scale = float(np.mean([s.length for s in frame.sides]))
     eps = tol.validate * scale
@@ -401,4 +409,21 @@ def validate_apex(
         slack.append(val)
         if val < eps:
             failing.append(f"{KINDS['face']} at face {int(f)}")
+        if centres is None:
+            continue
+        j = (i + 1) % len(frame.sides)
+        ends = []
+        for k, s_ in ((i, frame.sides[i].arc), (j, 0.0)):
+            l_end, _ = crease_length(frame, k, V, v, np.array([s_]))
+            ends.append(frame.sides[k].base([s_])[0] + l_end[0] * frame.sides[k].R)
+        d = ends[1] - ends[0]
+        if np.linalg.norm(d) <= eps:
+            continue
+        d = d / np.linalg.norm(d)
+        side_t = float(np.cross(d, frame.T_end[i] - ends[0]) @ n)
+        side_c = float(np.cross(d, centres[f] - ends[0]) @ n)
+        val = -side_c * np.sign(side_t) if side_t != 0 else abs(side_c)
+        slack.append(val)
+        if val < eps:
+            failing.append(f"{KINDS['centre']} on face {int(f)}")
     return ApexCheck(not failing, float(np.min(slack)), failing)

@@ -158,12 +158,13 @@ def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
 
 
 def solve_vertex_apex(
-    frame: VertexFrame, depth: float, res: VertexResult
+    frame: VertexFrame, depth: float, res: VertexResult, centres: np.ndarray | None = None
 ) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Developed and spatial apex of a cone vertex (sec. 2.4, 3.2), validated densely.
 
     Sets ``res.status`` to ``ok`` (with apex, depth used and margin) or ``infeasible`` (with
-    the constraints that fail) at the frame's vertex.
+    the constraints that fail) at the frame's vertex. ``centres`` ((n_faces, 3) float, the face
+    pieces' centres) adds the check that every straight crease stays short of the centre.
 
     Returns
     -------
@@ -214,7 +215,7 @@ def solve_vertex_apex(
             failing = sol.failing
             break
         v_sol = sol.developed if closed else v
-        check = validate_apex(frame, sol.apex, v_sol, sigma)
+        check = validate_apex(frame, sol.apex, v_sol, sigma, centres=centres)
         if check.ok:
             res.status[u] = "ok"
             res.apex[u] = sol.apex

@@ -1,0 +1,173 @@
+"""Fabrication layouts: nets of few pieces, pieces placed on sheets of material.
+
+``net_pieces`` tries a few choices of where each vertex module is cut (the default ring start,
+and cuts off glue spanning trees rooted at different vertices), grows nets for each, and keeps
+the one with the fewest pieces. ``pack_on_sheets`` turns every piece to its smallest bounding
+rectangle and places the pieces row by row onto as few sheets as it can.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+from .errors import ParameterError
+from .module import Piece, build_module, face_polygons
+from .net import build_nets, cut_edges_for_nets
+from .vertex.frame import apply, invert, vertex_frame
+
+#: Sheet sizes in millimetres (width, height), portrait.
+SHEETS_MM = {
+    "A4": (210.0, 297.0),
+    "A3": (297.0, 420.0),
+    "A2": (420.0, 594.0),
+    "A1": (594.0, 841.0),
+    "LETTER": (215.9, 279.4),
+    "LEGAL": (215.9, 355.6),
+}
+#: Millimetres per drawing unit.
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+
+
+def sheet_size_mm(sheet: str) -> tuple[float, float]:
+    """(width, height) in mm of a named sheet (A4, A3, A2, A1, Letter, Legal) or ``"WxH"``."""
+    key = sheet.strip().upper()
+    if key in SHEETS_MM:
+        return SHEETS_MM[key]
+    try:
+        w, h = (float(x) for x in key.split("X"))
+    except ValueError:
+        raise ParameterError(
+            f"sheet must be one of {', '.join(SHEETS_MM)} or 'WIDTHxHEIGHT' in mm, got {sheet!r}",
+            name="sheet",
+        ) from None
+    if not (w > 0 and h > 0 and np.isfinite(w) and np.isfinite(h)):
+        raise ParameterError(f"sheet size must be positive, got {sheet!r}", name="sheet")
+    return w, h
+
+
+def sheet_in_pattern_units(sheet: str, units: str, scale: float) -> tuple[float, float]:
+    """Sheet size in pattern units, when one pattern unit is drawn as ``scale`` ``units``."""
+    if units not in MM_PER_UNIT:
+        raise ParameterError(
+            f"units must be one of {', '.join(MM_PER_UNIT)}, got {units!r}", name="units"
+        )
+    if not (np.isfinite(scale) and scale > 0):
+        raise ParameterError(f"scale must be positive, got {scale!r}", name="scale")
+    w, h = sheet_size_mm(sheet)
+    k = 1.0 / (MM_PER_UNIT[units] * scale)
+    return w * k, h * k
+
+
+def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=None, tries=None):
+    """Vertex modules joined into the fewest nets found over a few choices of cuts.
+
+    Parameters
+    ----------
+    mesh, rounding : PolyMesh, EdgeRounding
+    modules : list of Piece
+        The modules as built from ``solved`` (used for the first choice of cuts).
+    solved : list of (frame, apex or None, developed apex or None)
+        The frames the apices were solved in, and the apices.
+    centres : (n_faces, 3) float
+    samples : int
+    eps : float
+    sheet : (float, float), optional
+        Every net must fit this (pattern units).
+    tries : int, optional
+        How many cut choices to try (the default ring starts first); default 4, or 2 above
+        60 vertices.
+
+    Returns
+    -------
+    list of Piece
+    """
+    if tries is None:
+        tries = 4 if mesh.n_vertices <= 60 else 2
+    choices = [None]
+    cut = cut_edges_for_nets(mesh)
+    choices.append(cut)
+    # further trees rooted at the vertices farthest from each other
+    far = np.argsort(-np.linalg.norm(mesh.vertices - mesh.vertices.mean(axis=0), axis=1))
+    for root in far[: max(0, tries - 2)]:
+        choices.append(cut_edges_for_nets(mesh, root=int(root)))
+    best = None
+    for cut in choices[:tries]:
+        pieces = [] if cut is not None else modules
+        for u, (frame, apex, v) in enumerate(solved if cut is not None else []):
+            if cut is not None and frame.ring.closed and cut[u] >= 0:
+                k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
+                new = vertex_frame(mesh, rounding, u, int(cut[u]))
+                if v is not None and k:
+                    v = apply(invert(frame.face_map[k - 1]), v)[0]
+                frame = new
+            pieces.extend(build_module(mesh, frame, centres, samples, apex, v))
+        nets, _ = build_nets(pieces, eps, sheet)
+        if best is None or len(nets) < len(best):
+            best = nets
+        if len(best) == 1:
+            break
+    return best
+
+
+def orient(piece: Piece) -> Piece:
+    """The piece turned so its smallest bounding rectangle is axis-aligned and wider than tall."""
+    p2, _ = piece.arrays()
+    shape = shapely.union_all(shapely.make_valid(face_polygons(p2, piece.faces)))
+    rect = np.asarray(shapely.minimum_rotated_rectangle(shape).exterior.coords)[:4]
+    sides = [rect[1] - rect[0], rect[2] - rect[1]]
+    d = max(sides, key=np.linalg.norm)
+    ang = -np.arctan2(d[1], d[0])
+    rot = np.array([[np.cos(ang), -np.sin(ang)], [np.sin(ang), np.cos(ang)]])
+    piece.points_2d = [rot @ q for q in piece.points_2d]
+    return piece
+
+
+def pack_on_sheets(pieces: list[Piece], sheet: tuple[float, float], gap: float):
+    """Translations that place pieces row by row on sheets, never overlapping.
+
+    Parameters
+    ----------
+    pieces : list of Piece
+        Already oriented (see :func:`orient`); each must fit a sheet.
+    sheet : (float, float)
+        Width and height of a sheet (pattern units); sheets are laid out left to right.
+    gap : float
+        Clearance between pieces and from the sheet edges.
+
+    Returns
+    -------
+    offsets : (n_pieces, 2) float
+    boxes : (n_sheets, 4) float
+        ``(xmin, ymin, xmax, ymax)`` of each sheet.
+    sheet_of : (n_pieces,) int
+    """
+    w, h = sheet
+    if w < h:  # pieces are landscape: use landscape sheets
+        w, h = h, w
+    arrays = [p.arrays()[0] for p in pieces]
+    size = np.array([np.ptp(a, axis=0) for a in arrays])
+    for k, (sw, sh) in enumerate(size):
+        if sw + 2 * gap > w * (1 + 1e-9) or sh + 2 * gap > h * (1 + 1e-9):
+            raise ParameterError(
+                f"piece {k + 1} ({sw:.4g} x {sh:.4g}) does not fit on the sheet "
+                f"({w:.4g} x {h:.4g} in pattern units); use a larger sheet or a smaller scale",
+                name="sheet",
+            )
+    order = np.argsort(-size[:, 1], kind="stable")
+    offsets = np.zeros((len(pieces), 2))
+    sheet_of = np.zeros(len(pieces), dtype=np.int64)
+    n_sheets, x, y, row_h = 1, gap, gap, 0.0
+    for k in order:
+        sw, sh = size[k]
+        if x + sw + gap > w:
+            x, y, row_h = gap, y + row_h + gap, 0.0
+        if y + sh + gap > h:
+            n_sheets, x, y, row_h = n_sheets + 1, gap, gap, 0.0
+        origin = np.array([(n_sheets - 1) * (w + 4 * gap), 0.0])
+        offsets[k] = origin + np.array([x, h - y - sh]) - arrays[k].min(axis=0)
+        sheet_of[k] = n_sheets - 1
+        x += sw + gap
+        row_h = max(row_h, sh)
+    boxes = np.array([[s * (w + 4 * gap), 0.0, s * (w + 4 * gap) + w, h] for s in range(n_sheets)])
+    return offsets, boxes, sheet_of
