@@ -16,6 +16,7 @@ import sys
 import numpy as np
 
 import filletfold
+from filletfold.module import face_piece_centres
 from filletfold.vertex.apex import build_constraints, validate_apex
 from filletfold.vertex.frame import vertex_frame
 
@@ -28,6 +29,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     d = filletfold.round_mesh(args.mesh, clamp=args.clamp)
     rng = np.random.default_rng(0)
+    centres = face_piece_centres(d.mesh, d.rounding)
     bad = [u for u, s in enumerate(d.vertices.status) if s == "infeasible"]
     found = 0
     for u in bad:
@@ -44,7 +46,7 @@ def main(argv=None) -> int:
             g = np.array([cons.values(p).min() for p in pts])
             if g.max() > best:
                 best, best_p = g.max(), pts[np.argmax(g)]
-        ok = validate_apex(fr, best_p, v, sigma).ok
+        ok = validate_apex(fr, best_p, v, sigma, centres=centres).ok
         found += ok
         print(
             f"vertex {u}: best sampled slack {best / scale:+.4f} (edge lengths)"
