@@ -193,7 +193,7 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         faces = [polys[i] for i in np.nonzero(p.face_piece == k)[0]]
         if not faces:
             continue
-        where = shapely.union_all(faces).representative_point()
+        where = shapely.union_all(shapely.make_valid(faces)).representative_point()
         name = part_names[k] if part_names is not None else f"P{k + 1}"
         ann.labels.append(Label(np.array([where.x, where.y]), name, 0.0, 2 * label_h, "part"))
     p.annotations = ann

@@ -120,7 +120,12 @@ class ApexConstraints:
 
 
 def build_constraints(
-    frame: VertexFrame, v: np.ndarray | None, sigma: int, n_samples: int, margin: float
+    frame: VertexFrame,
+    v: np.ndarray | None,
+    sigma: int,
+    n_samples: int,
+    margin: float,
+    lmax_scale: np.ndarray | None = None,
 ) -> ApexConstraints:
     """Sample the sec. 3.2 constraints of a closed-ring vertex.
 
@@ -135,8 +140,13 @@ def build_constraints(
         Samples per arc (>= 3, both ends included).
     margin : float
         Safety margin ``m`` (length).
+    lmax_scale : (n_sides, 2) float, optional
+        Factors on ``l_max`` at the start and end of each side (default 1): shorter creases
+        keep the straight crease on a face away from the face piece's centre.
     """
     scale = float(np.mean([s.length for s in frame.sides]))
+    if lmax_scale is None:
+        lmax_scale = np.ones((len(frame.sides), 2))
     quad = {k: [] for k in ("c", "R", "M", "Q", "t", "s", "coef", "sign", "const")}
     kind, elem = [], []
     la, lb, lkind, lelem = [], [], [], []
@@ -166,7 +176,10 @@ def build_constraints(
         # l >= m at every sample:  num - 2 m Dn >= 0
         add(C, side, Q, t, s, 2 * margin, 1.0, 0.0, "l_min", e)
         # l <= l_max - m at both ends:  2 Dn (l_max - m) - num >= 0
-        for idx, lmax in ((0, frame.lmax_start[i]), (-1, frame.lmax_end[i])):
+        for idx, lmax in (
+            (0, frame.lmax_start[i] * lmax_scale[i, 0]),
+            (-1, frame.lmax_end[i] * lmax_scale[i, 1]),
+        ):
             add(C[[idx]], side, Q, t, s[[idx]], -2 * (lmax - margin), -1.0, 0.0, "l_max", e)
         # valid patch: Dn - m >= 0
         add(C[[0]], side, Q, t, s[[0]], -scale, 0.0, -margin, "patch", e)

@@ -207,13 +207,19 @@ def solve_vertex_apex(
         res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
         return None, None
     failing = []
-    for n_samples, scale in ((9, 1.0), (33, 2.0), (65, 4.0)):
+    shrink = np.ones((len(frame.sides), 2))
+    attempts = [(9, 1.0), (33, 2.0), (65, 4.0)]
+    while attempts:
+        n_samples, scale = attempts.pop(0)
         m = min(margin * scale, 0.25 * low)
-        cons = build_constraints(frame, None if closed else v, sigma, n_samples, m)
+        cons = build_constraints(frame, None if closed else v, sigma, n_samples, m, shrink)
         sol = solve_apex(cons, target, starts)
         if not sol.ok:
             failing = sol.failing
-            break
+            if scale < 1.0:
+                break
+            attempts = [(129, 0.1)]  # infeasible with the margin: try a tenth of it
+            continue
         v_sol = sol.developed if closed else v
         check = validate_apex(frame, sol.apex, v_sol, sigma, centres=centres)
         if check.ok:
@@ -224,6 +230,15 @@ def solve_vertex_apex(
             res.margin[u] = check.margin
             return sol.apex, v_sol
         failing = check.failing
+        crossing = [f for f in failing if "face piece's centre" in f]
+        if crossing and len(crossing) == len(failing) and shrink.min() > 0.2:
+            # the straight creases run past the face centres: ask for shorter ones and retry
+            faces = {int(f.rsplit(" ", 1)[1]) for f in crossing}
+            for i, f in enumerate(frame.ring.faces):
+                if int(f) in faces:
+                    shrink[i, 1] *= 0.7
+                    shrink[(i + 1) % len(frame.sides), 0] *= 0.7
+            attempts.insert(0, (n_samples, scale))
     res.status[u] = "infeasible"
     res.reason[u] = "no apex meets every constraint: " + "; ".join(failing[:6])
     if len(failing) > 6:
