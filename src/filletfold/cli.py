@@ -5,8 +5,13 @@ Commands
 ``filletfold examples``
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--coplanar-tol DEG]``
+``[--format LIST] [--units U] [--scale S] [--sheet PAGE]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
-    ``folded.obj`` and ``pattern.svg`` into ``OUT``.
+    ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
+    pictures).
+``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
+    Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
+    ``pattern.svg``) and pictures (``pattern.png``, ``preview.png``) into ``DIR``.
 """
 
 from __future__ import annotations
@@ -65,6 +70,48 @@ def examples():
         v, f = example_mesh(name)
         table.add_row(name, str(len(v)), str(len(f)), ", ".join(ex.kinds), ex.description)
     console.print(table)
+
+
+#: Formats ``filletfold export`` can write from a ``design.fold``.
+EXPORT_FORMATS = ("obj", "svg", "dxf", "pdf", "png")
+
+FormatOption = Annotated[
+    str | None,
+    typer.Option(
+        "--format",
+        "-f",
+        help="Comma-separated output formats: fold, json, obj, svg, dxf, pdf, png (pattern.png "
+        "and preview.png), or all.",
+    ),
+]
+UnitsOption = Annotated[
+    str,
+    typer.Option(
+        "--units",
+        help="Drawing unit of the cut files: mm, cm, m or in (default: unitless; the PDF then "
+        "fits the drawing on one page).",
+    ),
+]
+ScaleOption = Annotated[
+    float | None,
+    typer.Option(
+        "--scale",
+        help="Drawing units per mesh length unit in the DXF, SVG and PDF (default 1).",
+    ),
+]
+SheetOption = Annotated[
+    str,
+    typer.Option(
+        "--sheet",
+        help="PDF page: A4, A3, A2, Letter, Legal or WxH in millimetres (e.g. 600x400).",
+    ),
+]
+
+
+def _error(message: str) -> typer.Exit:
+    """Print ``message`` as an error; return the exit (code 2) to raise."""
+    err_console.print(f"[bold red]error:[/] {message}", highlight=False)
+    return typer.Exit(2)
 
 
 def _default_out(mesh: str) -> Path:
@@ -149,13 +196,26 @@ def round_cmd(
     quiet: Annotated[
         bool, typer.Option("--quiet", "-q", help="Print only errors and the output folder.")
     ] = False,
+    formats: FormatOption = None,
+    units: UnitsOption = "",
+    scale: ScaleOption = None,
+    sheet: SheetOption = "A4",
 ):
     """Round every edge and vertex of MESH; write the design into the output folder.
 
     Writes design.fold (crease pattern + folded form), report.json, folded.obj and pattern.svg,
-    all or nothing.
+    all or nothing; --format all adds pattern.dxf, pattern.pdf, pattern.png and preview.png.
     """
+    from .export.cutfiles import DEFAULT_FORMATS, parse_formats
+    from .reporting import export_design
+
     target = out if out is not None else _default_out(mesh)
+    try:
+        chosen = parse_formats(formats if formats is not None else DEFAULT_FORMATS)
+        # check units, scale and page before the (slow) design
+        _check_export_options(units, scale, sheet, chosen)
+    except FilletfoldError as exc:
+        raise _error(str(exc)) from None
     try:
         with Progress(
             TextColumn("{task.description}"),
@@ -188,11 +248,76 @@ def round_cmd(
             console.print(design.summary(), highlight=False)
         if dry_run:
             return
-        written = design.export(target)
+        written = export_design(
+            design, target, formats=chosen, units=units, scale=scale, page=sheet
+        )
     except FilletfoldError as exc:
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False)
-        raise typer.Exit(2) from None
+        raise _error(str(exc)) from None
     console.print(f"wrote {len(written)} files to {target}/", highlight=False)
+
+
+def _check_export_options(units: str, scale, sheet: str, formats) -> None:
+    """Raise the ParameterError that writing would raise for ``units``, ``scale`` or ``sheet``."""
+    from .errors import ParameterError
+    from .export.cutfiles import UNITS
+    from .export.dxf import check_scale
+    from .export.pdf import page_size_mm
+
+    if units not in UNITS:
+        raise ParameterError(
+            f"units must be one of {', '.join(u for u in UNITS if u)}, got {units!r}",
+            name="units",
+        )
+    if scale is not None:
+        check_scale(scale)
+    if "pdf" in formats:
+        page_size_mm(sheet)
+
+
+@app.command("export")
+def export_cmd(
+    folder: Annotated[
+        Path, typer.Argument(help="A design folder written by 'filletfold round' (design.fold).")
+    ],
+    formats: FormatOption = "dxf,pdf,svg,png",
+    units: UnitsOption = "",
+    scale: ScaleOption = None,
+    sheet: SheetOption = "A4",
+):
+    """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
+
+    Formats: dxf (pattern.dxf), pdf (pattern.pdf, tiled at true scale), svg (pattern.svg), png
+    (pattern.png and preview.png), obj (folded.obj); all of them with --format all. The files
+    are written into FOLDER, all or nothing.
+    """
+    from .export import write_outputs
+    from .export.cutfiles import cut_files, parse_formats
+    from .export.fold_read import read_fold
+
+    try:
+        spec = formats if formats is not None else "dxf,pdf,svg,png"
+        chosen = EXPORT_FORMATS if spec.strip().lower() == "all" else parse_formats(spec)
+        bad = [f for f in chosen if f not in EXPORT_FORMATS]
+        if bad:
+            raise _error(
+                f"format {bad[0]} cannot be written from design.fold (export writes "
+                f"{', '.join(EXPORT_FORMATS)}; use 'filletfold round' for fold and json)"
+            )
+        _check_export_options(units, scale, sheet, chosen)
+        if not folder.is_dir():
+            raise _error(f"{folder}: no such folder (write a design with 'filletfold round')")
+        source = folder / "design.fold"
+        if not source.is_file():
+            raise _error(f"{source}: no design.fold in {folder} (write it with 'filletfold round')")
+        pattern = read_fold(source)
+        files = cut_files(pattern, chosen, units=units, scale=scale, page=sheet)
+        written = write_outputs(folder, files)
+    except FilletfoldError as exc:
+        raise _error(str(exc)) from None
+    console.print(
+        f"wrote {len(written)} files to {folder}/: {', '.join(p.name for p in written)}",
+        highlight=False,
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -17,16 +17,18 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ExportError, ParameterError
-from ..pattern import CreasePattern
+from ..pattern import Annotations, CreasePattern
 from ..tolerances import tol
 
 __all__ = [
     "FOLD_SPEC",
     "NAMESPACE",
+    "annotations_document",
     "face_signed_area_2d",
     "file_creator",
     "fold_document",
     "fold_json",
+    "has_annotations",
     "validate_pattern",
 ]
 
@@ -176,8 +178,10 @@ def fold_document(
         Keys in a fixed order: file metadata, key-frame metadata, ``vertices_coords`` (n, 2),
         ``edges_vertices`` (m, 2), ``edges_assignment`` (m,), ``edges_foldAngle`` (m,) degrees
         (valley positive), ``faces_vertices`` (counter-clockwise), ``filletfold:faces_patch`` and
-        ``filletfold:faces_piece`` (n_faces,), ``file_frames`` (the folded form: a child of the key
-        frame with 3D ``vertices_coords`` (n, 3)), then ``extra``.
+        ``filletfold:faces_piece`` (n_faces,), ``filletfold:pieces_vertex`` (n_pieces,),
+        ``file_frames`` (the folded form: a child of the key frame with 3D ``vertices_coords``
+        (n, 3)), ``filletfold:annotations`` when the pattern has any (see
+        :func:`annotations_document`), then ``extra``.
 
     Raises
     ------
@@ -207,6 +211,7 @@ def fold_document(
         "faces_vertices": [[int(v) for v in f] for f in pattern.faces],
         NAMESPACE + "faces_patch": [str(p) for p in pattern.face_patch],
         NAMESPACE + "faces_piece": pattern.face_piece.tolist(),
+        NAMESPACE + "pieces_vertex": pattern.piece_vertex.tolist(),
         "file_frames": [
             {
                 "frame_classes": ["foldedForm"],
@@ -217,6 +222,8 @@ def fold_document(
             }
         ],
     }
+    if has_annotations(pattern.annotations):
+        doc[NAMESPACE + "annotations"] = annotations_document(pattern.annotations)
     for key, value in (extra or {}).items():
         if not isinstance(key, str) or not key.startswith(NAMESPACE) or key == NAMESPACE:
             raise ParameterError(
@@ -228,6 +235,50 @@ def fold_document(
             )
         doc[key] = value
     return doc
+
+
+def has_annotations(annotations: Annotations) -> bool:
+    """Whether there is any tab, hinge, label or sheet to write."""
+    return bool(
+        len(annotations.tabs)
+        or len(annotations.tab_hinges)
+        or len(annotations.labels)
+        or len(np.asarray(annotations.sheets).reshape(-1))
+    )
+
+
+def annotations_document(annotations: Annotations) -> dict:
+    """The JSON form of a pattern's annotations (the ``filletfold:annotations`` FOLD key).
+
+    Parameters
+    ----------
+    annotations : Annotations
+
+    Returns
+    -------
+    dict
+        ``tabs``: list of tab outlines, each a list of ``[x, y]``; ``tab_hinges``: list of
+        ``[[x, y], [x, y]]``; ``labels``: list of ``{"position": [x, y], "text", "angle"
+        (degrees), "height", "kind"}``; ``sheets``: list of ``[xmin, ymin, xmax, ymax]``. All
+        in pattern coordinates.
+    """
+    return {
+        "tabs": [np.asarray(t, dtype=np.float64).reshape(-1, 2).tolist() for t in annotations.tabs],
+        "tab_hinges": [
+            np.asarray(h, dtype=np.float64).reshape(2, 2).tolist() for h in annotations.tab_hinges
+        ],
+        "labels": [
+            {
+                "position": np.asarray(lb.position, dtype=np.float64).reshape(2).tolist(),
+                "text": str(lb.text),
+                "angle": float(lb.angle),
+                "height": float(lb.height),
+                "kind": str(lb.kind),
+            }
+            for lb in annotations.labels
+        ],
+        "sheets": np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4).tolist(),
+    }
 
 
 def _round(x: float) -> float:

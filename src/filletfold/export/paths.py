@@ -9,6 +9,8 @@ cut (all of it except the hinge it shares with its piece).
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from ..pattern import Annotations, CreasePattern
@@ -19,10 +21,12 @@ __all__ = [
     "SPLINE_MIN_POINTS",
     "annotation_points",
     "chain_is_smooth",
+    "chain_runs",
     "edge_chains",
     "edge_layer_masks",
     "pattern_extent",
     "polyline_length",
+    "simplify_polyline",
     "tab_cut_paths",
 ]
 
@@ -35,6 +39,8 @@ SPLINE_MAX_TURN_DEG = 8.0
 #: Largest ratio of the lengths of two consecutive segments of a spline-smooth chain (uneven
 #: spacing makes interpolating splines overshoot).
 SPLINE_MAX_SPACING_RATIO = 3.0
+#: Interior points where a path turns by less than this (radians) are dropped as collinear.
+_COLLINEAR_RAD = 1e-7
 #: Relative tolerance (of the outline size) for matching a tab's hinge to its outline edges.
 _HINGE_RTOL = 1e-7
 
@@ -176,6 +182,113 @@ def chain_is_smooth(points: np.ndarray, closed: bool = False) -> bool:
     return bool(np.degrees(np.arccos(cos)).max() <= SPLINE_MAX_TURN_DEG)
 
 
+def simplify_polyline(points: np.ndarray, closed: bool = False) -> np.ndarray:
+    """Drop repeated points and interior points where the path goes straight on.
+
+    A point is dropped when the path turns there by less than ``1e-7`` radians, so the length
+    changes by a relative amount of order ``1e-14``.
+
+    Parameters
+    ----------
+    points : (k, 2) float
+    closed : bool
+        The path returns from the last point to the first (the first point may then go too).
+
+    Returns
+    -------
+    (j, 2) float
+        ``j >= 2`` for an open path of two distinct points or more.
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    keep = np.ones(len(p), dtype=bool)
+    keep[1:] = np.any(p[1:] != p[:-1], axis=1)
+    p = p[keep]
+    if closed and len(p) > 1 and np.array_equal(p[0], p[-1]):
+        p = p[:-1]
+    changed = True
+    while changed and len(p) > (3 if closed else 2):
+        prev = np.roll(p, 1, axis=0)
+        nxt = np.roll(p, -1, axis=0)
+        a, b = p - prev, nxt - p
+        cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        dot = np.einsum("ij,ij->i", a, b)
+        straight = (np.abs(np.arctan2(cross, dot)) < _COLLINEAR_RAD) & (dot > 0)
+        if not closed:
+            straight[[0, -1]] = False
+        # never drop two neighbours at once (their turn was measured against each other)
+        straight[1:] &= ~straight[:-1]
+        changed = bool(straight.any())
+        p = p[~straight]
+    return p
+
+
+def chain_runs(points: np.ndarray, closed: bool = False) -> list[tuple[np.ndarray, bool, bool]]:
+    """Split a path into spline runs and polyline runs.
+
+    The path is first simplified (:func:`simplify_polyline`), then cut at its *breaks*: points
+    where it turns by more than :data:`SPLINE_MAX_TURN_DEG` or where the lengths of the two
+    segments differ by more than a factor :data:`SPLINE_MAX_SPACING_RATIO` (a corner, or the
+    end of a sampled curve meeting a straight segment). A run between two breaks with at least
+    :data:`SPLINE_MIN_POINTS` points is a spline; neighbouring runs that are not are joined into
+    one polyline.
+
+    Parameters
+    ----------
+    points : (k, 2) float
+    closed : bool
+
+    Returns
+    -------
+    list of ((j, 2) float, bool, bool)
+        Each run's points, whether it is a spline, and whether it is closed (only a path that is
+        one run: a closed polyline, or a closed spline whose last point repeats its first).
+        Consecutive runs share their end points; together they trace the path.
+    """
+    p = simplify_polyline(points, closed)
+    if len(p) < 2:
+        return []
+    if closed:
+        if len(p) < 3:
+            return [(p, False, False)]
+        brk = _breaks(np.vstack([p[-1:], p, p[:1]]))
+        if not brk.any():
+            if chain_is_smooth(p, closed=True):
+                return [(np.vstack([p, p[:1]]), True, True)]
+            return [(p, False, True)]
+        start = int(np.flatnonzero(brk)[0])
+        p = np.vstack([np.roll(p, -start, axis=0), p[start : start + 1]])
+        inner = np.roll(brk, -start)[1:]
+    else:
+        inner = _breaks(p) if len(p) > 2 else np.zeros(0, dtype=bool)
+    cuts = [0, *(np.flatnonzero(inner) + 1).tolist(), len(p) - 1]
+    runs: list[tuple[np.ndarray, bool, bool]] = []
+    for a, b in itertools.pairwise(cuts):
+        run = p[a : b + 1]
+        spline = len(run) >= SPLINE_MIN_POINTS and chain_is_smooth(run)
+        if runs and not spline and not runs[-1][1]:
+            runs[-1] = (np.vstack([runs[-1][0], run[1:]]), False, False)
+        else:
+            runs.append((run, spline, False))
+    if closed and len(runs) == 1 and not runs[0][1]:
+        return [(runs[0][0][:-1], False, True)]
+    return runs
+
+
+def _breaks(p: np.ndarray) -> np.ndarray:
+    """(k - 2,) bool: interior points of the open path ``p`` (k, 2) that break a spline run."""
+    d = np.diff(p, axis=0)
+    length = np.linalg.norm(d, axis=1)
+    u = d / length[:, None]
+    cos = np.clip(np.einsum("ij,ij->i", u[1:], u[:-1]), -1.0, 1.0)
+    turn = np.degrees(np.arccos(cos))
+    ratio = length[1:] / length[:-1]
+    return (
+        (turn > SPLINE_MAX_TURN_DEG)
+        | (ratio > SPLINE_MAX_SPACING_RATIO)
+        | (ratio < 1.0 / SPLINE_MAX_SPACING_RATIO)
+    )
+
+
 def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     """The cut part of each glue-tab outline: the outline without its hinge.
 
@@ -267,4 +380,3 @@ def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
     if len(allp) == 0:
         return np.zeros(2), np.ones(2)
     return allp.min(axis=0), allp.max(axis=0)
-

@@ -6,6 +6,11 @@ reads) and, optionally, flat ``#dddddd``. The y axis is flipped so the drawing i
 The scale bar and legend below the drawing are filled shapes without stroke and text, in a
 separate ``annotation`` group, so stroke-colour readers (Origami Simulator, laser software)
 ignore them.
+
+A pattern's annotations are drawn when present: the cut part of each glue-tab outline black
+(group ``tab-cut``), the tab hinges green ``#00a000`` dashed (``tab-hinge``; not Origami
+Simulator's cut green ``#00ff00``), the sheet outlines thin grey ``#999999`` (``sheets``) and
+the labels as filled text, rotated, in the ``annotation`` group (``labels``).
 """
 
 from __future__ import annotations
@@ -18,8 +23,17 @@ import numpy as np
 from ..errors import ParameterError
 from ..pattern import CreasePattern
 from .fold import validate_pattern
+from .paths import pattern_extent, tab_cut_paths
 
-__all__ = ["ASSIGNMENT_COLOR", "MM_PER_UNIT", "nice_length", "pattern_svg"]
+__all__ = [
+    "ASSIGNMENT_COLOR",
+    "LABEL_COLOR",
+    "MM_PER_UNIT",
+    "SHEET_COLOR",
+    "TAB_HINGE_COLOR",
+    "nice_length",
+    "pattern_svg",
+]
 
 #: Stroke colour of each edge assignment.
 ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
@@ -37,6 +51,10 @@ _UNITLESS_MM = 200.0
 _MARGIN_MM = 10.0
 _FONT_MM = 3.5
 _SWATCH_MM = 8.0
+#: Colours of the annotations.
+TAB_HINGE_COLOR = "#00a000"
+SHEET_COLOR = "#999999"
+LABEL_COLOR = "#404040"
 
 
 def nice_length(target: float) -> float:
@@ -119,10 +137,7 @@ def pattern_svg(
     validate_pattern(pattern)
 
     v = pattern.vertices_2d
-    if len(v):
-        lo, hi = v.min(axis=0), v.max(axis=0)
-    else:
-        lo, hi = np.zeros(2), np.ones(2)
+    lo, hi = pattern_extent(pattern)
     size = hi - lo
     extent = float(size.max())
     if extent <= 0:
@@ -160,6 +175,7 @@ def pattern_svg(
                 attrs += f' opacity="{min(abs(angle[e]) / 180.0, 1.0):.4f}"'
             body.append(f"<line {attrs}/>")
         body.append("</g>")
+    body.extend(_annotation_groups(pattern, lo, hi, margin, fmt, sw))
 
     # scale bar and legend below the drawing
     draw_w = float(size[0]) + 2 * margin
@@ -192,7 +208,9 @@ def pattern_svg(
             f'<text x="{fmt(xcur)}" y="{fmt(leg_y)}" font-size="{fmt(font)}">{escape(text)}</text>'
         )
         xcur += (0.62 * _FONT_MM * len(text) + 6.0) * user
-    ann.append("</g></g>")
+    ann.append("</g>")
+    ann.extend(_label_group(pattern, lo, hi, margin, fmt))
+    ann.append("</g>")
 
     total_w = max(
         draw_w, xcur + margin, margin + bar + (2 + 0.62 * _FONT_MM * len(label)) * user + margin
@@ -207,3 +225,69 @@ def pattern_svg(
         f"<desc>mountain red, valley blue, cut black; units: {escape(units or 'none')}</desc>",
     ]
     return "\n".join([*head, *body, *ann, "</svg>"]) + "\n"
+
+
+def _annotation_groups(pattern, lo, hi, margin, fmt, sw) -> list[str]:
+    """SVG groups of the sheet outlines, tab cut paths and tab hinges (empty when none)."""
+    ann = pattern.annotations
+
+    def xy(pts) -> str:
+        q = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+        return " ".join(f"{fmt(x - lo[0] + margin)},{fmt(hi[1] - y + margin)}" for x, y in q)
+
+    out = []
+    sheets = np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4)
+    if len(sheets):
+        out.append(f'<g id="sheets" stroke="{SHEET_COLOR}" stroke-width="{sw}" fill="none">')
+        for x0, y0, x1, y1 in sheets:
+            out.append(
+                f'<rect x="{fmt(x0 - lo[0] + margin)}" y="{fmt(hi[1] - y1 + margin)}" '
+                f'width="{fmt(x1 - x0)}" height="{fmt(y1 - y0)}" stroke="{SHEET_COLOR}"/>'
+            )
+        out.append("</g>")
+    paths = tab_cut_paths(ann)
+    if paths:
+        color = ASSIGNMENT_COLOR["B"]
+        out.append(
+            f'<g id="tab-cut" stroke-width="{sw}" stroke-linecap="round" '
+            'stroke-linejoin="round" fill="none">'
+        )
+        for pts, closed in paths:
+            tag = "polygon" if closed else "polyline"
+            out.append(f'<{tag} points="{xy(pts)}" stroke="{color}"/>')
+        out.append("</g>")
+    if len(ann.tab_hinges):
+        out.append(
+            f'<g id="tab-hinge" stroke-width="{sw}" stroke-dasharray="{fmt(6 * float(sw))} '
+            f'{fmt(4 * float(sw))}" fill="none">'
+        )
+        for h in ann.tab_hinges:
+            (x1, y1), (x2, y2) = np.asarray(h, dtype=np.float64).reshape(2, 2)
+            out.append(
+                f'<line x1="{fmt(x1 - lo[0] + margin)}" y1="{fmt(hi[1] - y1 + margin)}" '
+                f'x2="{fmt(x2 - lo[0] + margin)}" y2="{fmt(hi[1] - y2 + margin)}" '
+                f'stroke="{TAB_HINGE_COLOR}"/>'
+            )
+        out.append("</g>")
+    return out
+
+
+def _label_group(pattern, lo, hi, margin, fmt) -> list[str]:
+    """The ``labels`` group: filled text, centred on each anchor, rotated (empty when none)."""
+    labels = pattern.annotations.labels
+    if not labels:
+        return []
+    out = [
+        f'<g id="labels" font-family="sans-serif" fill="{LABEL_COLOR}" text-anchor="middle" '
+        'dominant-baseline="central">'
+    ]
+    for lb in labels:
+        x, y = np.asarray(lb.position, dtype=np.float64).reshape(2)
+        tx, ty = fmt(x - lo[0] + margin), fmt(hi[1] - y + margin)
+        rot = f' transform="rotate({fmt(-float(lb.angle))} {tx} {ty})"' if lb.angle else ""
+        out.append(
+            f'<text x="{tx}" y="{ty}" font-size="{fmt(float(lb.height))}" '
+            f'class="{escape(str(lb.kind))}"{rot}>{escape(str(lb.text))}</text>'
+        )
+    out.append("</g>")
+    return out

@@ -1,0 +1,173 @@
+"""DXF (R2010) cut file of the flat crease pattern, for laser cutters, plotters and CAD.
+
+Layers and colours (ACI):
+
+===========  ======  ==========================================================================
+layer        colour  content
+===========  ======  ==========================================================================
+``CUT``      7       ``B`` edges (piece borders and cuts) and the cut part of each glue-tab
+                     outline (the outline without its hinge)
+``MOUNTAIN`` 1 red   ``M`` edges
+``VALLEY``   5 blue  ``V`` edges
+``TAB``      3 green the tab hinges (the fold between a tab and its piece), linetype ``DASHED``;
+                     the tab outline is *not* repeated here, so a machine that cuts ``CUT`` and
+                     scores ``TAB`` never cuts a line twice
+``LABEL``    8 grey  ``TEXT`` entities of the labels (centred on their anchor, rotated)
+``FLAT``     9       ``F`` edges, only with ``flat_edges=True``
+===========  ======  ==========================================================================
+
+Edges of one layer are chained end to end through vertices where exactly two of them meet
+(:func:`~filletfold.export.paths.edge_chains`); each chain is cut at corners and spacing jumps
+into runs (:func:`~filletfold.export.paths.chain_runs`). A smooth run of at least seven points
+(turning at most 8 degrees per point, neighbouring segments within a factor 3 in length) is a
+``SPLINE`` through its points (fit points plus the control points of the CAD-style
+interpolation); everything else is an ``LWPOLYLINE``. Sheet outlines are not written (one DXF
+holds every sheet). Besides these, the file has the standard layers ``0`` and ``Defpoints``
+(empty).
+
+The output is deterministic: entities are written in a fixed order with sequential handles and
+the DXF's dates and GUIDs are fixed.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..pattern import CreasePattern
+from .fold import validate_pattern
+from .paths import chain_runs, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
+
+__all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
+
+#: ``$INSUNITS`` code of each drawing unit ("" = unitless).
+DXF_INSUNITS = {"": 0, "in": 1, "mm": 4, "cm": 5, "m": 6}
+#: ACI colour of each layer, in the order the layers are created.
+LAYER_COLOR = {"CUT": 7, "MOUNTAIN": 1, "VALLEY": 5, "TAB": 3, "LABEL": 8, "FLAT": 9}
+#: Dash length of the TAB layer's linetype, as a share of the drawing's larger side.
+_DASH_SHARE = 0.005
+
+
+def check_scale(scale) -> float:
+    """``scale`` as a float; a :class:`ParameterError` unless it is a positive finite number."""
+    if isinstance(scale, bool) or not isinstance(scale, int | float):
+        raise ParameterError(f"scale must be a positive number, got {scale!r}", name="scale")
+    if not (math.isfinite(scale) and scale > 0):
+        raise ParameterError(f"scale must be a positive number, got {scale!r}", name="scale")
+    return float(scale)
+
+
+def pattern_dxf(
+    pattern: CreasePattern, *, units: str = "", scale: float = 1.0, flat_edges: bool = False
+) -> str:
+    """The flat layout of a crease pattern as a DXF R2010 document.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Checked with :func:`~filletfold.export.fold.validate_pattern`; its annotations (tabs,
+        hinges, labels) are drawn when present.
+    units : str
+        Drawing unit written to ``$INSUNITS``: ``""`` (unitless), ``"mm"``, ``"cm"``, ``"m"`` or
+        ``"in"``.
+    scale : float
+        Drawing units per pattern length unit: every coordinate and text height is multiplied
+        by it.
+    flat_edges : bool
+        Also write the ``F`` edges, on layer ``FLAT``.
+
+    Returns
+    -------
+    str
+        The DXF text. Same input, same text.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown ``units`` or a ``scale`` that is not a positive number.
+    ExportError
+        When the pattern is inconsistent.
+    """
+    import ezdxf
+
+    if units not in DXF_INSUNITS:
+        raise ParameterError(
+            f"units must be one of {', '.join(u for u in DXF_INSUNITS if u)} or '', got {units!r}",
+            name="units",
+        )
+    scale = check_scale(scale)
+    validate_pattern(pattern)
+
+    fixed = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True  # fixed dates, GUIDs and markers
+    try:
+        doc = ezdxf.new("R2010", setup=False)
+        _fill(doc, pattern, units, scale, flat_edges)
+        stream = io.StringIO()
+        doc.write(stream)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = fixed
+    return stream.getvalue()
+
+
+def _fill(doc, pattern: CreasePattern, units: str, scale: float, flat_edges: bool) -> None:
+    """Add the header variables, layers and entities of :func:`pattern_dxf` to ``doc``."""
+    from ezdxf.enums import TextEntityAlignment
+
+    doc.header["$INSUNITS"] = DXF_INSUNITS[units]
+    doc.header["$MEASUREMENT"] = 0 if units == "in" else 1
+    lo, hi = pattern_extent(pattern)
+    size = max(float((hi - lo).max()) * scale, 1e-12)
+    dash = _DASH_SHARE * size
+    doc.linetypes.add("DASHED", pattern=[2 * dash, dash, -dash], description="Dashed __ __ __")
+    layers = dict(LAYER_COLOR)
+    if not flat_edges:
+        del layers["FLAT"]
+    for name, color in layers.items():
+        layer = doc.layers.add(name, color=color)
+        if name == "TAB":
+            layer.dxf.linetype = "DASHED"
+    msp = doc.modelspace()
+
+    v2 = pattern.vertices_2d * scale
+    for layer, mask in edge_layer_masks(pattern, flat_edges=flat_edges).items():
+        for chain, closed in edge_chains(pattern.edges, mask):
+            _add_path(msp, v2[chain], closed, layer)
+        if layer == "CUT":
+            for pts, closed in tab_cut_paths(pattern.annotations):
+                _add_path(msp, np.asarray(pts) * scale, closed, "CUT")
+    for hinge in pattern.annotations.tab_hinges:
+        a, b = np.asarray(hinge, dtype=np.float64).reshape(2, 2) * scale
+        msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": "TAB"})
+    for label in pattern.annotations.labels:
+        pos = np.asarray(label.position, dtype=np.float64).reshape(2) * scale
+        text = msp.add_text(
+            str(label.text),
+            height=float(label.height) * scale,
+            rotation=float(label.angle),
+            dxfattribs={"layer": "LABEL"},
+        )
+        text.set_placement(tuple(pos), align=TextEntityAlignment.MIDDLE_CENTER)
+    doc.set_modelspace_vport(height=size * 1.1, center=tuple((lo + hi) / 2 * scale))
+
+
+def _add_path(msp, points: np.ndarray, closed: bool, layer: str) -> None:
+    """Write one path as its spline and polyline runs (see the module docstring)."""
+    from ezdxf.math import fit_points_to_cad_cv
+
+    for run, spline, run_closed in chain_runs(points, closed):
+        if spline:
+            fit = [(float(x), float(y), 0.0) for x, y in run]
+            entity = msp.add_spline(fit, degree=3, dxfattribs={"layer": layer})
+            entity.apply_construction_tool(fit_points_to_cad_cv(fit))
+            entity.fit_points = fit
+        else:
+            msp.add_lwpolyline(
+                [(float(x), float(y)) for x, y in run],
+                format="xy",
+                close=run_closed,
+                dxfattribs={"layer": layer},
+            )

@@ -1,0 +1,197 @@
+"""Reading back a design written by :func:`~filletfold.export.fold.fold_document`.
+
+:func:`read_fold` rebuilds the :class:`~filletfold.pattern.CreasePattern` of a ``design.fold``:
+the key frame's 2D ``vertices_coords``, ``faces_vertices``, ``edges_vertices``,
+``edges_assignment`` and ``edges_foldAngle`` (kept as written, not derived again),
+``filletfold:faces_patch``, ``filletfold:faces_piece``, ``filletfold:pieces_vertex`` and, from the
+folded frame, the 3D ``vertices_coords``. The annotations come from ``filletfold:annotations``
+when the file has that key.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ExportError, MeshReadError
+from ..pattern import Annotations, CreasePattern, Label
+from .fold import NAMESPACE, validate_pattern
+
+__all__ = ["pattern_from_fold", "read_fold"]
+
+_REQUIRED = (
+    "vertices_coords",
+    "faces_vertices",
+    "edges_vertices",
+    "edges_assignment",
+    "edges_foldAngle",
+    NAMESPACE + "faces_patch",
+    NAMESPACE + "faces_piece",
+)
+
+
+def read_fold(path) -> CreasePattern:
+    """Read a filletfold ``design.fold`` back into a crease pattern.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    CreasePattern
+        With the file's edges, assignments and fold angles, and its annotations (empty when the
+        file has none).
+
+    Raises
+    ------
+    MeshReadError
+        When the file is missing or unreadable, is not JSON, or is not a filletfold FOLD file
+        (a required key or the folded frame is missing, or the data is inconsistent); the
+        message names the file and the problem.
+    """
+    path = Path(os.fspath(path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise MeshReadError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise MeshReadError(f"{path}: is a folder, not a FOLD file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MeshReadError(f"{path}: cannot read: {exc}") from exc
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise MeshReadError(f"{path}: not a FOLD file (invalid JSON: {exc.msg})") from None
+    try:
+        return pattern_from_fold(doc)
+    except MeshReadError as exc:
+        raise MeshReadError(f"{path}: {exc}") from None
+
+
+def pattern_from_fold(doc: dict) -> CreasePattern:
+    """The crease pattern of a parsed filletfold FOLD document (see :func:`read_fold`).
+
+    Parameters
+    ----------
+    doc : dict
+
+    Returns
+    -------
+    CreasePattern
+
+    Raises
+    ------
+    MeshReadError
+        When the document is not a filletfold FOLD document.
+    """
+    if not isinstance(doc, dict):
+        raise MeshReadError(f"not a FOLD file (top level is a {type(doc).__name__}, not an object)")
+    missing = [k for k in _REQUIRED if k not in doc]
+    if missing:
+        raise MeshReadError(
+            f"not a filletfold FOLD file: missing key(s) {', '.join(missing)} "
+            "(write it with 'filletfold round')"
+        )
+    frame = _folded_frame(doc)
+    try:
+        v2 = np.asarray(doc["vertices_coords"], dtype=np.float64)
+        v3 = np.asarray(frame["vertices_coords"], dtype=np.float64)
+        faces = [np.asarray(f, dtype=np.int64) for f in doc["faces_vertices"]]
+        edges = np.asarray(doc["edges_vertices"], dtype=np.int64).reshape(-1, 2)
+        assign = np.asarray([str(a) for a in doc["edges_assignment"]], dtype="<U1")
+        angle = np.asarray(doc["edges_foldAngle"], dtype=np.float64).reshape(-1)
+        face_piece = np.asarray(doc[NAMESPACE + "faces_piece"], dtype=np.int64).reshape(-1)
+        patches = [str(p) for p in doc[NAMESPACE + "faces_patch"]]
+    except (TypeError, ValueError) as exc:
+        raise MeshReadError(f"not a filletfold FOLD file: malformed arrays ({exc})") from None
+    if v2.ndim != 2 or v2.shape[1] != 2:
+        raise MeshReadError(f"key frame vertices_coords must be 2D points, got shape {v2.shape}")
+    if v3.ndim != 2 or v3.shape[1] != 3:
+        raise MeshReadError(f"folded frame vertices_coords must be 3D points, got shape {v3.shape}")
+    n_pieces = int(face_piece.max()) + 1 if len(face_piece) else 0
+    pv = doc.get(NAMESPACE + "pieces_vertex")
+    piece_vertex = np.full(n_pieces, -1, dtype=np.int64) if pv is None else np.asarray(pv)
+    pattern = CreasePattern(
+        v2,
+        v3,
+        faces,
+        patches,
+        face_piece,
+        piece_vertex,
+        edges=edges,
+        edge_assignment=assign,
+        edge_fold_angle=angle,
+        edge_faces=None,
+        annotations=_annotations(doc.get(NAMESPACE + "annotations")),
+    )
+    try:
+        validate_pattern(pattern)
+    except ExportError as exc:
+        raise MeshReadError(f"not a valid filletfold design: {exc}") from None
+    pattern.edge_faces = _edge_faces(pattern.edges, pattern.faces, len(v2))
+    return pattern
+
+
+def _folded_frame(doc: dict) -> dict:
+    """The first frame of ``file_frames`` with 3D vertex coordinates (``foldedForm`` first)."""
+    frames = doc.get("file_frames")
+    if not isinstance(frames, list) or not frames:
+        raise MeshReadError("not a filletfold FOLD file: no folded frame (file_frames is missing)")
+    frames = [f for f in frames if isinstance(f, dict) and "vertices_coords" in f]
+    frames.sort(key=lambda f: "foldedForm" not in (f.get("frame_classes") or []))
+    if not frames:
+        raise MeshReadError("not a filletfold FOLD file: no frame of file_frames has coordinates")
+    return frames[0]
+
+
+def _edge_faces(edges: np.ndarray, faces: list, n: int) -> np.ndarray:
+    """(m, 2) int: the face on each edge's ``a -> b`` side, then on its ``b -> a`` side."""
+    ef = -np.ones((len(edges), 2), dtype=np.int64)
+    if not len(faces) or not len(edges):
+        return ef
+    sizes = np.array([len(f) for f in faces])
+    a = np.concatenate(faces).astype(np.int64)
+    start = np.concatenate([[0], np.cumsum(sizes)])
+    nxt = np.arange(len(a)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    b = a[nxt]
+    face_of = np.repeat(np.arange(len(faces)), sizes)
+    lo, hi = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
+    keys = lo * n + hi
+    order = np.argsort(keys)
+    hkey = np.minimum(a, b) * n + np.maximum(a, b)
+    pos = np.clip(np.searchsorted(keys[order], hkey), 0, len(keys) - 1)
+    found = keys[order][pos] == hkey
+    e = order[pos[found]]
+    side = (a[found] != edges[e, 0]).astype(np.int64)
+    ef[e, side] = face_of[found]
+    return ef
+
+
+def _annotations(data) -> Annotations:
+    """Annotations from the ``filletfold:annotations`` value (``None``: none)."""
+    if data is None:
+        return Annotations()
+    if not isinstance(data, dict):
+        raise MeshReadError("filletfold:annotations must be an object")
+    try:
+        tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in data.get("tabs", [])]
+        hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in data.get("tab_hinges", [])]
+        labels = [
+            Label(
+                position=np.asarray(lb["position"], dtype=np.float64).reshape(2),
+                text=str(lb["text"]),
+                angle=float(lb.get("angle", 0.0)),
+                height=float(lb.get("height", 0.05)),
+                kind=str(lb.get("kind", "part")),
+            )
+            for lb in data.get("labels", [])
+        ]
+        sheets = np.asarray(data.get("sheets", []), dtype=np.float64).reshape(-1, 4)
+    except (TypeError, ValueError, KeyError, AttributeError) as exc:
+        raise MeshReadError(f"filletfold:annotations is malformed ({exc!r})") from None
+    return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)

@@ -1,0 +1,373 @@
+"""Printable PDF of the flat crease pattern at true scale, tiled over pages.
+
+The drawing is printed so that one pattern length unit is ``scale`` ``units`` on paper. It is cut
+into *regions*: one per sheet of material when the pattern's annotations have sheets (each sheet
+is tiled on its own pages; anything outside every sheet is not printed), otherwise one region
+around everything (pattern, tabs, labels). Each
+region, grown by :data:`REGION_PAD_MM` on every side, is tiled from its top-left corner by tiles
+the size of the printable area (the page minus ``margin_mm`` on each side), in rows top to bottom
+and columns left to right: ``ceil(width / tile_width) * ceil(height / tile_height)`` pages per
+region. Tiles abut exactly (no overlap): trim each page along its thin grey frame and butt the
+frames together, aligning the corner crosses (registration marks). Each page says which region,
+row and column it is; the first page also carries a scale bar.
+
+Lines: mountain red, valley blue, borders/cuts black, tab outlines black and tab hinges green
+dashed, sheet outlines grey, labels dark grey. Pages are portrait (custom ``"WxH"`` sizes are used
+as given). The output is deterministic (no creation date).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..pattern import CreasePattern
+from .dxf import check_scale
+from .fold import validate_pattern
+from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
+from .svg import MM_PER_UNIT, nice_length
+
+__all__ = ["MAX_PAGES", "PAGE_SIZES_MM", "REGION_PAD_MM", "Tile", "page_size_mm", "pattern_pdf"]
+
+#: Portrait paper sizes (width, height) in millimetres.
+PAGE_SIZES_MM = {
+    "A4": (210.0, 297.0),
+    "A3": (297.0, 420.0),
+    "A2": (420.0, 594.0),
+    "Letter": (215.9, 279.4),
+    "Legal": (215.9, 355.6),
+}
+#: Blank border (mm) added around each region before it is tiled.
+REGION_PAD_MM = 2.0
+#: Most pages one PDF may have (a guard against a mistyped scale).
+MAX_PAGES = 400
+_PT_PER_MM = 72.0 / 25.4
+_LINE_MM = 0.25
+_MARK_MM = 5.0
+_FONT_PT = 8.0
+_COLORS = {"CUT": "#000000", "MOUNTAIN": "#ff0000", "VALLEY": "#0000ff", "FLAT": "#cccccc"}
+_HINGE = "#00a000"
+_SHEET = "#999999"
+_LABEL = "#404040"
+_FRAME = "#b0b0b0"
+
+
+@dataclass(frozen=True)
+class Tile:
+    """One page of the tiled drawing.
+
+    Attributes
+    ----------
+    region : int
+        Index of the region (sheet) the page belongs to.
+    row, col : int
+        Position of the tile in its region, from 1, rows top to bottom.
+    rows, cols : int
+        Tiles of the region.
+    box : (4,) tuple of float
+        ``(xmin, ymin, xmax, ymax)`` of the tile in drawing millimetres.
+    """
+
+    region: int
+    row: int
+    col: int
+    rows: int
+    cols: int
+    box: tuple
+
+
+def page_size_mm(page: str) -> tuple[float, float]:
+    """Width and height (mm) of a page: a name of :data:`PAGE_SIZES_MM` (any case) or ``"WxH"``.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown name or a malformed or non-positive custom size.
+    """
+    if not isinstance(page, str):
+        raise ParameterError(f"page must be a string, got {type(page).__name__}", name="page")
+    for name, size in PAGE_SIZES_MM.items():
+        if page.strip().lower() == name.lower():
+            return size
+    m = re.fullmatch(r"\s*(\d+(?:\.\d*)?)\s*[xX×]\s*(\d+(?:\.\d*)?)\s*(?:mm)?\s*", page)
+    if not m or float(m.group(1)) <= 0 or float(m.group(2)) <= 0:
+        raise ParameterError(
+            f"page must be one of {', '.join(PAGE_SIZES_MM)} or 'WxH' in millimetres "
+            f"(e.g. '600x400'), got {page!r}",
+            name="page",
+        )
+    return float(m.group(1)), float(m.group(2))
+
+
+def _check_units(units: str) -> float:
+    if units not in MM_PER_UNIT:
+        raise ParameterError(
+            f"units must be one of {', '.join(MM_PER_UNIT)} for a printed PDF, got {units!r}",
+            name="units",
+        )
+    return MM_PER_UNIT[units]
+
+
+def pdf_tiles(
+    pattern: CreasePattern,
+    *,
+    page: str = "A4",
+    units: str = "mm",
+    scale: float = 1.0,
+    margin_mm: float = 10.0,
+) -> list[Tile]:
+    """The pages of :func:`pattern_pdf`, in order (see the module docstring for the rule).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    page, units, scale, margin_mm
+        As for :func:`pattern_pdf`.
+
+    Returns
+    -------
+    list of Tile
+
+    Raises
+    ------
+    ParameterError
+        For an invalid page, unit, scale or margin, or more than :data:`MAX_PAGES` pages.
+    """
+    width, height = page_size_mm(page)
+    k = _check_units(units) * check_scale(scale)
+    if isinstance(margin_mm, bool) or not isinstance(margin_mm, int | float):
+        raise ParameterError(f"margin_mm must be a number, got {margin_mm!r}", name="margin_mm")
+    if not (math.isfinite(margin_mm) and 0 <= margin_mm and 2 * margin_mm < min(width, height)):
+        raise ParameterError(
+            f"margin_mm must be >= 0 and leave a printable area on a {width:g} x {height:g} mm "
+            f"page, got {margin_mm!r}",
+            name="margin_mm",
+        )
+    tw, th = width - 2 * margin_mm, height - 2 * margin_mm
+    sheets = np.asarray(pattern.annotations.sheets, dtype=np.float64).reshape(-1, 4)
+    if len(sheets):
+        regions = sheets * k
+    else:
+        lo, hi = pattern_extent(pattern)
+        regions = np.array([[*(lo * k), *(hi * k)]])
+    tiles = []
+    for r, (x0, y0, x1, y1) in enumerate(regions):
+        x0, y0, x1, y1 = (
+            x0 - REGION_PAD_MM,
+            y0 - REGION_PAD_MM,
+            x1 + REGION_PAD_MM,
+            y1 + REGION_PAD_MM,
+        )
+        cols = max(1, math.ceil((x1 - x0) / tw - 1e-9))
+        rows = max(1, math.ceil((y1 - y0) / th - 1e-9))
+        if len(tiles) + rows * cols > MAX_PAGES:
+            raise ParameterError(
+                f"the PDF would need more than {MAX_PAGES} {width:g} x {height:g} mm pages; "
+                "use a smaller scale or a larger page",
+                name="scale",
+            )
+        for i in range(rows):
+            for j in range(cols):
+                box = (x0 + j * tw, y1 - (i + 1) * th, x0 + (j + 1) * tw, y1 - i * th)
+                tiles.append(Tile(r, i + 1, j + 1, rows, cols, tuple(float(b) for b in box)))
+    return tiles
+
+
+def pattern_pdf(
+    pattern: CreasePattern,
+    *,
+    page: str = "A4",
+    units: str = "mm",
+    scale: float = 1.0,
+    margin_mm: float = 10.0,
+) -> bytes:
+    """The flat layout at true scale, tiled over printable pages.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Checked with :func:`~filletfold.export.fold.validate_pattern`; its annotations are
+        drawn when present.
+    page : str
+        ``"A4"``, ``"A3"``, ``"A2"``, ``"Letter"``, ``"Legal"`` (portrait) or ``"WxH"`` in mm.
+    units : str
+        ``"mm"``, ``"cm"``, ``"m"``, ``"in"`` or ``"pt"``: the printed unit of
+        ``scale`` pattern units (one pattern unit is printed ``scale`` ``units`` long).
+    scale : float
+        Positive.
+    margin_mm : float
+        Unprinted border of each page, on every side.
+
+    Returns
+    -------
+    bytes
+        The PDF (starts with ``%PDF``); one page per :class:`Tile` of :func:`pdf_tiles`. Same
+        input, same bytes.
+
+    Raises
+    ------
+    ParameterError
+        For an invalid page, unit, scale or margin, or too many pages.
+    ExportError
+        When the pattern is inconsistent.
+    """
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    tiles = pdf_tiles(pattern, page=page, units=units, scale=scale, margin_mm=margin_mm)
+    validate_pattern(pattern)
+    width, height = page_size_mm(page)
+    k = MM_PER_UNIT[units] * float(scale)
+    layers = _drawing_mm(pattern, k)
+    n_regions = 1 + max(t.region for t in tiles)
+    buf = io.BytesIO()
+    with PdfPages(buf, metadata={"CreationDate": None, "Creator": "filletfold"}) as pdf:
+        for number, tile in enumerate(tiles):
+            fig = _page_figure(layers, tile, width, height, margin_mm)
+            head = f"row {tile.row} / col {tile.col}"
+            if n_regions > 1:
+                head = f"sheet {tile.region + 1} / {n_regions} - {head}"
+            fig.axes[0].text(
+                margin_mm,
+                height - 0.5 * margin_mm,
+                f"{head}    (page {number + 1} of {len(tiles)}; trim at the grey frame, "
+                "abut, align the crosses)",
+                fontsize=_FONT_PT,
+                va="center",
+                ha="left",
+                color="#000000",
+            )
+            if number == 0:
+                _scale_bar(fig.axes[0], units, float(scale), margin_mm, width)
+            pdf.savefig(fig)
+    return buf.getvalue()
+
+
+def _drawing_mm(pattern: CreasePattern, k: float) -> dict:
+    """Polylines (in drawing mm) of every layer, and the labels."""
+    v = pattern.vertices_2d * k
+    out = {}
+    for layer, mask in edge_layer_masks(pattern).items():
+        lines = []
+        for chain, closed in edge_chains(pattern.edges, mask):
+            p = v[chain]
+            lines.append(np.vstack([p, p[:1]]) if closed else p)
+        out[layer] = lines
+    ann = pattern.annotations
+    out["CUT"] = out["CUT"] + [
+        np.vstack([p, p[:1]]) * k if closed else np.asarray(p) * k
+        for p, closed in tab_cut_paths(ann)
+    ]
+    out["TAB"] = [np.asarray(h, dtype=np.float64).reshape(2, 2) * k for h in ann.tab_hinges]
+    sheets = np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4) * k
+    out["SHEET"] = [
+        np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]]) for x0, y0, x1, y1 in sheets
+    ]
+    out["LABEL"] = [
+        (
+            np.asarray(lb.position, dtype=np.float64).reshape(2) * k,
+            str(lb.text),
+            float(lb.angle),
+            float(lb.height) * k,
+        )
+        for lb in ann.labels
+    ]
+    return out
+
+
+def _in_box(lines: list, box) -> list:
+    """The polylines whose bounding box meets ``box``."""
+    x0, y0, x1, y1 = box
+    keep = []
+    for p in lines:
+        lo, hi = p.min(axis=0), p.max(axis=0)
+        if hi[0] >= x0 and lo[0] <= x1 and hi[1] >= y0 and lo[1] <= y1:
+            keep.append(p)
+    return keep
+
+
+def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: float):
+    """One page: the tile's part of the drawing clipped to the printable area, frame, marks."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
+
+    fig = Figure(figsize=(width / 25.4, height / 25.4))
+    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
+    ax.set_xlim(0.0, width)
+    ax.set_ylim(0.0, height)
+    ax.set_axis_off()
+    x0, y0, x1, y1 = tile.box
+    tw, th = x1 - x0, y1 - y0
+    shift = np.array([margin - x0, margin - y0])
+    clip = Rectangle((margin, margin), tw, th, transform=ax.transData, fill=False)
+    lw = _LINE_MM * _PT_PER_MM
+    styles = [
+        ("SHEET", _SHEET, 0.5 * lw, "solid"),
+        ("CUT", _COLORS["CUT"], lw, "solid"),
+        ("VALLEY", _COLORS["VALLEY"], lw, "solid"),
+        ("MOUNTAIN", _COLORS["MOUNTAIN"], lw, "solid"),
+        ("TAB", _HINGE, lw, (0, (4, 3))),
+    ]
+    for layer, color, width_pt, style in styles:
+        lines = _in_box(layers.get(layer, []), tile.box)
+        if not lines:
+            continue
+        lc = LineCollection(
+            [p + shift for p in lines], colors=color, linewidths=width_pt, linestyles=style
+        )
+        lc.set_capstyle("round")
+        lc.set_joinstyle("round")
+        ax.add_collection(lc)
+        lc.set_clip_path(clip)
+    for pos, text, angle, h in layers["LABEL"]:
+        if not (x0 - 5 * h <= pos[0] <= x1 + 5 * h and y0 - 5 * h <= pos[1] <= y1 + 5 * h):
+            continue
+        t = ax.text(
+            *(pos + shift),
+            text,
+            rotation=angle,
+            rotation_mode="anchor",
+            ha="center",
+            va="center",
+            fontsize=max(h * _PT_PER_MM / 0.72, 1.0),
+            color=_LABEL,
+        )
+        t.set_clip_path(clip)
+    ax.add_patch(
+        Rectangle(
+            (margin, margin), tw, th, fill=False, edgecolor=_FRAME, linewidth=0.1 * _PT_PER_MM
+        )
+    )
+    arm = min(_MARK_MM, 0.25 * min(tw, th))
+    marks = []
+    for cx, cy in (
+        (margin, margin),
+        (margin + tw, margin),
+        (margin, margin + th),
+        (margin + tw, margin + th),
+    ):
+        marks.append([(cx - arm, cy), (cx + arm, cy)])
+        marks.append([(cx, cy - arm), (cx, cy + arm)])
+    ax.add_collection(LineCollection(marks, colors="#000000", linewidths=0.15 * _PT_PER_MM))
+    return fig
+
+
+def _scale_bar(ax, units: str, scale: float, margin: float, width: float) -> None:
+    """A bar of a round length in ``units`` in the bottom margin, with its label."""
+    mm_per = MM_PER_UNIT[units]
+    bar = nice_length(min(50.0, 0.4 * (width - 2 * margin)) / mm_per)
+    length_mm = bar * mm_per
+    y = 0.35 * margin
+    h = min(1.5, 0.2 * max(margin, 1.0))
+    from matplotlib.patches import Rectangle
+
+    ax.add_patch(Rectangle((margin, y), length_mm, h, facecolor="#000000", edgecolor="none"))
+    text = f"{bar:g} {units}"
+    if scale != 1.0:
+        text += f"  (= {bar / scale:g} pattern units; scale {scale:g} {units} per unit)"
+    ax.text(margin + length_mm + 2.0, y + 0.5 * h, text, fontsize=_FONT_PT, va="center")
