@@ -102,3 +102,45 @@ def test_material_loss_without_solution_is_an_error(capsys, tmp_path):
     assert main(["round", "random-convex", "--material-loss", "-o", str(tmp_path / "o")]) == 2
     assert "no consistent material loss" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_net_on_sheets_with_all_formats(tmp_path, capsys):
+    out = tmp_path / "n"
+    args = [
+        "round",
+        "dodecahedron",
+        "--layout",
+        "net",
+        "--sheet",
+        "A4",
+        "--units",
+        "mm",
+        "--scale",
+        "60",
+        "--format",
+        "all",
+        "-o",
+        str(out),
+    ]
+    assert main(args) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "(net)" in text and "glue tabs:" in text and "sheets:" in text
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [
+        "design.fold",
+        "folded.obj",
+        "pattern.dxf",
+        "pattern.pdf",
+        "pattern.png",
+        "pattern.svg",
+        "preview.png",
+        "report.json",
+    ]
+    fab = json.loads((out / "report.json").read_text())["fabrication"]
+    assert fab["sheets"] == len(fab["pieces_per_sheet"]) and fab["pieces"] < 20
+
+
+def test_no_tabs(tmp_path):
+    assert main(["round", "cube", "--no-tabs", "-o", str(tmp_path / "c")]) == 0
+    fab = json.loads((tmp_path / "c" / "report.json").read_text())["fabrication"]
+    assert fab["tabs"] == 0 and fab["cut_borders"] == 0

@@ -100,10 +100,12 @@ ScaleOption = Annotated[
     ),
 ]
 SheetOption = Annotated[
-    str,
+    str | None,
     typer.Option(
         "--sheet",
-        help="PDF page: A4, A3, A2, Letter, Legal or WxH in millimetres (e.g. 600x400).",
+        help="Sheet size: A4, A3, A2, A1, Letter, Legal or WxH in millimetres (e.g. 600x400). "
+        "The PDF is tiled on it [default: A4]; with 'round' the pieces are also split to fit "
+        "and placed on sheets of this size.",
     ),
 ]
 
@@ -180,8 +182,9 @@ def round_cmd(
         str,
         typer.Option(
             "--layout",
-            help="'modules' (one piece per vertex), 'sheet' (all glued into one sheet; fails "
-            "if they do not fit) or 'auto' (the sheet when possible).",
+            help="'modules' (one piece per vertex), 'net' (modules joined into few pieces), "
+            "'sheet' (all glued into one uncut sheet; fails if they do not fit) or 'auto' (the "
+            "sheet with --material-loss when possible, nets with --sheet, else modules).",
         ),
     ] = "auto",
     coplanar_tol: Annotated[
@@ -199,7 +202,10 @@ def round_cmd(
     formats: FormatOption = None,
     units: UnitsOption = "",
     scale: ScaleOption = None,
-    sheet: SheetOption = "A4",
+    sheet: SheetOption = None,
+    no_tabs: Annotated[
+        bool, typer.Option("--no-tabs", help="No glue tabs, seam labels or part numbers.")
+    ] = False,
 ):
     """Round every edge and vertex of MESH; write the design into the output folder.
 
@@ -213,7 +219,7 @@ def round_cmd(
     try:
         chosen = parse_formats(formats if formats is not None else DEFAULT_FORMATS)
         # check units, scale and page before the (slow) design
-        _check_export_options(units, scale, sheet, chosen)
+        _check_export_options(units, scale, sheet or "A4", chosen)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
     try:
@@ -241,6 +247,10 @@ def round_cmd(
                 material_loss=material_loss,
                 max_loss=max_loss,
                 layout=layout,
+                sheet=sheet,
+                units=units or "mm",
+                scale=scale if scale is not None else 1.0,
+                tabs=not no_tabs,
                 coplanar_deg=coplanar_tol,
                 progress=progress,
             )
@@ -249,7 +259,7 @@ def round_cmd(
         if dry_run:
             return
         written = export_design(
-            design, target, formats=chosen, units=units, scale=scale, page=sheet
+            design, target, formats=chosen, units=units, scale=scale, page=sheet or "A4"
         )
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
@@ -282,7 +292,7 @@ def export_cmd(
     formats: FormatOption = "dxf,pdf,svg,png",
     units: UnitsOption = "",
     scale: ScaleOption = None,
-    sheet: SheetOption = "A4",
+    sheet: SheetOption = None,
 ):
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
@@ -303,14 +313,14 @@ def export_cmd(
                 f"format {bad[0]} cannot be written from design.fold (export writes "
                 f"{', '.join(EXPORT_FORMATS)}; use 'filletfold round' for fold and json)"
             )
-        _check_export_options(units, scale, sheet, chosen)
+        _check_export_options(units, scale, sheet or "A4", chosen)
         if not folder.is_dir():
             raise _error(f"{folder}: no such folder (write a design with 'filletfold round')")
         source = folder / "design.fold"
         if not source.is_file():
             raise _error(f"{source}: no design.fold in {folder} (write it with 'filletfold round')")
         pattern = read_fold(source)
-        files = cut_files(pattern, chosen, units=units, scale=scale, page=sheet)
+        files = cut_files(pattern, chosen, units=units, scale=scale, page=sheet or "A4")
         written = write_outputs(folder, files)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None

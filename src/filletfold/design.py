@@ -187,17 +187,41 @@ class Design:
 
         return design_summary(self)
 
-    def export(self, folder, *, title: str | None = None) -> list[Path]:
-        """Write ``design.fold``, ``report.json``, ``folded.obj`` and ``pattern.svg`` atomically.
+    def export(
+        self,
+        folder,
+        *,
+        title: str | None = None,
+        formats=("fold", "json", "obj", "svg"),
+        units: str = "",
+        scale: float | None = None,
+        page: str = "A4",
+    ) -> list[Path]:
+        """Write the design's files into ``folder`` atomically (all of them or none).
+
+        Parameters
+        ----------
+        folder : str or Path
+        title : str, optional
+        formats : sequence of str or str
+            Any of ``fold`` (design.fold), ``json`` (report.json), ``obj`` (folded.obj),
+            ``svg`` (pattern.svg), ``dxf`` (pattern.dxf), ``pdf`` (pattern.pdf), ``png``
+            (pattern.png and preview.png), or ``"all"``.
+        units, scale, page : str, float, str
+            Drawing units and pattern-units-to-drawing scale of the cut files; PDF page size.
 
         Returns
         -------
         list of Path
             The files written.
         """
+        from .export.cutfiles import parse_formats
         from .reporting import export_design
 
-        return export_design(self, folder, title=title)
+        chosen = parse_formats(formats)
+        return export_design(
+            self, folder, title=title, formats=chosen, units=units, scale=scale, page=page
+        )
 
 
 def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
