@@ -697,9 +697,10 @@ def test_export_design_all_formats(cube, tmp_path):
         "pattern.pdf",
         "pattern.png",
         "preview.png",
+        "assembly.txt",
     ]
     written = export_design(cube, tmp_path / "some", formats="dxf,json")
-    assert [p.name for p in written] == ["report.json", "pattern.dxf"]
+    assert [p.name for p in written] == ["report.json", "pattern.dxf", "assembly.txt"]
 
 
 # ---------------------------------------------------------------- CLI
@@ -758,7 +759,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 8 files" in capsys.readouterr().out
+    assert "wrote 9 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 

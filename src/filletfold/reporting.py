@@ -11,6 +11,7 @@ from . import __version__
 from .export import report_json, write_outputs
 from .export.cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .rounding import loss_from_radius
+from .tabs import assembly_text
 
 #: The files :func:`export_design` writes by default.
 OUTPUT_FILES = output_names(DEFAULT_FORMATS)
@@ -236,7 +237,7 @@ def export_design(
         Output formats (see :mod:`filletfold.export.cutfiles`): by default ``fold``, ``json``,
         ``obj`` and ``svg``, i.e. ``design.fold``, ``report.json``, ``folded.obj`` and
         ``pattern.svg``; ``"all"`` adds ``pattern.dxf``, ``pattern.pdf``, ``pattern.png`` and
-        ``preview.png``.
+        ``preview.png``. With glue tabs, ``assembly.txt`` (the assembly sheet) is written too.
     units, scale, page
         Real size of the cut files and PDF page (see
         :func:`~filletfold.export.cutfiles.cut_files`).
@@ -264,4 +265,9 @@ def export_design(
     design.timings["export"] = time.perf_counter() - t
     if "json" in formats:
         files["report.json"] = report_json(design_report(design))
-    return write_outputs(folder, {k: files[k] for k in output_names(formats)})
+    names = list(output_names(formats))
+    seams = design.fabrication.get("seams")
+    if seams:
+        files["assembly.txt"] = assembly_text(seams)
+        names.append("assembly.txt")
+    return write_outputs(folder, {k: files[k] for k in names})

@@ -137,8 +137,9 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
     Returns
     -------
     dict
-        ``cut_borders``, ``tabs`` (placed), ``tabs_reduced`` (at a smaller height) and
-        ``untabbed`` (cut borders where no tab fits: they keep their two labels).
+        ``cut_borders``, ``tabs`` (placed), ``tabs_reduced`` (at a smaller height),
+        ``untabbed`` (cut borders where no tab fits: they keep their two labels) and ``seams``
+        (per label: the two pieces it joins and the piece carrying the tab).
     """
     polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
     tree = shapely.STRtree(polys)
@@ -146,6 +147,7 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
     ann = Annotations(sheets=p.annotations.sheets)
     label_h = 0.45 * tab_height
     stats = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
+    seams = []
 
     def clear(tab: shapely.Polygon) -> bool:
         shrunk = tab.buffer(-1e-9 * tab_height)
@@ -154,13 +156,17 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
                 return False
         return not any(t.intersects(shrunk) for t in placed_tabs)
 
-    runs = []
+    runs, run_edges = [], []
     for side_a, side_b in _runs(p, _seam_pairs(p)):
         sides = [_segment(p, side_a), _segment(p, side_b)]
         if np.linalg.norm(sides[0][0][1] - sides[0][0][0]) > 1e-6 * tab_height:
             runs.append(sides)  # shorter runs are slivers of round-off, not borders
+            run_edges.append((side_a, side_b))
+    piece_of_edge = p.face_piece[p.edge_faces.max(axis=1)]
+    names = part_names or [f"P{k + 1}" for k in range(p.n_pieces)]
     for n, sides in enumerate(runs, start=1):
         stats["cut_borders"] += 1
+        tab_on = None
         done = False
         for scale, part in ((1.0, None), (0.5, None), (0.5, 0), (0.5, 1), (0.25, 0), (0.25, 1)):
             for ends, normal in sides:
@@ -177,12 +183,17 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
                     placed_tabs.append(tab)
                     stats["tabs"] += 1
                     stats["tabs_reduced"] += scale < 1
+                    tab_on = 0 if ends is sides[0][0] else 1
                     done = True
                     break
             if done:
                 break
         if not done:
             stats["untabbed"] += 1
+        pieces = [names[piece_of_edge[edges[0]]] for edges in run_edges[n - 1]]
+        seams.append(
+            {"label": n, "pieces": pieces, "tab_on": None if tab_on is None else pieces[tab_on]}
+        )
         for ends, normal in sides:
             d = ends[1] - ends[0]
             pos = ends.mean(axis=0) - 0.9 * label_h * normal
@@ -194,7 +205,18 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         if not faces:
             continue
         where = shapely.union_all(shapely.make_valid(faces)).representative_point()
-        name = part_names[k] if part_names is not None else f"P{k + 1}"
-        ann.labels.append(Label(np.array([where.x, where.y]), name, 0.0, 2 * label_h, "part"))
+        ann.labels.append(Label(np.array([where.x, where.y]), names[k], 0.0, 2 * label_h, "part"))
     p.annotations = ann
+    stats["seams"] = seams
     return stats
+
+
+def assembly_text(seams: list[dict]) -> str:
+    """The assembly sheet: which piece each numbered cut border joins, and where the tab is."""
+    lines = [
+        "# filletfold assembly: glue each numbered border to the border with the same number",
+        "label\tpieces\ttab on",
+    ]
+    for s in seams:
+        lines.append(f"{s['label']}\t{s['pieces'][0]} - {s['pieces'][1]}\t{s['tab_on'] or '-'}")
+    return "\n".join(lines) + "\n"
