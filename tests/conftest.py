@@ -38,3 +38,13 @@ def random_convex(seed: int):
         a, b, c = p[s]
         faces.append(s if np.cross(b - a, c - a) @ eq[:3] > 0 else s[::-1])
     return p, faces
+
+
+def signed_volume(mesh) -> float:
+    """Signed volume of a closed mesh (positive when its faces point outward)."""
+    p = mesh.vertices - mesh.vertices.mean(axis=0)
+    total = 0.0
+    for f in mesh.faces:
+        q = p[f]
+        total += sum(np.dot(q[0], np.cross(q[i], q[i + 1])) for i in range(1, len(f) - 1))
+    return total / 6.0

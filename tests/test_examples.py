@@ -12,6 +12,8 @@ from scipy.spatial.transform import Rotation
 from filletfold.errors import MeshReadError
 from filletfold.mesh import EXAMPLES, PolyMesh, clean_mesh, example_mesh, example_names, load_mesh
 
+from .conftest import signed_volume
+
 NAMES = example_names()
 CLOSED = [n for n in NAMES if EXAMPLES[n].closed]
 OPEN = [n for n in NAMES if not EXAMPLES[n].closed]
@@ -22,15 +24,6 @@ PLATONIC = {
     "dodecahedron": (12, 5),
     "icosahedron": (20, 3),
 }
-
-
-def signed_volume(mesh: PolyMesh) -> float:
-    p = mesh.vertices - mesh.vertices.mean(axis=0)
-    total = 0.0
-    for f in mesh.faces:
-        q = p[f]
-        total += sum(np.dot(q[0], np.cross(q[i], q[i + 1])) for i in range(1, len(f) - 1))
-    return total / 6.0
 
 
 def edge_is_convex(mesh: PolyMesh) -> np.ndarray:

@@ -10,14 +10,7 @@ from filletfold.errors import MeshError
 from filletfold.mesh import CleanLog, PolyMesh, clean_mesh, example_mesh
 from filletfold.tolerances import tol
 
-
-def signed_volume(mesh: PolyMesh) -> float:
-    p = mesh.vertices - mesh.vertices.mean(axis=0)
-    total = 0.0
-    for f in mesh.faces:
-        q = p[f]
-        total += sum(np.dot(q[0], np.cross(q[i], q[i + 1])) for i in range(1, len(f) - 1))
-    return total / 6.0
+from .conftest import signed_volume
 
 
 def cube():

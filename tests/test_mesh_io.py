@@ -12,7 +12,6 @@ from numpy.testing import assert_allclose
 
 from filletfold.errors import ExportError, MeshError, MeshReadError
 from filletfold.mesh import (
-    PolyMesh,
     example_mesh,
     load_mesh,
     read_mesh,
@@ -20,16 +19,9 @@ from filletfold.mesh import (
     write_off,
 )
 
+from .conftest import signed_volume
+
 BUNNY = Path(__file__).resolve().parents[1] / "examples" / "bunny-lowres.obj"
-
-
-def signed_volume(mesh: PolyMesh) -> float:
-    p = mesh.vertices - mesh.vertices.mean(axis=0)
-    total = 0.0
-    for f in mesh.faces:
-        q = p[f]
-        total += sum(np.dot(q[0], np.cross(q[i], q[i + 1])) for i in range(1, len(f) - 1))
-    return total / 6.0
 
 
 def assert_same_faces(a, b):
