@@ -192,7 +192,7 @@ class Design:
         folder,
         *,
         title: str | None = None,
-        formats=("fold", "json", "obj", "svg"),
+        formats="fold,json,obj,svg",
         units: str = "",
         scale: float | None = None,
         page: str = "A4",
@@ -215,12 +215,10 @@ class Design:
         list of Path
             The files written.
         """
-        from .export.cutfiles import parse_formats
         from .reporting import export_design
 
-        chosen = parse_formats(formats)
         return export_design(
-            self, folder, title=title, formats=chosen, units=units, scale=scale, page=page
+            self, folder, title=title, formats=formats, units=units, scale=scale, page=page
         )
 
 
