@@ -9,6 +9,8 @@ Commands
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
     pictures).
+``filletfold app [MESH] [--port N] [--host ADDR]``
+    Start the browser app (viser) on MESH and print its address.
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
     Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
     ``pattern.svg``) and pictures (``pattern.png``, ``preview.png``) into ``DIR``.
@@ -328,6 +330,35 @@ def export_cmd(
         f"wrote {len(written)} files to {folder}/: {', '.join(p.name for p in written)}",
         highlight=False,
     )
+
+
+@app.command("app")
+def app_cmd(
+    mesh: Annotated[
+        str, typer.Argument(help="Mesh file or built-in example name to open first.")
+    ] = "icosahedron",
+    port: Annotated[int, typer.Option("--port", help="Port to serve on (0: a free one).")] = 0,
+    host: Annotated[
+        str, typer.Option("--host", help="Address to bind (default: this machine only).")
+    ] = "127.0.0.1",
+    open_browser: Annotated[
+        bool, typer.Option("--open", help="Open the page in the default browser.")
+    ] = False,
+):
+    """Start the browser app (needs the 'app' extra: pip install 'filletfold[app]').
+
+    Prints the page's address and runs until Ctrl-C.
+    """
+    from .app.server import run_app
+
+    if not 0 <= port <= 65535:
+        raise _error(f"port must be in 0..65535, got {port}")
+    try:
+        server = run_app(mesh, host=host, port=port, open_browser=open_browser)
+    except FilletfoldError as exc:
+        raise _error(str(exc)) from None
+    console.print(f"filletfold app at {server.url}  (Ctrl-C to stop)", highlight=False)
+    server.wait()
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -305,9 +305,9 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
     from scipy.spatial import cKDTree
 
     tree = cKDTree(pattern.vertices_3d)
+    cones = {int(s.split()[1]) for s in set(pattern.face_patch) if s.startswith("cone ")}
     for u in np.nonzero(np.isfinite(res.apex[:, 0]))[0]:
-        cone = [i for i, s in enumerate(pattern.face_patch) if s == f"cone {u}"]
-        if not cone:
+        if int(u) not in cones:
             continue
         dist, k = tree.query(res.apex[u])
         if dist < 1e-9 * (1 + np.abs(res.apex[u]).max()):
