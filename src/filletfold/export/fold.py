@@ -63,12 +63,16 @@ def face_signed_area_2d(vertices_2d: np.ndarray, faces: list) -> np.ndarray:
     (n_faces,) float
         Positive for counter-clockwise faces.
     """
-    out = np.empty(len(faces))
-    for i, f in enumerate(faces):
-        p = vertices_2d[np.asarray(f, dtype=np.int64)]
-        q = np.roll(p, -1, axis=0)
-        out[i] = 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
-    return out
+    if len(faces) == 0:
+        return np.zeros(0)
+    sizes = np.array([len(f) for f in faces], dtype=np.int64)
+    start = np.concatenate([[0], np.cumsum(sizes)])
+    a = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
+    nxt = np.arange(len(a)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    p, q = vertices_2d[a], vertices_2d[a[nxt]]
+    cross = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]
+    return 0.5 * np.add.reduceat(cross, start[:-1])
 
 
 def validate_pattern(pattern: CreasePattern) -> None:
