@@ -1,0 +1,387 @@
+"""The browser app on viser: a thin front end over :class:`~filletfold.app.session.AppSession`.
+
+The page shows the folded surface (patches coloured, creases mountain red / valley blue), the
+crease pattern laid flat beside it, vertex status markers and a legend; the panel holds the
+example list, an upload button, sliders for radius, depth and samples, the material-loss
+switch, a vertex inspector with its own depth, and the download button.
+
+Every change is handed to one worker thread; changes that arrive while it computes are merged
+into the next computation, and a result older than the one shown is dropped.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import threading
+import webbrowser
+
+from ..design import DEFAULT_SAMPLES
+from ..errors import FilletfoldError
+from ..mesh import example_names
+from .session import AppSession, nearest_vertex_to_ray
+from .view import CREASE_RGB, PATCH_RGB, legend_markdown, scene_arrays
+
+log = logging.getLogger(__name__)
+
+DEFAULT_RADIUS_PERCENT = 10.0
+DEFAULT_DEPTH_PERCENT = 30.0
+
+
+def _import_viser():
+    try:
+        import viser
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise FilletfoldError("the browser app needs viser: pip install 'filletfold[app]'") from exc
+    return viser
+
+
+class AppServer:
+    """A running app: the viser server, its session and its worker thread.
+
+    Attributes
+    ----------
+    session : AppSession
+    host : str
+    port : int
+    url : str
+        ``http://HOST:PORT``.
+    """
+
+    def __init__(self, server, session: AppSession, host: str):
+        self.server = server
+        self.session = session
+        self.host = host
+        self.port = int(server.get_port())
+        self.url = f"http://{host}:{self.port}"
+        self.status = "starting"
+        self._wake = threading.Condition()
+        self._dirty = False
+        self._upload = None
+        self._stopping = False
+        self._stopped = threading.Event()
+        self._selected = 0
+        self._build_gui()
+        self._worker = threading.Thread(target=self._work, name="filletfold-app", daemon=True)
+        self._worker.start()
+
+    # -- lifecycle ------------------------------------------------------------------------
+    def stop(self) -> None:
+        """Stop the worker and the viser server (idempotent)."""
+        with self._wake:
+            if self._stopping:
+                return
+            self._stopping = True
+            self._wake.notify_all()
+        self._worker.join(timeout=30)
+        with _quiet_stdout():
+            self.server.stop()
+        self._stopped.set()
+        log.info("filletfold app stopped")
+
+    def wait(self) -> None:
+        """Block until :meth:`stop` (Ctrl-C stops the app)."""
+        try:
+            while not self._stopped.wait(0.5):
+                pass
+        except KeyboardInterrupt:
+            self.stop()
+
+    # -- worker ---------------------------------------------------------------------------
+    def request_update(self) -> None:
+        """Ask the worker to recompute with the current parameters."""
+        with self._wake:
+            self._dirty = True
+            self._wake.notify_all()
+        self._set_status("computing…")
+
+    def request_load(self, source: str, content: bytes | None = None) -> None:
+        """Ask the worker to load an example or an uploaded file (replacing any load not yet
+        started)."""
+        with self._wake:
+            self._upload = (source, content)
+            self._wake.notify_all()
+        self._set_status(f"loading {source}…")
+
+    def _work(self) -> None:
+        while True:
+            with self._wake:
+                while not (self._dirty or self._upload or self._stopping):
+                    self._wake.wait()
+                if self._stopping:
+                    return
+                upload, self._upload = self._upload, None
+                dirty, self._dirty = self._dirty, False
+            try:
+                if upload is not None:
+                    self.session.load(upload[0], upload[1])
+                    self._after_load()
+                    if dirty:
+                        self.session.recompute()
+                elif dirty:
+                    self.session.recompute()
+                self._draw()
+            except FilletfoldError as exc:
+                self._set_status(f"**error:** {exc}")
+                log.info("app: %s", exc)
+            except Exception as exc:  # keep the app alive; show what happened
+                log.exception("app: unexpected error")
+                self._set_status(f"**unexpected error:** {type(exc).__name__}: {exc}")
+
+    # -- GUI ------------------------------------------------------------------------------
+    def _set_status(self, text: str) -> None:
+        self.status = text
+        handle = getattr(self, "_status_md", None)
+        if handle is not None:
+            handle.content = text
+
+    def _build_gui(self) -> None:
+        gui = self.server.gui
+        self._status_md = gui.add_markdown("starting…")
+        with gui.add_folder("Mesh"):
+            names = list(example_names())
+            name = self.session.name
+            self._example = gui.add_dropdown(
+                "Example", names, initial_value=name if name in names else names[0]
+            )
+            self._upload_button = gui.add_upload_button(
+                "Upload mesh (OBJ/OFF/PLY/STL, ≤ 50 MB)", icon=None
+            )
+        with gui.add_folder("Parameters"):
+            self._radius = gui.add_slider("Radius (% edge)", 1.0, 50.0, 0.5, DEFAULT_RADIUS_PERCENT)
+            self._depth = gui.add_slider("Depth (% edge)", 1.0, 150.0, 1.0, DEFAULT_DEPTH_PERCENT)
+            self._samples = gui.add_slider("Samples", 3, 64, 1, DEFAULT_SAMPLES)
+            self._loss = gui.add_checkbox("Material loss", False)
+            self._show_pattern = gui.add_checkbox("Show crease pattern", True)
+        with gui.add_folder("Vertex"):
+            self._vertex = gui.add_number("Vertex index", 0, min=0, step=1)
+            self._vertex_depth = gui.add_number("Its depth (% edge, 0 = default)", 0.0, min=0.0)
+            self._vertex_md = gui.add_markdown("")
+        with gui.add_folder("Download"):
+            self._download = gui.add_button("Download design (zip)")
+        gui.add_markdown(legend_markdown())
+
+        @self._example.on_update
+        def _(event) -> None:
+            if event.client is not None:
+                self.request_load(self._example.value)
+
+        @self._upload_button.on_upload
+        def _(event) -> None:
+            f = event.target.value
+            self.request_load(f.name, f.content)
+
+        for handle in (self._radius, self._depth, self._samples, self._loss):
+            handle.on_update(lambda _event: self._params_changed())
+
+        @self._show_pattern.on_update
+        def _(_event) -> None:
+            for node in getattr(self, "_flat_nodes", []):
+                node.visible = self._show_pattern.value
+
+        @self._vertex.on_update
+        def _(event) -> None:
+            if event.client is not None:
+                self._select(int(self._vertex.value))
+
+        @self._vertex_depth.on_update
+        def _(event) -> None:
+            if event.client is None:  # set by the app itself, not by the user
+                return
+            value = float(self._vertex_depth.value)
+            try:
+                self.session.set_vertex_depth(self._selected, f"{value}%" if value > 0 else None)
+            except FilletfoldError as exc:
+                self._set_status(f"**error:** {exc}")
+                return
+            self.request_update()
+
+        @self._download.on_click
+        def _(event) -> None:
+            try:
+                data = self.session.export_zip()
+            except FilletfoldError as exc:
+                self._set_status(f"**error:** {exc}")
+                return
+            stem = (self.session.name or "design").rsplit(".", 1)[0].replace(":", "_")
+            target = event.client if event.client is not None else self.server
+            target.send_file_download(f"{stem}-filletfold.zip", data)
+
+    def _params_changed(self) -> None:
+        self.session.set_params(
+            radius=f"{float(self._radius.value)}%",
+            depth=f"{float(self._depth.value)}%",
+            samples=int(self._samples.value),
+            material_loss=bool(self._loss.value),
+        )
+        self.request_update()
+
+    def _after_load(self) -> None:
+        self._selected = 0
+        self._vertex.value = 0
+        self._vertex_depth.value = 0.0
+        if self.session.name in self._example.options:
+            self._example.value = self.session.name
+
+    def _select(self, u: int) -> None:
+        self._selected = u
+        try:
+            info = self.session.vertex_info(u)
+        except FilletfoldError as exc:
+            self._vertex_md.content = f"**error:** {exc}"
+            return
+
+        def num(x):
+            return "–" if x is None else f"{x:.4g}"
+
+        lines = [
+            f"**vertex {u}**: {info['status']} ({info['kind']})",
+            f"reason: {info['reason'] or '–'}",
+            f"depth used {num(info['depth'])}, requested {num(info['depth_requested'])}",
+            f"margin {num(info['margin'])}",
+            "normal " + ", ".join(num(x) for x in info["normal"] or []),
+        ]
+        self._vertex_md.content = "  \n".join(lines)
+        override = info["override"]
+        percent = float(override[:-1]) if isinstance(override, str) and override[-1:] == "%" else 0
+        self._vertex_depth.value = percent
+
+    def _draw(self) -> None:
+        design = self.session.design
+        if design is None:
+            return
+        arrays = scene_arrays(design)
+        scene = self.server.scene
+        flat_nodes, folded_nodes = [], []
+        with self.server.atomic():
+            for kind, rgb in PATCH_RGB.items():
+                for root, parts in (("/folded", arrays.folded), ("/pattern", arrays.flat)):
+                    name = f"{root}/{kind}"
+                    if kind not in parts:
+                        scene.add_mesh_simple(name, *_empty_mesh(), visible=False)
+                        continue
+                    vertices, faces = parts[kind]
+                    node = scene.add_mesh_simple(
+                        name, vertices, faces, color=rgb, side="double", flat_shading=False
+                    )
+                    (flat_nodes if root == "/pattern" else folded_nodes).append(node)
+            for root, segs in (
+                ("/folded", arrays.folded_creases),
+                ("/pattern", arrays.flat_creases),
+            ):
+                for a, points in segs.items():
+                    name = f"{root}/crease_{a}"
+                    node = scene.add_line_segments(
+                        name,
+                        points if len(points) else _empty_segments(),
+                        CREASE_RGB[a],
+                        thickness=2.0 if a != "B" else 1.0,
+                        thickness_units="screen",
+                        visible=len(points) > 0,
+                    )
+                    if root == "/pattern":
+                        flat_nodes.append(node)
+            scene.add_point_cloud(
+                "/folded/vertices",
+                arrays.vertex_points,
+                arrays.vertex_colors,
+                point_size=arrays.point_size,
+                point_shape="circle",
+                point_shading="flat",
+            )
+        for node in flat_nodes:
+            node.visible = self._show_pattern.value
+        self._flat_nodes = flat_nodes
+
+        def clicked(event) -> None:
+            u = nearest_vertex_to_ray(arrays.vertex_points, event.ray_origin, event.ray_direction)
+            if u >= 0:
+                self._vertex.value = u
+                self._select(u)
+
+        for node in folded_nodes:  # point clouds take no clicks in viser; the surface does
+            node.on_click(clicked)
+
+        counts = ", ".join(f"{n} {s}" for s, n in design.status_counts().items() if n)
+        self._set_status(
+            f"**{design.source}**: {len(design.mesh.vertices)} vertices ({counts}), "
+            f"{len(design.pattern.faces)} pattern faces"
+        )
+        n = len(design.mesh.vertices)
+        self._vertex.max = max(n - 1, 0)
+        if self._selected < n:
+            self._select(self._selected)
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Send what viser prints to the log (debug level) instead of stdout."""
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        yield
+    if buf.getvalue().strip():
+        log.debug("viser: %s", buf.getvalue().strip())
+
+
+def _empty_mesh():
+    import numpy as np
+
+    return np.zeros((3, 3)), np.array([[0, 1, 2]])
+
+
+def _empty_segments():
+    import numpy as np
+
+    return np.zeros((1, 2, 3))
+
+
+def run_app(
+    mesh="icosahedron",
+    host: str = "127.0.0.1",
+    port: int = 0,
+    open_browser: bool = False,
+) -> AppServer:
+    """Start the browser app on ``mesh`` and return at once (the server runs in threads).
+
+    Parameters
+    ----------
+    mesh : str, os.PathLike or PolyMesh
+        A built-in example name or a mesh file; its design is computed before the server starts.
+    host : str
+        Address to bind (default only this machine).
+    port : int
+        Port to bind; 0 picks a free one.
+    open_browser : bool
+        Open the page in the default browser.
+
+    Returns
+    -------
+    AppServer
+        ``.url`` is the page's address; call ``.stop()`` (or ``.wait()`` to block until
+        Ctrl-C).
+
+    Raises
+    ------
+    FilletfoldError
+        viser is missing, or the mesh cannot be read or rounded.
+    """
+    viser = _import_viser()
+    session = AppSession(
+        radius=f"{DEFAULT_RADIUS_PERCENT}%",
+        depth=f"{DEFAULT_DEPTH_PERCENT}%",
+        samples=DEFAULT_SAMPLES,
+    )
+    session.load(mesh)
+    with _quiet_stdout():  # viser prints its own banner; the URL is logged and returned
+        server = viser.ViserServer(host=host, port=port, label="filletfold", verbose=False)
+    try:
+        app = AppServer(server, session, host)
+        app._draw()
+    except BaseException:
+        server.stop()
+        raise
+    log.info("filletfold app at %s", app.url)
+    if open_browser:
+        webbrowser.open(app.url)
+    return app

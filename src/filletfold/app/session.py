@@ -1,0 +1,399 @@
+"""The browser app's state, without any GUI: mesh, parameters, the current design.
+
+:class:`AppSession` is what the viser front end (:mod:`filletfold.app.server`) drives. It keeps
+the current mesh and parameters, recomputes the design on request, and numbers every request so
+that a newer change supersedes an older one: a result computed for an old request never replaces
+a result of a newer one. A failed load or recompute raises the library's error and leaves the
+current design in place.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import math
+import os
+import tempfile
+import threading
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..design import DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES, Design, round_mesh
+from ..errors import MeshReadError, ParameterError
+from ..export.cutfiles import cut_files
+from ..export.report import report_json
+from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
+from ..mesh.polymesh import PolyMesh
+from ..tabs import assembly_text
+
+log = logging.getLogger(__name__)
+
+#: Largest mesh file the app accepts, in bytes (50 MB).
+UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
+#: Files in the zip from :meth:`AppSession.export_zip`, besides ``report.json``.
+ZIP_FORMATS = ("fold", "obj", "svg", "dxf")
+#: Parameters :meth:`AppSession.set_params` accepts.
+PARAM_NAMES = ("radius", "depth", "samples", "material_loss", "clamp")
+
+
+@dataclass(frozen=True)
+class Request:
+    """One recompute: its id and a snapshot of everything the design depends on.
+
+    Attributes
+    ----------
+    id : int
+        Increases with every request of a session.
+    mesh : PolyMesh
+    name : str
+        What the mesh came from (example name or file name).
+    params : dict
+        Keyword arguments of :func:`~filletfold.design.round_mesh` (``depth`` already merged
+        with the per-vertex overrides).
+    """
+
+    id: int
+    mesh: PolyMesh
+    name: str
+    params: dict = field(default_factory=dict)
+
+
+def _plain(x):
+    """JSON-friendly value: floats (None for NaN), lists for arrays."""
+    if x is None:
+        return None
+    arr = np.asarray(x, dtype=float)
+    if arr.ndim == 0:
+        v = float(arr)
+        return v if math.isfinite(v) else None
+    return [None if not math.isfinite(v) else float(v) for v in arr.ravel()]
+
+
+def read_upload(filename: str, content: bytes) -> PolyMesh:
+    """Read an uploaded mesh file through the library's reader.
+
+    Parameters
+    ----------
+    filename : str
+        The uploaded file's name; its extension chooses the reader.
+    content : bytes
+        The file's bytes, at most :data:`UPLOAD_LIMIT_BYTES`.
+
+    Returns
+    -------
+    PolyMesh
+        The cleaned mesh.
+
+    Raises
+    ------
+    MeshReadError
+        Over the size cap, an unsupported extension, or the reader's own error.
+    MeshError
+        The mesh is invalid.
+    """
+    name = Path(filename or "upload").name or "upload"
+    if len(content) > UPLOAD_LIMIT_BYTES:
+        raise MeshReadError(
+            f"{name}: the file is {len(content) / 1e6:.1f} MB; the app accepts files up to "
+            f"{UPLOAD_LIMIT_BYTES // (1024 * 1024)} MB"
+        )
+    if Path(name).suffix.lower() not in SUPPORTED_EXTENSIONS:
+        raise MeshReadError(
+            f"{name}: unsupported file type; supported: {', '.join(SUPPORTED_EXTENSIONS)}"
+        )
+    with tempfile.TemporaryDirectory(prefix="filletfold-upload-") as tmp:
+        path = Path(tmp) / name
+        path.write_bytes(content)
+        try:
+            mesh, _ = load_mesh(path)
+        except MeshReadError as exc:
+            # name the file as the user knows it, not by its temporary path
+            raise MeshReadError(str(exc).replace(str(path), name)) from None
+    return mesh
+
+
+class AppSession:
+    """The stateful part of the browser app: mesh, parameters, current design.
+
+    Parameters
+    ----------
+    radius, depth : float or str
+        As for :func:`~filletfold.design.round_mesh` (``"10%"`` of the mean edge length...).
+    samples : int
+    material_loss : bool
+
+    Attributes
+    ----------
+    mesh : PolyMesh or None
+    name : str
+        What the mesh came from.
+    params : dict
+        ``radius``, ``depth``, ``samples``, ``material_loss``, ``clamp``.
+    vertex_depth : dict of int to float or str
+        Per-vertex depth overrides.
+    design : Design or None
+        The newest design computed.
+    design_id : int
+        Request id of ``design`` (0 before the first).
+    """
+
+    def __init__(
+        self,
+        *,
+        radius=DEFAULT_RADIUS,
+        depth=DEFAULT_DEPTH,
+        samples: int = DEFAULT_SAMPLES,
+        material_loss: bool = False,
+    ):
+        self.mesh: PolyMesh | None = None
+        self.name = ""
+        self.params = {
+            "radius": radius,
+            "depth": depth,
+            "samples": samples,
+            "material_loss": material_loss,
+            "clamp": True,
+        }
+        self.vertex_depth: dict = {}
+        self.design: Design | None = None
+        self.design_id = 0
+        self._next_id = 0
+        self._lock = threading.RLock()
+
+    # -- requests -------------------------------------------------------------------------
+    def begin(self, *, mesh: PolyMesh | None = None, name: str | None = None) -> Request:
+        """Number a new request and snapshot the state it is computed from.
+
+        Parameters
+        ----------
+        mesh, name : optional
+            A mesh to compute instead of the current one (a load in progress).
+        """
+        with self._lock:
+            self._next_id += 1
+            mesh = self.mesh if mesh is None else mesh
+            if mesh is None:
+                raise MeshReadError("no mesh loaded")
+            params = dict(self.params)
+            if self.vertex_depth:
+                params["depth"] = {"default": params["depth"], **self.vertex_depth}
+            return Request(self._next_id, mesh, self.name if name is None else name, params)
+
+    @staticmethod
+    def compute(request: Request) -> Design:
+        """The design of a request (slow; no session state is touched)."""
+        design = round_mesh(request.mesh, **request.params)
+        design.source = request.name
+        return design
+
+    def commit(self, request: Request, design: Design) -> bool:
+        """Make ``design`` current unless a newer request's design already is.
+
+        Returns
+        -------
+        bool
+            Whether the design was taken.
+        """
+        with self._lock:
+            if request.id <= self.design_id:
+                log.debug("request %d superseded by %d", request.id, self.design_id)
+                return False
+            self.design, self.design_id = design, request.id
+            if request.mesh is not self.mesh:
+                self.mesh, self.name = request.mesh, request.name
+            return True
+
+    @property
+    def latest_id(self) -> int:
+        """Id of the newest request begun."""
+        return self._next_id
+
+    # -- state changes --------------------------------------------------------------------
+    def load(self, source, content: bytes | None = None) -> Design:
+        """Load a mesh and compute its design; on any error keep the current one.
+
+        Parameters
+        ----------
+        source : str, os.PathLike or PolyMesh
+            A built-in example name, a file path, or (with ``content``) the uploaded file name.
+        content : bytes, optional
+            The uploaded file's bytes.
+
+        Returns
+        -------
+        Design
+            The new current design.
+
+        Raises
+        ------
+        MeshReadError
+            Unreadable file, over :data:`UPLOAD_LIMIT_BYTES`, or unknown example.
+        FilletfoldError
+            Invalid mesh, or the design of the new mesh fails.
+        """
+        if content is not None:
+            mesh, name = read_upload(str(source), content), Path(str(source)).name
+        elif isinstance(source, PolyMesh):
+            mesh, name = source, "mesh"
+        else:
+            path = Path(os.fspath(source))
+            if path.is_file() and path.stat().st_size > UPLOAD_LIMIT_BYTES:
+                raise MeshReadError(
+                    f"{source}: the file is over the app's limit of "
+                    f"{UPLOAD_LIMIT_BYTES // (1024 * 1024)} MB"
+                )
+            mesh, _ = load_mesh(str(source) if isinstance(source, str) else path)
+            name = str(source) if not path.exists() else path.name
+        with self._lock:
+            saved = self.vertex_depth
+            self.vertex_depth = {}
+            try:
+                request = self.begin(mesh=mesh, name=name)
+            finally:
+                self.vertex_depth = saved
+        design = self.compute(request)
+        with self._lock:
+            if self.commit(request, design):
+                self.vertex_depth = {}
+        return self.design
+
+    def set_params(self, **kw) -> None:
+        """Change parameters (``radius``, ``depth``, ``samples``, ``material_loss``, ``clamp``).
+
+        Raises
+        ------
+        ParameterError
+            For an unknown parameter name.
+        """
+        for key in kw:
+            if key not in PARAM_NAMES:
+                raise ParameterError(
+                    f"unknown parameter {key!r}: choose from {', '.join(PARAM_NAMES)}", name=key
+                )
+        with self._lock:
+            self.params.update(kw)
+
+    def set_vertex_depth(self, u: int, depth) -> None:
+        """Give vertex ``u`` its own apex depth (``None`` removes the override).
+
+        Raises
+        ------
+        ParameterError
+            When ``u`` is not a vertex of the current mesh.
+        """
+        with self._lock:
+            n = 0 if self.mesh is None else len(self.mesh.vertices)
+            if isinstance(u, bool) or not isinstance(u, int | np.integer) or not 0 <= u < n:
+                raise ParameterError(f"vertex {u!r} does not exist (0..{n - 1})", name="vertex")
+            if depth is None:
+                self.vertex_depth.pop(int(u), None)
+            else:
+                self.vertex_depth[int(u)] = depth
+
+    def recompute(self) -> Design:
+        """Recompute the design of the current state.
+
+        Returns
+        -------
+        Design
+            The current design afterwards (a newer request's, if one finished first).
+
+        Raises
+        ------
+        FilletfoldError
+            When the design fails; the current design stays.
+        """
+        request = self.begin()
+        design = self.compute(request)
+        self.commit(request, design)
+        return self.design
+
+    # -- queries --------------------------------------------------------------------------
+    def vertex_info(self, u: int) -> dict:
+        """What the app shows about vertex ``u`` of the current design.
+
+        Returns
+        -------
+        dict
+            ``vertex``, ``kind``, ``status``, ``reason``, ``margin``, ``depth`` (used),
+            ``depth_requested``, ``normal`` (3 floats), ``apex`` (3 floats or None), ``override``
+            (the per-vertex depth given, or None). NaN becomes None.
+        """
+        with self._lock:
+            design = self.design
+            if design is None:
+                raise ParameterError("no design computed yet", name="vertex")
+            res = design.vertices
+            n = len(res.status)
+            if isinstance(u, bool) or not isinstance(u, int | np.integer) or not 0 <= u < n:
+                raise ParameterError(f"vertex {u!r} does not exist (0..{n - 1})", name="vertex")
+            apex = _plain(res.apex[u])
+            return {
+                "vertex": int(u),
+                "kind": res.kind[u],
+                "status": res.status[u],
+                "reason": res.reason[u],
+                "margin": _plain(res.margin[u]),
+                "depth": _plain(res.depth[u]),
+                "depth_requested": _plain(res.depth_requested[u]),
+                "normal": _plain(res.normal[u]),
+                "apex": None if apex is None or None in apex else apex,
+                "override": self.vertex_depth.get(int(u)),
+            }
+
+    def export_files(self) -> dict[str, str | bytes]:
+        """The current design's files, built in memory (nothing is written)."""
+        with self._lock:
+            design = self.design
+        if design is None:
+            raise ParameterError("no design computed yet", name="design")
+        files = dict(
+            cut_files(
+                design.pattern,
+                ZIP_FORMATS,
+                title=f"filletfold design of {design.source}",
+                description="Curved-crease rounded design: vertex modules",
+            )
+        )
+        files["report.json"] = report_json(design.report())
+        seams = design.fabrication.get("seams")
+        if seams:
+            files["assembly.txt"] = assembly_text(seams)
+        return files
+
+    def export_zip(self) -> bytes:
+        """A zip of ``design.fold``, ``report.json``, ``folded.obj``, ``pattern.svg`` and
+        ``pattern.dxf`` (and ``assembly.txt`` with glue tabs), built in memory."""
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+            for name, data in self.export_files().items():
+                zf.writestr(name, data)
+        return buf.getvalue()
+
+
+def nearest_vertex_to_ray(points: np.ndarray, origin, direction) -> int:
+    """Index of the point closest to a ray (a click in the 3D view).
+
+    Parameters
+    ----------
+    points : (n, 3) float
+    origin, direction : (3,) float
+
+    Returns
+    -------
+    int
+        -1 for no points.
+    """
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    if not len(points):
+        return -1
+    o = np.asarray(origin, dtype=float)
+    d = np.asarray(direction, dtype=float)
+    d = d / max(np.linalg.norm(d), 1e-300)
+    rel = points - o
+    t = np.maximum(rel @ d, 0.0)
+    dist = np.linalg.norm(rel - t[:, None] * d, axis=1)
+    return int(np.argmin(dist))

@@ -1,0 +1,184 @@
+"""What the browser app draws, as plain arrays (no GUI): triangles, creases, markers.
+
+Kept apart from :mod:`filletfold.app.server` so it can be tested without viser.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..design import Design
+
+#: RGB (0..255) of each patch kind.
+PATCH_RGB = {"cone": (245, 158, 64), "cylinder": (89, 153, 230), "face": (115, 199, 115)}
+#: RGB of each crease assignment drawn.
+CREASE_RGB = {"M": (220, 40, 40), "V": (40, 80, 220), "B": (40, 40, 40)}
+#: RGB of each vertex status.
+STATUS_RGB = {
+    "ok": (40, 170, 60),
+    "saddle": (240, 140, 20),
+    "infeasible": (220, 30, 30),
+    "boundary": (150, 150, 150),
+    "developable": (150, 70, 200),
+}
+
+
+def _hex(rgb) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*rgb)
+
+
+def legend_markdown() -> str:
+    """The legend shown in the GUI panel (Markdown with coloured squares)."""
+
+    def row(rgb, text):
+        return f'<span style="color:{_hex(rgb)}">&#9632;</span> {text}  '
+
+    lines = ["**Patches**  "]
+    lines += [row(PATCH_RGB[k], k) for k in ("cone", "cylinder", "face")]
+    lines += ["", "**Creases**  "]
+    lines += [
+        row(CREASE_RGB["M"], "mountain"),
+        row(CREASE_RGB["V"], "valley"),
+        row(CREASE_RGB["B"], "cut / border"),
+    ]
+    lines += ["", "**Vertices**  "]
+    lines += [row(rgb, status) for status, rgb in STATUS_RGB.items()]
+    return "\n".join(lines)
+
+
+def triangulate_polygon(poly_2d: np.ndarray) -> np.ndarray:
+    """Triangles of a simple counter-clockwise polygon (ear clipping; a fan when convex).
+
+    Parameters
+    ----------
+    poly_2d : (k, 2) float
+
+    Returns
+    -------
+    (k - 2, 3) int
+        Indices into the polygon's corners.
+    """
+    p = np.asarray(poly_2d, dtype=float)
+    k = len(p)
+    if k == 3:
+        return np.array([[0, 1, 2]])
+    prev, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
+    turn = _cross(p - prev, nxt - p)
+    scale = max(float(np.ptp(p, axis=0).max()) ** 2, 1e-300)
+    if np.all(turn >= -1e-12 * scale):
+        return np.array([[0, i, i + 1] for i in range(1, k - 1)])
+    idx = list(range(k))
+    out = []
+    guard = 0
+    while len(idx) > 3 and guard < 10 * k:
+        guard += 1
+        n = len(idx)
+        for j in range(n):
+            a, b, c = idx[j - 1], idx[j], idx[(j + 1) % n]
+            if _cross(p[b] - p[a], p[c] - p[b]) <= 0:
+                continue
+            tri = p[[a, b, c]]
+            others = [i for i in idx if i not in (a, b, c)]
+            if others and _inside(p[others], tri).any():
+                continue
+            out.append([a, b, c])
+            idx.pop(j)
+            break
+        else:  # degenerate: fall back to a fan of what is left
+            break
+    out += [[idx[0], idx[i], idx[i + 1]] for i in range(1, len(idx) - 1)]
+    return np.array(out, dtype=np.int64)
+
+
+def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """z-component of the cross product of 2D vectors (broadcasting)."""
+    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+
+def _inside(q: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(m,) bool: points inside or on a counter-clockwise triangle (which would block it as
+    an ear), except points at its corners."""
+    a, b, c = tri
+    s1 = _cross(b - a, q - a)
+    s2 = _cross(c - b, q - b)
+    s3 = _cross(a - c, q - c)
+    corner = (np.abs(q[:, None, :] - tri[None]).max(axis=2) == 0).any(axis=1)
+    return (s1 >= 0) & (s2 >= 0) & (s3 >= 0) & ~corner
+
+
+@dataclass
+class SceneArrays:
+    """Everything the 3D view shows of a design.
+
+    Attributes
+    ----------
+    folded : dict of str to (vertices (n, 3), triangles (t, 3))
+        The folded surface, one mesh per patch kind (``cone``, ``cylinder``, ``face``).
+    flat : dict of str to (vertices (n, 3), triangles (t, 3))
+        The crease pattern laid flat beside the folded form (z constant).
+    folded_creases, flat_creases : dict of str to (s, 2, 3) float
+        Segments per assignment (``M``, ``V``; the flat view also ``B``).
+    vertex_points : (n_vertices, 3) float
+        Mesh vertices (status markers).
+    vertex_colors : (n_vertices, 3) uint8
+    point_size : float
+        Marker size in scene units.
+    """
+
+    folded: dict = field(default_factory=dict)
+    flat: dict = field(default_factory=dict)
+    folded_creases: dict = field(default_factory=dict)
+    flat_creases: dict = field(default_factory=dict)
+    vertex_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    vertex_colors: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.uint8))
+    point_size: float = 0.05
+
+
+def scene_arrays(design: Design) -> SceneArrays:
+    """Triangles, crease segments and vertex markers of a design.
+
+    The crease pattern is placed in the plane through the lowest folded point, to the right
+    (+x) of the folded form with a gap of a tenth of the form's size, centred in y.
+    """
+    pattern = design.pattern
+    v2, v3 = pattern.vertices_2d, pattern.vertices_3d
+    lo, hi = v3.min(axis=0), v3.max(axis=0)
+    size = float(np.max(hi - lo)) or 1.0
+    p_lo, p_hi = v2.min(axis=0), v2.max(axis=0)
+    shift = np.array(
+        [hi[0] + 0.1 * size - p_lo[0], 0.5 * (lo[1] + hi[1]) - 0.5 * (p_lo[1] + p_hi[1])]
+    )
+    flat3 = np.column_stack([v2 + shift, np.full(len(v2), lo[2])])
+
+    tris: dict[str, list] = {k: [] for k in PATCH_RGB}
+    for face, patch in zip(pattern.faces, pattern.face_patch, strict=True):
+        face = np.asarray(face, dtype=np.int64)
+        kind = patch.split()[0]
+        tris.setdefault(kind, []).append(face[triangulate_polygon(v2[face])])
+    out = SceneArrays()
+    for kind, parts in tris.items():
+        if not parts:
+            continue
+        t = np.vstack(parts)
+        used, inverse = np.unique(t, return_inverse=True)
+        local = inverse.reshape(t.shape)
+        out.folded[kind] = (v3[used], local)
+        out.flat[kind] = (flat3[used], local)
+    assign = np.asarray(pattern.edge_assignment)
+    for a in ("M", "V", "B"):
+        e = pattern.edges[assign == a]
+        if a != "B":
+            out.folded_creases[a] = v3[e]
+        out.flat_creases[a] = flat3[e]
+    mesh = design.mesh
+    out.vertex_points = np.asarray(mesh.vertices, dtype=float)
+    out.vertex_colors = np.array(
+        [STATUS_RGB.get(s, (0, 0, 0)) for s in design.vertices.status], dtype=np.uint8
+    ).reshape(-1, 3)
+    lengths = np.linalg.norm(
+        mesh.vertices[mesh.edges[:, 1]] - mesh.vertices[mesh.edges[:, 0]], axis=1
+    )
+    out.point_size = 0.08 * float(lengths.mean()) if len(lengths) else 0.05 * size
+    return out
