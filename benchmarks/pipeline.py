@@ -2,8 +2,8 @@
 
     .venv/bin/python benchmarks/pipeline.py [--repeat N] [--max-faces F]
 
-Cases: the icosahedron and geodesic spheres (icosahedron subdivided, projected on the sphere)
-of 80, 320, 1280, ... faces, convex so every vertex gets a cone. For each: the median over
+Cases: the built-in ``geodesic-sphere`` at levels 0, 1, 2, ... (20, 80, 320, 1280, ...
+faces), convex so every vertex gets a cone. For each: the median over
 ``--repeat`` runs of every stage of ``round_mesh`` (read, rounding, normals, apices, surface
 with nets/tabs off) and of the export, the peak memory (ru_maxrss growth, MB) and seconds per
 vertex. Prints the machine and the command first.
@@ -19,38 +19,11 @@ import sys
 import tempfile
 import time
 
-import numpy as np
-
 import filletfold
 from filletfold.mesh import example_mesh
 
 sys.path.insert(0, os.path.dirname(__file__))
 from examples import machine
-
-
-def geodesic_sphere(level: int):
-    """Icosahedron subdivided ``level`` times (faces x4 each), projected on the unit sphere."""
-    v, f = example_mesh("icosahedron")
-    v = v / np.linalg.norm(v, axis=1)[:, None]
-    faces = [tuple(x) for x in f]
-    for _ in range(level):
-        cache: dict = {}
-        verts = list(v)
-
-        def mid(a, b, cache=cache, verts=verts):
-            key = (min(a, b), max(a, b))
-            if key not in cache:
-                p = verts[a] + verts[b]
-                verts.append(p / np.linalg.norm(p))
-                cache[key] = len(verts) - 1
-            return cache[key]
-
-        new = []
-        for a, b, c in faces:
-            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
-            new += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
-        v, faces = np.array(verts), new
-    return v, [list(x) for x in faces]
 
 
 def main(argv=None) -> int:
@@ -69,7 +42,7 @@ def main(argv=None) -> int:
     )
     level = 0
     while True:
-        v, f = geodesic_sphere(level)
+        v, f = example_mesh(f"geodesic-sphere:level={level}")
         if len(f) > args.max_faces:
             break
         times = {s: [] for s in [*stages, "total"]}

@@ -245,6 +245,15 @@ def _icosphere(subdivisions: int) -> tuple[np.ndarray, list[np.ndarray]]:
     return np.array(pts), [np.array(t, dtype=np.int64) for t in tris]
 
 
+def _geodesic_sphere(level: float = 1):
+    """Icosahedron subdivided ``level`` times (4**level x 20 triangles) on the unit sphere."""
+    lv = float(level)
+    if lv != int(lv) or not 0 <= lv <= 6:
+        raise ParameterError(f"level must be a whole number in 0..6, got {level!r}", name="level")
+    v, f = _icosphere(int(lv))
+    return _scale_mean_edge(v, f), f
+
+
 def _blob():
     v, faces = _icosphere(2)
     bumps = [  # (direction, height, width): bumps out (>0) and dents in (<0)
@@ -382,6 +391,14 @@ EXAMPLES: dict[str, Example] = {
             "bumpy icosphere (320 triangles): convex, concave and saddle vertices",
             ("non-convex", "saddle", "closed", "triangles"),
             _blob,
+        ),
+        Example(
+            "geodesic-sphere",
+            "icosahedron subdivided on a sphere: 20 x 4^level triangles, mean edge 1, convex "
+            "(for scaling studies). Parameters: level (0..6, default 1)",
+            ("convex", "closed", "triangles"),
+            _geodesic_sphere,
+            ("level",),
         ),
         Example("open-box", "cube without its top face", ("convex", "open", "polygons"), _open_box),
         Example(
