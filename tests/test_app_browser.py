@@ -9,6 +9,7 @@ import io
 import shutil
 import socket
 import subprocess
+import time
 from pathlib import Path
 
 import numpy as np
@@ -56,16 +57,24 @@ def test_page_draws_the_design(tmp_path):
 
     app = run_app("icosahedron", host="127.0.0.1", port=_free_port())
     try:
+        # the first design is computed in the app's worker: wait for it before looking
+        end = time.monotonic() + 60
+        while app.session.design_id == 0 or "computing" in app.status:
+            assert time.monotonic() < end, "the app did not finish its first design"
+            time.sleep(0.1)
         ARTIFACTS.mkdir(exist_ok=True)
         shot = ARTIFACTS / "app-icosahedron.png"
-        _screenshot(app.url + "/", shot, tmp_path)
-        img = imread(io.BytesIO(shot.read_bytes()))[..., :3]
+        for _ in range(3):  # a loaded machine can take the shot before the first frame
+            _screenshot(app.url + "/", shot, tmp_path)
+            img = imread(io.BytesIO(shot.read_bytes()))[..., :3]
+            orange = (img[..., 0] > 0.8) & (img[..., 1] > 0.55) & (img[..., 2] < 0.5)
+            if orange.mean() > 0.002:
+                break
         # the canvas draws the model: many colours, and the patch colours are present
         colours = np.unique((img * 255).astype(np.uint8).reshape(-1, 3), axis=0)
         assert len(colours) > 200
         not_white = np.any(img < 0.95, axis=-1).mean()
         assert not_white > 0.1
-        orange = (img[..., 0] > 0.8) & (img[..., 1] > 0.55) & (img[..., 2] < 0.5)
         assert orange.mean() > 0.002  # the cones
     finally:
         app.stop()
