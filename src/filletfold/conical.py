@@ -97,10 +97,7 @@ def conical_material_loss(
     tm = np.where(rounded, tan_minus_angle(np.where(rounded, g, 1.0)), 1.0)
     d1 = np.where(rounded, w1 * np.tan(g) / (2 * tm), 0.0)
     he_edge = mesh.halfedge_edge
-    prev = np.empty(len(he_edge), dtype=np.int64)
-    for fi in range(mesh.n_faces):
-        s, e = mesh.face_start[fi], mesh.face_start[fi + 1]
-        prev[s:e] = np.roll(np.arange(s, e), 1)
+    prev = mesh.halfedge_prev
     alpha = mesh.corner_angles()
     sin, cos = np.sin(alpha), np.cos(alpha)
     L = mesh.edge_length

@@ -86,10 +86,7 @@ def _corner_rows(mesh: PolyMesh):
     alpha : (n_halfedges,) float
         Corner angle.
     """
-    prev = np.empty(len(mesh.halfedge_from), dtype=np.int64)
-    for fi in range(mesh.n_faces):
-        s, e = mesh.face_start[fi], mesh.face_start[fi + 1]
-        prev[s:e] = np.roll(np.arange(s, e), 1)
+    prev = mesh.halfedge_prev
     return np.arange(len(prev)), prev, mesh.corner_angles()
 
 

@@ -88,11 +88,7 @@ def _corner_table(mesh: PolyMesh):
         Face angle at the corner (radians).
     """
     he_edge = mesh.halfedge_edge
-    prev = np.empty_like(he_edge)
-    for fi in range(mesh.n_faces):
-        s, e = mesh.face_start[fi], mesh.face_start[fi + 1]
-        prev[s:e] = np.roll(np.arange(s, e), 1)
-    return he_edge, he_edge[prev], mesh.corner_angles()
+    return he_edge, he_edge[mesh.halfedge_prev], mesh.corner_angles()
 
 
 def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarray):

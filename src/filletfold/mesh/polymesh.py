@@ -118,6 +118,13 @@ class PolyMesh:
         self._he_key_sorted = key[order]
         self._he_order = order
 
+    @cached_property
+    def halfedge_prev(self) -> np.ndarray:
+        """(n_halfedges,) int: the half-edge before each one in its face (it ends at the tail)."""
+        prev = np.arange(len(self.halfedge_from)) - 1
+        prev[self.face_start[:-1]] = self.face_start[1:] - 1
+        return prev
+
     def halfedge(self, a: int, b: int) -> int:
         """Index of the half-edge ``a -> b``, or -1."""
         k = a * len(self.vertices) + b

@@ -233,28 +233,16 @@ def build_side(
     length = float(np.linalg.norm(d))
     R = d / length
     M = 0.5 * (mesh.vertices[u] + mesh.vertices[other])
+    common = {"edge": int(e), "R": R, "M": M, "length": length}
     if n_prev is None or n_next is None:
-        return Side(edge=int(e), rounded=False, R=R, M=M, length=length)
+        return Side(rounded=False, **common)
     r = float(rounding.radius[e])
     if r <= 0:  # flat edge between coplanar faces: a cylinder of radius 0
-        return Side(
-            edge=int(e),
-            rounded=True,
-            R=R,
-            M=M,
-            length=length,
-            O=M,
-            N0=n_prev,
-            B=np.cross(R, n_prev),
-        )
+        return Side(rounded=True, O=M, N0=n_prev, B=np.cross(R, n_prev), **common)
     B = n_next - (n_next @ n_prev) * n_prev
     B /= np.linalg.norm(B)
     return Side(
-        edge=int(e),
         rounded=True,
-        R=R,
-        M=M,
-        length=length,
         radius=r,
         gamma=float(rounding.half_angle[e]),
         arc=float(rounding.arc_length[e]),
@@ -262,6 +250,7 @@ def build_side(
         O=rounding.axis_point[e],
         N0=n_prev,
         B=B,
+        **common,
     )
 
 
