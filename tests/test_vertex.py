@@ -15,7 +15,8 @@ import filletfold
 from filletfold.mesh import load_mesh
 from filletfold.rounding import round_edges
 from filletfold.tolerances import tol
-from filletfold.vertex.apex import build_constraints, solve_apex, validate_apex
+from filletfold.vertex.apex import build_constraints, validate_apex
+from filletfold.vertex.batch import solve_apex
 from filletfold.vertex.frame import vertex_frame
 from filletfold.vertex.normal import max_min_direction, vertex_normal
 

@@ -26,7 +26,7 @@ from .rounding import EdgeRounding, clamp_radii, round_edges
 from .sheet import glue_pieces
 from .tabs import add_tabs_and_labels
 from .tolerances import tol
-from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_vertex_apex
+from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_apices
 
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
@@ -454,16 +454,8 @@ def round_mesh(
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    solved = []
-    for u, frame in enumerate(frames):
-        apex, v = (
-            solve_vertex_apex(frame, float(depths[u]), res, centres)
-            if res.status[u] == ""
-            else (None, None)
-        )
-        solved.append((frame, apex, v))
-        if progress is not None:
-            progress("apices", u + 1, pm.n_vertices)
+    apices = solve_apices(frames, depths, res, centres, progress)
+    solved = [(frame, *apices.get(u, (None, None))) for u, frame in enumerate(frames)]
     timings["apices"] = time.perf_counter() - t
 
     t = time.perf_counter()

@@ -13,7 +13,8 @@ import numpy as np
 from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
-from .apex import build_constraints, solve_apex, validate_apex
+from .apex import build_constraints, validate_apex
+from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frame
 from .normal import is_developable, solid_angle_front, vertex_normal
 
@@ -157,24 +158,70 @@ def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
     return None
 
 
-def solve_vertex_apex(
-    frame: VertexFrame, depth: float, res: VertexResult, centres: np.ndarray | None = None
-) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """Developed and spatial apex of a cone vertex (sec. 2.4, 3.2), validated densely.
+@dataclass
+class ApexProblem:
+    """The apex problem of one cone vertex and the state of its attempts.
 
-    Sets ``res.status`` to ``ok`` (with apex, depth used and margin) or ``infeasible`` (with
-    the constraints that fail) at the frame's vertex. ``centres`` ((n_faces, 3) float, the face
-    pieces' centres) adds the check that every straight crease stays short of the centre.
+    Attributes
+    ----------
+    frame : VertexFrame
+    closed : bool
+        True for a developable vertex: the developed apex is a variable too (sec. 3).
+    sigma : int
+        Side of the apex (+1 front, -1 back).
+    v : (2,) float
+        Developed apex (fixed point of rho), or its start for a closed development.
+    target : (3,) or (5,) float
+        ``P = U + d D`` (and ``v`` when closed).
+    starts : list of (3,) or (5,) float
+        Further starts for the feasibility phase, along ``D``.
+    margin : float
+        The safety margin ``m`` at scale 1.
+    low : float
+        The shortest ``l_max``: margins stay under a quarter of it.
+    shrink : (n_sides, 2) float
+        Factors on ``l_max`` (shortened creases after a face-centre crossing).
+    attempts : list of (int, float)
+        Remaining (samples per arc, margin scale) to try, in order.
+    failing : list of str
+        What failed at the last attempt.
+    """
 
-    Returns
-    -------
-    apex : (3,) float or None
-    dev_apex : (2,) float or None
-        Developed apex in the vertex's common 2D frame.
+    frame: VertexFrame
+    closed: bool
+    sigma: int
+    v: np.ndarray
+    target: np.ndarray
+    starts: list
+    margin: float
+    low: float
+    shrink: np.ndarray
+    attempts: list
+    failing: list
+
+    def constraints(self, n_samples: int, scale: float):
+        """The sampled constraints of the next attempt (:func:`build_constraints`)."""
+        m = min(self.margin * scale, 0.25 * self.low)
+        v = None if self.closed else self.v
+        return build_constraints(self.frame, v, self.sigma, n_samples, m, self.shrink)
+
+
+#: Attempts per vertex: (samples per arc, margin scale). After an infeasible attempt only
+#: :data:`THIN_ATTEMPT` follows (a tenth of the margin, for thin windows).
+ATTEMPTS = [(9, 1.0), (33, 2.0), (65, 4.0)]
+THIN_ATTEMPT = (129, 0.1)
+
+
+def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexProblem | None:
+    """Set up the apex problem of a cone vertex, or mark it infeasible and return None.
+
+    Records the requested depth and the developed apex in ``res``. A vertex gets no problem
+    (status ``infeasible`` with the reason) when it has no developed apex, a reflex face
+    corner, or a tangent-line crossing beyond an edge midpoint.
     """
     u = frame.vertex
     res.depth_requested[u] = depth
-    D, sigma = res.normal[u], int(res.sigma[u])
+    D = res.normal[u]
     closed = res.kind[u] == "developable"  # rho is the identity: v is a variable (sec. 3)
     v = central_rulings_crossing(frame) if closed else frame.developed_apex()
     if v is None:
@@ -184,7 +231,7 @@ def solve_vertex_apex(
             if closed
             else "the development does not turn (rho is a translation): no developed apex"
         )
-        return None, None
+        return None
     res.apex_developed[u] = v
     if np.any(frame.corner_angle > np.pi):
         res.status[u] = "infeasible"
@@ -192,7 +239,7 @@ def solve_vertex_apex(
             "a face has a reflex corner at this vertex: the straight crease on it "
             "would leave the face"
         )
-        return None, None
+        return None
     U = frame.U
     lengths = np.array([s.length for s in frame.sides])
     target = U + depth * D
@@ -200,47 +247,128 @@ def solve_vertex_apex(
     if closed:
         target = np.concatenate([target, v])
         starts = [np.concatenate([x, v]) for x in starts]
-    margin = tol.margin * lengths.min()
-    low = np.fmin(frame.lmax_start, frame.lmax_end).min()
+    low = float(np.fmin(frame.lmax_start, frame.lmax_end).min())
     if not low > 0:
         res.status[u] = "infeasible"
         res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
-        return None, None
-    failing = []
-    shrink = np.ones((len(frame.sides), 2))
-    attempts = [(9, 1.0), (33, 2.0), (65, 4.0)]
-    while attempts:
-        n_samples, scale = attempts.pop(0)
-        m = min(margin * scale, 0.25 * low)
-        cons = build_constraints(frame, None if closed else v, sigma, n_samples, m, shrink)
-        sol = solve_apex(cons, target, starts)
-        if not sol.ok:
-            failing = sol.failing
-            if scale < 1.0:
-                break
-            attempts = [(129, 0.1)]  # infeasible with the margin: try a tenth of it
-            continue
-        v_sol = sol.developed if closed else v
-        check = validate_apex(frame, sol.apex, v_sol, sigma, centres=centres)
-        if check.ok:
-            res.status[u] = "ok"
-            res.apex[u] = sol.apex
-            res.apex_developed[u] = v_sol
-            res.depth[u] = float((sol.apex - U) @ D)
-            res.margin[u] = check.margin
-            return sol.apex, v_sol
-        failing = check.failing
-        crossing = [f for f in failing if "face piece's centre" in f]
-        if crossing and len(crossing) == len(failing) and shrink.min() > 0.2:
-            # the straight creases run past the face centres: ask for shorter ones and retry
-            faces = {int(f.rsplit(" ", 1)[1]) for f in crossing}
-            for i, f in enumerate(frame.ring.faces):
-                if int(f) in faces:
-                    shrink[i, 1] *= 0.7
-                    shrink[(i + 1) % len(frame.sides), 0] *= 0.7
-            attempts.insert(0, (n_samples, scale))
-    res.status[u] = "infeasible"
-    res.reason[u] = "no apex meets every constraint: " + "; ".join(failing[:6])
-    if len(failing) > 6:
-        res.reason[u] += f"; and {len(failing) - 6} more"
-    return None, None
+        return None
+    problem = ApexProblem(
+        frame=frame,
+        closed=closed,
+        sigma=int(res.sigma[u]),
+        v=np.asarray(v, dtype=float),
+        target=target,
+        starts=starts,
+        margin=tol.margin * lengths.min(),
+        low=low,
+        shrink=np.ones((len(frame.sides), 2)),
+        attempts=list(ATTEMPTS),
+        failing=[],
+    )
+    return problem
+
+
+def solve_apices(
+    frames: list[VertexFrame],
+    depths: np.ndarray,
+    res: VertexResult,
+    centres: np.ndarray | None = None,
+    progress=None,
+    vertices=None,
+) -> dict:
+    """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
+
+    All vertices still without a status are solved together, one attempt per round, by
+    :func:`~filletfold.vertex.batch.solve_apex_batch`; a vertex whose attempt fails the
+    dense validation :func:`validate_apex` goes to its next attempt in the next round (more
+    samples and margin, shorter creases when a straight crease passes a face piece's centre,
+    a tenth of the margin when the sampled problem is infeasible). Sets ``res.status`` to
+    ``ok`` (with apex, depth used and margin) or ``infeasible`` (with the constraints that
+    fail).
+
+    Parameters
+    ----------
+    frames : sequence or mapping of VertexFrame
+        Indexed by mesh vertex.
+    depths : (n,) float or mapping
+        Requested depth, indexed by mesh vertex.
+    res : VertexResult
+    centres : (n_faces, 3) float, optional
+        Face pieces' centres: adds the check that every straight crease stays short of them.
+    progress : callable, optional
+        ``progress("apices", done, total)`` after every round.
+    vertices : iterable of int, optional
+        The vertices to solve (default: every vertex whose status is still empty).
+
+    Returns
+    -------
+    dict
+        Per solved vertex: (apex, dev_apex), the (3,) float spatial apex and the (2,) float
+        developed apex in the vertex's common frame, or (None, None) when infeasible.
+    """
+    if vertices is None:
+        vertices = [u for u in range(len(res.status)) if res.status[u] == ""]
+    out, pending = {}, {}
+    for u in vertices:
+        out[u] = (None, None)
+        problem = apex_problem(frames[u], float(depths[u]), res)
+        if problem is not None:
+            pending[u] = problem
+    total = len(pending)
+    while pending:
+        order = list(pending)
+        tries = [pending[u].attempts.pop(0) for u in order]
+        cons = [pending[u].constraints(*t) for u, t in zip(order, tries, strict=True)]
+        sols = solve_apex_batch(
+            cons, [pending[u].target for u in order], [pending[u].starts for u in order]
+        )
+        for u, attempt, sol in zip(order, tries, sols, strict=True):
+            p = pending[u]
+            if not sol.ok:
+                p.failing = sol.failing
+                p.attempts = [] if attempt[1] < 1.0 else [THIN_ATTEMPT]
+            else:
+                v_sol = sol.developed if p.closed else p.v
+                check = validate_apex(p.frame, sol.apex, v_sol, p.sigma, centres=centres)
+                if check.ok:
+                    res.status[u] = "ok"
+                    res.apex[u] = sol.apex
+                    res.apex_developed[u] = v_sol
+                    res.depth[u] = float((sol.apex - p.frame.U) @ res.normal[u])
+                    res.margin[u] = check.margin
+                    out[u] = (sol.apex, v_sol)
+                    del pending[u]
+                    continue
+                p.failing = check.failing
+                _shorten_creases(p, attempt)
+            if not p.attempts:
+                res.status[u] = "infeasible"
+                res.reason[u] = "no apex meets every constraint: " + "; ".join(p.failing[:6])
+                if len(p.failing) > 6:
+                    res.reason[u] += f"; and {len(p.failing) - 6} more"
+                del pending[u]
+        if progress is not None:
+            progress("apices", total - len(pending), total)
+    return out
+
+
+def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
+    """After a failed validation: when only face-centre crossings fail, retry ``attempt``
+    with shorter creases on those faces."""
+    crossing = [f for f in p.failing if "face piece's centre" in f]
+    if crossing and len(crossing) == len(p.failing) and p.shrink.min() > 0.2:
+        faces = {int(f.rsplit(" ", 1)[1]) for f in crossing}
+        n_sides = len(p.frame.sides)
+        for i, f in enumerate(p.frame.ring.faces):
+            if int(f) in faces:
+                p.shrink[i, 1] *= 0.7
+                p.shrink[(i + 1) % n_sides, 0] *= 0.7
+        p.attempts.insert(0, attempt)
+
+
+def solve_vertex_apex(
+    frame: VertexFrame, depth: float, res: VertexResult, centres: np.ndarray | None = None
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """One vertex through :func:`solve_apices` (the frame's vertex; same parameters)."""
+    u = frame.vertex
+    return solve_apices({u: frame}, {u: depth}, res, centres, vertices=[u])[u]

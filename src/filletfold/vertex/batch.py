@@ -1,0 +1,398 @@
+"""Batched apex solver: a primal-dual interior-point method over many vertices at once.
+
+Every apex problem of sec. 3.2 (see :mod:`filletfold.vertex.apex`) has the same shape: a few
+variables ``x`` (the spatial apex ``V``, and the developed apex ``v`` of a closed
+development), the objective ``|x - P|^2`` and constraint rows that are all of the form ::
+
+    g_j(x) = a_j + A_j . x + alpha_j (|v|^2 - |V|^2) >= 0
+
+(linear rows have ``alpha_j = 0``; the crease-length rows of eq. (1) are quadratic with an
+identity Hessian up to sign because the charts are rigid). The solver stacks the problems of
+many vertices into padded arrays and runs one primal-dual interior-point iteration for all of
+them in lockstep (numpy, no Python loop over vertices):
+
+* **phase 1** (only for targets that violate a row and starts that do too): maximise ``t``
+  subject to ``g_j(x) >= t`` and ``t <= t_cap``, from the best start, until ``t > 0``; the
+  reverse-convex rows (``l <= l_max``) can stall it, so the remaining starts are tried next;
+* **phase 2**: from the strictly feasible point, the closest point to ``P``, to a duality
+  measure of ``1e-13`` (relative to the squared length scale).
+
+The Newton matrix is ``diag(q - 2 (sum_j lambda_j alpha_j) e) + sum_j (lambda_j / g_j)
+grad g_j grad g_j^T`` with the diagonal part clamped to be positive (the only indefinite part
+of this problem's Hessian is diagonal). Steps keep ``g > 0`` and ``lambda > 0`` and decrease the
+barrier merit function.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .apex import ApexConstraints, ApexSolution
+
+#: Vertices per chunk (keeps the padded arrays small and in cache).
+CHUNK = 2048
+#: Phase 1 stops once the smallest slack exceeds half of this (in units of the scale).
+T_CAP = 1e-3
+#: Starts tried at once in phase 1 before the remaining ones.
+PARALLEL_STARTS = 3
+
+
+@dataclass
+class RowBlock:
+    """Padded constraint rows of a batch, in the dimensionless variables ``y = (x - P) / L``.
+
+    Attributes
+    ----------
+    a : (B, R) float
+        Row values at ``y = 0``, over ``L``.
+    A : (B, R, n) float
+        Row gradients at ``y = 0``.
+    alpha : (B, R) float
+        Quadratic coefficient, times ``L``.
+    e : (n,) float
+        Signs of the quadratic form: -1 on ``V``, +1 on ``v``, 0 on a phase-1 slack.
+    mask : (B, R) bool
+        Real rows (padding rows are ``g = 1`` and ignored).
+    """
+
+    a: np.ndarray
+    A: np.ndarray
+    alpha: np.ndarray
+    e: np.ndarray
+    mask: np.ndarray
+
+    def values(self, y: np.ndarray) -> np.ndarray:
+        """(B, R) row values at ``y`` ((B, n) float)."""
+        quad = (y * self.e * y).sum(axis=1)
+        return self.a + _matvec(self.A, y) + self.alpha * quad[:, None]
+
+    def take(self, idx: np.ndarray) -> RowBlock:
+        return RowBlock(self.a[idx], self.A[idx], self.alpha[idx], self.e, self.mask[idx])
+
+
+def rows_of(cons: ApexConstraints, target: np.ndarray):
+    """The rows of one problem about ``target`` in the dimensionless form of :class:`RowBlock`.
+
+    Returns
+    -------
+    a : (R,) float
+    A : (R, n) float
+    alpha : (R,) float
+    """
+    L = cons.scale
+    a = cons.values(target) / L
+    A = cons.jacobian(target)
+    alpha = np.zeros(len(a))
+    alpha[: len(cons.quad_sign)] = cons.quad_sign / cons.scale * L
+    return a, A, alpha
+
+
+def pack(rows: Sequence[tuple], n: int) -> RowBlock:
+    """Stack per-problem rows (from :func:`rows_of`) into one padded :class:`RowBlock`."""
+    B = len(rows)
+    R = max(len(r[0]) for r in rows)
+    a = np.ones((B, R))
+    A = np.zeros((B, R, n))
+    alpha = np.zeros((B, R))
+    mask = np.zeros((B, R), dtype=bool)
+    for b, (a_, A_, al_) in enumerate(rows):
+        k = len(a_)
+        a[b, :k], A[b, :k, : A_.shape[1]], alpha[b, :k], mask[b, :k] = a_, A_, al_, True
+    e = np.array([-1.0, -1.0, -1.0, 1.0, 1.0][:n])
+    return RowBlock(a, A, alpha, e, mask)
+
+
+def interior_point(
+    rows: RowBlock,
+    q: np.ndarray,
+    c: np.ndarray,
+    y: np.ndarray,
+    *,
+    stop_slack: int | None = None,
+    groups: np.ndarray | None = None,
+    max_iter: int = 80,
+    tol: float = 1e-13,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Minimise ``0.5 y.q.y + c.y`` subject to ``rows(y) > 0`` from strictly feasible ``y``.
+
+    Parameters
+    ----------
+    rows : RowBlock
+    q : (n,) float
+        Diagonal of the objective's Hessian.
+    c : (B, n) float
+        Linear term of the objective.
+    y : (B, n) float
+        Strictly feasible starting points.
+    stop_slack : int, optional
+        Index of a variable (phase 1's ``t``): a problem is done once it exceeds
+        ``T_CAP / 2`` or is positive and at least the duality gap (within a factor 2 of the
+        largest), or once ``t`` plus the duality gap is negative (infeasible, for the convex
+        part of the problem).
+    groups : (B,) int, optional
+        With ``stop_slack``: problems with the same group are copies from different starts;
+        all are done when one reaches ``T_CAP / 2``.
+    max_iter : int
+    tol : float
+        Mean complementarity ``lambda g`` at which a problem is done (and stationarity
+        ``1e-2 sqrt(tol)``).
+
+    Returns
+    -------
+    y : (B, n) float
+        Final points (strictly feasible).
+    converged : (B,) bool
+    """
+    y = y.copy()
+    B, _, n = rows.A.shape
+    e = rows.e
+    diag_idx = np.arange(n)
+    converged = np.zeros(B, dtype=bool)
+    live = np.arange(B)
+    a, A, al, mf, cl = rows.a, rows.A, rows.alpha, rows.mask.astype(float), c
+    outer = (A[:, :, :, None] * A[:, :, None, :]).reshape(B, -1, n * n)
+    count = mf.sum(axis=1)
+    yl = y
+    g = a + _matvec(A, yl) + al * (yl * e * yl).sum(axis=1)[:, None]
+    lam = mf * np.maximum(1e-2, np.abs(yl * q + cl).max(axis=1))[:, None] / g
+    stuck = np.zeros(B, dtype=bool)
+    for _ in range(max_iter):
+        ey = e * yl
+        lam_al = (lam * al).sum(axis=1)
+        stat = yl * q + cl - _vecmat(lam, A) - 2 * lam_al[:, None] * ey
+        comp = (lam * g).sum(axis=1)
+        mu = 0.1 * comp / count
+        done = (np.abs(stat).max(axis=1) <= 1e-2 * tol**0.5) & (comp / count <= tol)
+        if stop_slack is not None:
+            t = yl[:, stop_slack]
+            reached = (t >= 0.5 * T_CAP) | ((t > 0) & (comp <= t))
+            if groups is not None and reached.any():
+                reached = np.isin(groups[live], groups[live[reached]])
+            done |= reached | (t + comp < -1e-9)
+        new = done & ~converged[live]
+        y[live[new]], converged[live[new]] = yl[new], True
+        done |= stuck  # no step possible: keep the point (not converged)
+        if done.all():
+            rest = ~converged[live]
+            y[live[rest]] = yl[rest]
+            return y, converged
+        if done.sum() * 4 >= len(live):  # drop finished problems once a quarter is done
+            k = ~done
+            gone = done & ~converged[live]
+            y[live[gone]] = yl[gone]
+            live, a, A, al, mf, cl, outer, count, yl, g, lam, stuck = (
+                live[k], a[k], A[k], al[k], mf[k], cl[k], outer[k], count[k], yl[k], g[k],
+                lam[k], stuck[k],
+            )  # fmt: skip
+            ey, lam_al, mu = ey[k], lam_al[k], mu[k]
+        # Newton matrix: sum_j w_j grad g_j grad g_j^T (grad g_j = A_j + 2 alpha_j e*y) + diag
+        w = lam / g
+        wa = w * al
+        u = _vecmat(wa, A)
+        H = _vecmat(w, outer).reshape(-1, n, n)
+        H += 2 * (u[:, :, None] * ey[:, None, :] + ey[:, :, None] * u[:, None, :])
+        H += 4 * (wa * al).sum(axis=1)[:, None, None] * ey[:, :, None] * ey[:, None, :]
+        H[:, diag_idx, diag_idx] += np.maximum(q - 2 * lam_al[:, None] * e, 1e-8)
+        v = mu[:, None] / g
+        rhs = -(yl * q + cl) + _vecmat(v, A) + 2 * (v * al).sum(axis=1)[:, None] * ey
+        bad = ~(np.isfinite(H).all(axis=(1, 2)) & np.isfinite(rhs).all(axis=1))
+        if bad.any():  # cannot happen with g > 0; never let one problem stop the batch
+            H[bad], rhs[bad] = np.eye(n), 0.0
+        dy = _solve_small(H, rhs)
+        Ad = _matvec(A, dy)
+        p = (ey * dy).sum(axis=1)
+        qq = (dy * e * dy).sum(axis=1)
+        dlam = mf * (mu[:, None] - lam * g - lam * (Ad + 2 * al * p[:, None])) / g
+        # fraction to the boundary for lambda, then backtracking on g > 0 and the merit
+        ratio = np.where(dlam < 0, lam / np.where(dlam < 0, -dlam, 1.0), np.inf)
+        step = np.minimum(1.0, 0.995 * ratio.min(axis=1))
+        merit0 = 0.5 * (yl * q * yl).sum(axis=1) + (cl * yl).sum(axis=1)
+        merit0 -= mu * np.log(g).sum(axis=1)
+        slope = np.minimum(-(rhs * dy).sum(axis=1), 0.0)
+        todo = np.arange(len(yl))
+        for _ in range(40):
+            s_ = step[todo]
+            gt = g[todo] + s_[:, None] * Ad[todo]
+            gt += al[todo] * (2 * s_ * p[todo] + s_ * s_ * qq[todo])[:, None]
+            ok = np.all(gt > 0.005 * g[todo], axis=1)
+            yt = yl[todo] + s_[:, None] * dy[todo]
+            mt = 0.5 * (yt * q * yt).sum(axis=1) + (cl[todo] * yt).sum(axis=1)
+            mt -= mu[todo] * np.log(np.where(ok[:, None], gt, 1.0)).sum(axis=1)
+            bound = merit0[todo] + 1e-4 * s_ * slope[todo]
+            ok &= mt <= bound + 1e-13 * np.maximum(1.0, np.abs(merit0[todo]))
+            todo = todo[~ok]
+            if len(todo) == 0:
+                break
+            step[todo] *= 0.5
+        step[todo] = 0.0
+        y_new = yl + step[:, None] * dy
+        g_new = a + _matvec(A, y_new) + al * (y_new * e * y_new).sum(axis=1)[:, None]
+        # rounding can put a row a hair from its boundary onto it: no step then
+        step[np.any(g_new <= 0, axis=1)] = 0.0
+        stuck = step == 0
+        yl = np.where(stuck[:, None], yl, y_new)
+        g = np.where(stuck[:, None], g, g_new)
+        lam = np.maximum(lam + step[:, None] * dlam, 1e-30 * mf)
+    rest = ~converged[live]
+    y[live[rest]] = yl[rest]
+    return y, converged
+
+
+def _solve_small(H: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """(B, n) solutions of ``H x = r``; least squares for the (rare) singular ``H``."""
+    try:
+        return np.linalg.solve(H, r[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.stack([np.linalg.lstsq(h, b, rcond=None)[0] for h, b in zip(H, r, strict=True)])
+
+
+def _matvec(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """(B, R) products of (B, R, n) matrices with (B, n) vectors."""
+    return np.matmul(A, x[:, :, None])[:, :, 0]
+
+
+def _vecmat(x: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """(B, k) products of (B, R) row vectors with (B, R, k) matrices."""
+    return np.matmul(x[:, None, :], A)[:, 0, :]
+
+
+def _phase1(rows: RowBlock, y0: np.ndarray, groups: np.ndarray, max_iter: int) -> np.ndarray:
+    """(B, n) points of larger smallest slack, maximised from ``y0`` (see :func:`interior_point`
+    for ``groups``)."""
+    B, R, n = rows.A.shape
+    g0 = np.where(rows.mask, rows.values(y0), np.inf).min(axis=1)
+    t0 = g0 - np.maximum(0.1, 0.1 * np.abs(g0))
+    # rows g - t >= 0, plus the cap T_CAP - t >= 0
+    a = np.concatenate([rows.a, np.full((B, 1), T_CAP)], axis=1)
+    A = np.zeros((B, R + 1, n + 1))
+    A[:, :R, :n] = rows.A
+    A[:, :R, n] = np.where(rows.mask, -1.0, 0.0)
+    A[:, R, n] = -1.0
+    alpha = np.concatenate([rows.alpha, np.zeros((B, 1))], axis=1)
+    mask = np.concatenate([rows.mask, np.ones((B, 1), dtype=bool)], axis=1)
+    ext = RowBlock(a, A, alpha, np.append(rows.e, 0.0), mask)
+    q = np.append(np.full(n, 1e-6), 0.0)
+    c = np.concatenate([-1e-6 * y0, -np.ones((B, 1))], axis=1)
+    z, _ = interior_point(
+        ext, q, c, np.concatenate([y0, t0[:, None]], axis=1), stop_slack=n, groups=groups,
+        max_iter=max_iter,
+    )  # fmt: skip
+    return z[:, :n]
+
+
+def solve_apex_batch(
+    problems: Sequence[ApexConstraints],
+    targets: Sequence[np.ndarray],
+    starts: Sequence[Sequence[np.ndarray]] | None = None,
+    *,
+    max_iter: int = 80,
+) -> list[ApexSolution]:
+    """Project every target onto its problem's feasible set, all problems at once.
+
+    Parameters
+    ----------
+    problems : sequence of ApexConstraints
+        One per vertex; 3 variables (open development) and 5 (closed) may be mixed.
+    targets : sequence of (3,) or (5,) float
+        ``P = U + d D`` (followed by the developed apex's target for 5 variables).
+    starts : sequence of sequences of (3,) or (5,) float, optional
+        Further starting points per problem for the feasibility phase.
+    max_iter : int
+        Interior-point iterations per phase.
+
+    Returns
+    -------
+    list of ApexSolution
+        In the order of ``problems``; ``ok`` is False when no start reached a feasible point,
+        and ``failing`` then names the violated constraints at the best point found.
+    """
+    out: list[ApexSolution | None] = [None] * len(problems)
+    for n in (3, 5):
+        idx = [i for i, p in enumerate(problems) if p.n_vars == n]
+        for k in range(0, len(idx), CHUNK):
+            chunk = idx[k : k + CHUNK]
+            sols = _solve_chunk(
+                [problems[i] for i in chunk],
+                [np.asarray(targets[i], dtype=float) for i in chunk],
+                [list(starts[i]) if starts is not None else [] for i in chunk],
+                n,
+                max_iter,
+            )
+            for i, s in zip(chunk, sols, strict=True):
+                out[i] = s
+    return out
+
+
+def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSolution:
+    """One problem through :func:`solve_apex_batch` (same parameters, one of each)."""
+    return solve_apex_batch([cons], [target], [list(starts) if starts is not None else []])[0]
+
+
+def _solve_chunk(problems, targets, starts, n, max_iter) -> list[ApexSolution]:
+    B = len(problems)
+    rows = pack([rows_of(p, t) for p, t in zip(problems, targets, strict=True)], n)
+    L = np.array([p.scale for p in problems])
+    T = np.stack(targets)
+    g_target = np.where(rows.mask, rows.a, np.inf).min(axis=1)
+    at_target = g_target >= 0
+    # candidate starts in y coordinates, the target (y = 0) first
+    n_s = 1 + max((len(s) for s in starts), default=0)
+    cand = np.zeros((B, n_s, n))
+    valid = np.zeros((B, n_s), dtype=bool)
+    valid[:, 0] = True
+    for b, s in enumerate(starts):
+        for j, x in enumerate(s):
+            cand[b, j + 1] = (np.asarray(x, dtype=float) - T[b]) / L[b]
+            valid[b, j + 1] = True
+    gmin = np.full((B, n_s), -np.inf)
+    for j in range(n_s):
+        gj = np.where(rows.mask, rows.values(cand[:, j]), np.inf).min(axis=1)
+        gmin[:, j] = np.where(valid[:, j], gj, -np.inf)
+    order = np.argsort(-gmin, axis=1)
+    ar = np.arange(B)
+    y0 = np.zeros((B, n))
+    best = cand[ar, order[:, 0]]
+    best_g = gmin[ar, order[:, 0]]
+    need = ~at_target
+    # a start that is already strictly feasible skips phase 1
+    feasible = need & (best_g > 0)
+    y0[feasible] = best[feasible]
+    # phase 1 from the best starts first (several at once), then from the others
+    for lo, hi in ((0, PARALLEL_STARTS), (PARALLEL_STARTS, n_s)):
+        todo_b, todo_j = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]
+        for j in range(lo, min(hi, n_s)):
+            b = np.nonzero(need & ~feasible & valid[ar, order[:, j]])[0]
+            todo_b.append(b)
+            todo_j.append(order[b, j])
+        todo_b, todo_j = np.concatenate(todo_b), np.concatenate(todo_j)
+        if len(todo_b) == 0:
+            continue
+        y = _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter)
+        g_y = np.where(rows.mask[todo_b], rows.take(todo_b).values(y), np.inf).min(axis=1)
+        for k in np.argsort(g_y):  # the best point per problem wins
+            b = todo_b[k]
+            if g_y[k] > best_g[b]:
+                best[b], best_g[b] = y[k], g_y[k]
+        feasible |= need & (best_g > 0)
+        y0[feasible] = best[feasible]
+    solve = np.nonzero(need & feasible)[0]
+    y = np.zeros((B, n))
+    if len(solve):
+        y[solve], _ = interior_point(
+            rows.take(solve), np.full(n, 2.0), np.zeros((len(solve), n)), y0[solve],
+            max_iter=max_iter,
+        )  # fmt: skip
+    result = []
+    for b, p in enumerate(problems):
+        if at_target[b]:
+            result.append(ApexSolution(True, T[b].copy(), [], True))
+        elif feasible[b]:
+            result.append(ApexSolution(True, T[b] + L[b] * y[b], [], False))
+        else:
+            x = T[b] + L[b] * best[b]
+            vals = p.values(x)
+            result.append(ApexSolution(False, x, p.describe(np.nonzero(vals < 0)[0]), False))
+    return result
