@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import io
+import itertools
 import json
 import socket
+import threading
 import time
 import urllib.request
 import zipfile
@@ -15,7 +17,12 @@ from numpy.testing import assert_allclose
 
 from filletfold.app import session as session_mod
 from filletfold.app.session import AppSession, nearest_vertex_to_ray
-from filletfold.app.view import scene_arrays, triangulate_polygon
+from filletfold.app.view import (
+    SCENE_WIDTH,
+    scene_arrays,
+    triangulate_faces,
+    triangulate_polygon,
+)
 from filletfold.cli import main
 from filletfold.errors import MeshReadError, ParameterError
 
@@ -175,19 +182,96 @@ def test_triangulation_covers_the_polygon(poly):
     assert_allclose(sum(areas), _area(p), rtol=1e-12)
 
 
+def test_triangulate_faces_covers_every_face():
+    polys = [
+        [[0, 0], [1, 0], [0, 1]],
+        [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],  # not convex
+        [[0, 0], [1, 0], [1, 1], [0, 1]],
+        [[0, 0], [3, 0], [3, 3], [2, 1], [1, 1], [0, 3]],  # not convex
+        [[0, 0], [2, 0], [3, 1], [1, 2], [-1, 1]],
+        [[5, 5], [6, 5], [6, 6], [5, 6]],
+    ]
+    points = np.vstack([np.array(q, dtype=float) for q in polys])
+    starts = np.cumsum([0] + [len(q) for q in polys])
+    faces = [np.arange(a, b) for a, b in itertools.pairwise(starts)]
+    tris, owner = triangulate_faces(points, faces)
+    assert len(tris) == sum(len(f) - 2 for f in faces) and np.all(np.diff(owner) >= 0)
+    for i, f in enumerate(faces):
+        mine = tris[owner == i]
+        assert np.isin(mine, f).all()
+        areas = [_area(points[t]) for t in mine]
+        assert min(areas) > 0
+        assert_allclose(sum(areas), _area(points[f]), rtol=1e-12)
+
+
 def test_scene_arrays_match_the_pattern(cube_session):
     design = cube_session.design
     arrays = scene_arrays(design)
     n_tri = sum(len(f) - 2 for f in design.pattern.faces)
     assert sum(len(t) for _, t in arrays.folded.values()) == n_tri
     assert set(arrays.folded) == {"cone", "cylinder", "face"}
+    model_right = max(v[:, 0].max() for v, _ in arrays.folded.values())
     for kind, (v, t) in arrays.flat.items():
         assert t.max() < len(v)
         assert_allclose(v[:, 2], v[0, 2], atol=0)  # the pattern lies flat
-        assert v[:, 0].min() > design.pattern.vertices_3d[:, 0].max()  # beside the model
+        assert v[:, 0].min() > model_right  # beside the model
         assert len(arrays.folded[kind][0]) == len(v)
     assert arrays.folded_creases["M"].shape[1:] == (2, 3)
     assert arrays.vertex_points.shape == (8, 3) and arrays.vertex_colors.shape == (8, 3)
+
+
+@pytest.mark.parametrize("name", ["cube", "icosahedron", "miura"])
+def test_scene_frames_model_and_pattern_in_one_box(name):
+    """Every design is drawn in the same box around the origin (one camera frames all), the
+    folded form and the pattern similar to the design's (pattern at most at true scale)."""
+    s = AppSession()
+    design = s.load(name)
+    arrays = scene_arrays(design)
+    points = np.vstack([v for v, _ in [*arrays.folded.values(), *arrays.flat.values()]])
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    assert_allclose((hi - lo).max(), SCENE_WIDTH, rtol=1e-12)
+    assert_allclose(0.5 * (lo + hi), 0, atol=1e-12)
+    assert 0 < arrays.pattern_scale <= 1
+    v3, v2 = design.pattern.vertices_3d, design.pattern.vertices_2d
+    assert_allclose(arrays.vertex_points, arrays.to_scene(design.mesh.vertices))
+    edges = design.pattern.edges
+    e3 = np.linalg.norm(np.diff(v3[edges], axis=1), axis=-1)
+    e2 = np.linalg.norm(np.diff(v2[edges], axis=1), axis=-1)
+    drawn3 = np.linalg.norm(np.diff(arrays.to_scene(v3)[edges], axis=1), axis=-1)
+    flat = arrays.flat_creases
+    drawn2 = np.linalg.norm(np.diff(np.vstack(list(flat.values())), axis=1), axis=-1)
+    assign = np.asarray(design.pattern.edge_assignment)
+    order = np.concatenate([np.flatnonzero(assign == a) for a in flat])
+    assert_allclose(drawn3, arrays.scale * e3, rtol=1e-9, atol=1e-12)
+    assert_allclose(drawn2, arrays.scale * arrays.pattern_scale * e2[order], rtol=1e-9, atol=1e-12)
+
+
+def test_recompute_and_load_report_progress():
+    s = AppSession()
+    calls = []
+    s.load("cube", progress=lambda *a: calls.append(a))
+    assert {"apices", "surface"} <= {stage for stage, _, _ in calls}
+    assert all(0 < done <= total == 8 for _, done, total in calls)
+    calls.clear()
+    s.set_params(radius="5%")
+    s.recompute(progress=lambda *a: calls.append(a))
+    assert calls[-1] == ("surface", 8, 8)
+
+
+def test_an_exception_from_progress_stops_the_computation_and_keeps_the_design():
+    s = AppSession()
+    design = s.load("cube")
+
+    class Stop(Exception):
+        pass
+
+    def stop(stage, done, total):
+        raise Stop
+
+    s.set_params(radius="5%")
+    with pytest.raises(Stop):
+        s.recompute(progress=stop)
+    assert s.design is design
 
 
 def test_cli_app_with_unknown_mesh_exits_2(capsys):
@@ -246,3 +330,59 @@ def test_server_answers_and_stops():
         app.stop()
     with pytest.raises(OSError):
         urllib.request.urlopen(app.url + "/", timeout=2)
+
+
+def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(monkeypatch):
+    """While the worker computes, the page shows the stage and a progress bar, the server
+    answers and takes GUI changes, and a newer change stops the older computation."""
+    pytest.importorskip("viser")
+    from filletfold.app import run_app
+
+    real = session_mod.round_mesh
+    armed, reached, release = threading.Event(), threading.Event(), threading.Event()
+    finished, first_call = [], []
+
+    def gated_round_mesh(mesh, progress=None, **kw):
+        def hook(stage, done, total):
+            if progress is not None:
+                progress(stage, done, total)  # the app's callback: updates the page
+            if armed.is_set() and not release.is_set():  # hold the first report
+                first_call.append((stage, done, total))
+                reached.set()
+                release.wait(30)
+
+        design = real(mesh, progress=hook, **kw)
+        finished.append(kw["radius"])
+        return design
+
+    monkeypatch.setattr(session_mod, "round_mesh", gated_round_mesh)
+    app = run_app("cube", host="127.0.0.1", port=_free_port())
+    try:
+        assert app.wait_drawn(1)
+        assert app.progress is None and not app._progress_bar.visible
+        armed.set()
+        app._radius.value = 15.0  # what the slider's on_update does, from the server side
+        assert reached.wait(30), "the worker did not start computing"
+        # mid-computation: the stage and the bar are shown
+        ((stage, done, total),) = first_call
+        assert app.progress == (stage, done, total) and total == 8
+        assert app.status == f"computing… {stage} {done}/{total}"
+        assert app._progress_bar.visible
+        assert app._progress_bar.value == pytest.approx(100 * done / total)
+        # ...and the page is not frozen: the server answers and takes a newer change at once
+        with urllib.request.urlopen(app.url + "/", timeout=5) as r:
+            assert r.status == 200
+        t = time.perf_counter()
+        app._radius.value = 20.0
+        assert time.perf_counter() - t < 1.0
+        assert app.session.params["radius"] == "20.0%"
+        release.set()
+        assert _wait_for(lambda: app.session.design.params.radius == "20.0%", 30)
+        assert app.wait_drawn(app.session.design_id)
+        assert "15.0%" not in finished  # the superseded computation was stopped
+        assert _wait_for(lambda: app.progress is None and not app._progress_bar.visible)
+        assert app.status.startswith("**cube**")
+        assert set(app.timings) == {"compute", "draw"}
+    finally:
+        release.set()
+        app.stop()

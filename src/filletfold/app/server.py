@@ -6,7 +6,9 @@ example list, an upload button, sliders for radius, depth and samples, the mater
 switch, a vertex inspector with its own depth, and the download button.
 
 Every change is handed to one worker thread; changes that arrive while it computes are merged
-into the next computation, and a result older than the one shown is dropped.
+into the next computation, a computation that a newer change makes useless is stopped at its
+next progress report, and a result older than the one shown is dropped. While the worker
+computes, the panel shows the stage and a progress bar.
 """
 
 from __future__ import annotations
@@ -15,18 +17,32 @@ import contextlib
 import io
 import logging
 import threading
+import time
 import webbrowser
 
 from ..design import DEFAULT_SAMPLES
 from ..errors import FilletfoldError
 from ..mesh import example_names
 from .session import AppSession, nearest_vertex_to_ray
-from .view import CREASE_RGB, PATCH_RGB, legend_markdown, scene_arrays
+from .view import (
+    CAMERA_LOOK_AT,
+    CAMERA_POSITION,
+    CREASE_RGB,
+    PATCH_RGB,
+    legend_markdown,
+    scene_arrays,
+)
 
 log = logging.getLogger(__name__)
 
 DEFAULT_RADIUS_PERCENT = 10.0
 DEFAULT_DEPTH_PERCENT = 30.0
+#: Shortest time between two progress updates sent to the page, in seconds.
+PROGRESS_INTERVAL = 0.1
+
+
+class _Superseded(Exception):
+    """Raised from the progress callback to stop a computation a newer change replaces."""
 
 
 def _import_viser():
@@ -47,6 +63,14 @@ class AppServer:
     port : int
     url : str
         ``http://HOST:PORT``.
+    status : str
+        The status line shown in the page (Markdown).
+    progress : tuple or None
+        ``(stage, done, total)`` of the computation in progress, None when idle.
+    drawn_id : int
+        Design id (:attr:`AppSession.design_id`) of the scene last drawn.
+    timings : dict
+        Seconds of the last computation (``compute``) and drawing (``draw``).
     """
 
     def __init__(self, server, session: AppSession, host: str):
@@ -60,8 +84,15 @@ class AppServer:
         self._dirty = False
         self._upload = None
         self._stopping = False
+        self._busy = False
         self._stopped = threading.Event()
         self._selected = 0
+        self._phase = ""
+        self._last_progress = 0.0
+        self.progress = None
+        self.drawn_id = 0
+        self._drawn = threading.Condition()
+        self.timings: dict[str, float] = {}
         self._build_gui()
         self._worker = threading.Thread(target=self._work, name="filletfold-app", daemon=True)
         self._worker.start()
@@ -104,30 +135,94 @@ class AppServer:
             self._wake.notify_all()
         self._set_status(f"loading {source}…")
 
+    def wait_drawn(self, design_id: int, timeout: float = 30.0) -> bool:
+        """Wait until the scene shows design ``design_id`` or a newer one.
+
+        Returns
+        -------
+        bool
+            False on timeout.
+        """
+        with self._drawn:
+            return self._drawn.wait_for(lambda: self.drawn_id >= design_id, timeout)
+
+    def wait_idle(self, timeout: float = 30.0) -> bool:
+        """Wait until the worker has nothing to do (every change computed and drawn, or failed).
+
+        Returns
+        -------
+        bool
+            False on timeout.
+        """
+        with self._wake:
+            return self._wake.wait_for(
+                lambda: not (self._busy or self._dirty or self._upload), timeout
+            )
+
     def _work(self) -> None:
         while True:
             with self._wake:
+                self._busy = False
+                self._wake.notify_all()
                 while not (self._dirty or self._upload or self._stopping):
                     self._wake.wait()
                 if self._stopping:
                     return
                 upload, self._upload = self._upload, None
                 dirty, self._dirty = self._dirty, False
+                self._busy = True
+            t = time.perf_counter()
             try:
                 if upload is not None:
-                    self.session.load(upload[0], upload[1])
+                    self._phase = "load"
+                    self.session.load(upload[0], upload[1], progress=self._report_progress)
                     self._after_load()
-                    if dirty:
-                        self.session.recompute()
-                elif dirty:
-                    self.session.recompute()
+                if dirty:
+                    self._phase = "recompute"
+                    self.session.recompute(progress=self._report_progress)
+                self._phase = ""
+                self.timings["compute"] = time.perf_counter() - t
                 self._draw()
+            except _Superseded:
+                # the newer change is waiting: the next turn computes and draws it
+                log.debug("app: computation superseded by a newer change")
             except FilletfoldError as exc:
                 self._set_status(f"**error:** {exc}")
                 log.info("app: %s", exc)
             except Exception as exc:  # keep the app alive; show what happened
                 log.exception("app: unexpected error")
                 self._set_status(f"**unexpected error:** {type(exc).__name__}: {exc}")
+            finally:
+                self._phase = ""
+                self._end_progress()
+
+    def _report_progress(self, stage: str, done: int, total: int) -> None:
+        """``round_mesh``'s progress callback (worker thread): show the stage in the page, at
+        most every :data:`PROGRESS_INTERVAL` seconds; stop when a newer change replaces this
+        computation."""
+        with self._wake:
+            superseded = (
+                self._stopping
+                or self._upload is not None
+                or (self._dirty and self._phase == "recompute")
+            )
+        if superseded:
+            raise _Superseded
+        first = self.progress is None or self.progress[0] != stage
+        self.progress = (stage, done, total)
+        now = time.monotonic()
+        if not first and done < total and now - self._last_progress < PROGRESS_INTERVAL:
+            return
+        self._last_progress = now
+        percent = 100.0 * done / total if total else 100.0
+        self._progress_bar.value = min(max(percent, 0.0), 100.0)
+        self._progress_bar.visible = True
+        self._set_status(f"computing… {stage} {done}/{total}")
+
+    def _end_progress(self) -> None:
+        self.progress = None
+        self._progress_bar.visible = False
+        self._progress_bar.value = 0.0
 
     # -- GUI ------------------------------------------------------------------------------
     def _set_status(self, text: str) -> None:
@@ -139,6 +234,7 @@ class AppServer:
     def _build_gui(self) -> None:
         gui = self.server.gui
         self._status_md = gui.add_markdown("starting…")
+        self._progress_bar = gui.add_progress_bar(0.0, visible=False, animated=True)
         with gui.add_folder("Mesh"):
             names = list(example_names())
             name = self.session.name
@@ -248,7 +344,8 @@ class AppServer:
         self._vertex_depth.value = percent
 
     def _draw(self) -> None:
-        design = self.session.design
+        t = time.perf_counter()
+        design, design_id = self.session.design, self.session.design_id
         if design is None:
             return
         arrays = scene_arrays(design)
@@ -304,14 +401,51 @@ class AppServer:
             node.on_click(clicked)
 
         counts = ", ".join(f"{n} {s}" for s, n in design.status_counts().items() if n)
+        shown = f", pattern drawn at {arrays.pattern_scale:.0%}" if arrays.pattern_scale < 1 else ""
         self._set_status(
             f"**{design.source}**: {len(design.mesh.vertices)} vertices ({counts}), "
-            f"{len(design.pattern.faces)} pattern faces"
+            f"{len(design.pattern.faces)} pattern faces{shown}  \n{params_text(design.params)}"
         )
         n = len(design.mesh.vertices)
         self._vertex.max = max(n - 1, 0)
         if self._selected < n:
             self._select(self._selected)
+        self.timings["draw"] = time.perf_counter() - t
+        with self._drawn:
+            self.drawn_id = max(self.drawn_id, design_id)
+            self._drawn.notify_all()
+
+
+def params_text(params) -> str:
+    """The parameters a design was computed with, as the status line shows them.
+
+    Parameters
+    ----------
+    params : filletfold.design.Parameters
+
+    Returns
+    -------
+    str
+        E.g. ``radius 10.0%, depth 30.0% (own depth at 2 vertices), samples 24``.
+    """
+
+    def length(x) -> str:
+        if isinstance(x, str):
+            return x
+        try:
+            return f"{float(x):.4g}"
+        except (TypeError, ValueError):
+            return "per element"
+
+    depth = params.depth
+    own = ""
+    if isinstance(depth, dict):
+        n = sum(1 for k in depth if k != "default")
+        where = f"{n} vertex" if n == 1 else f"{n} vertices"
+        depth, own = depth.get("default"), f" (own depth at {where})" if n else ""
+    radius = ("max " if params.material_loss else "") + length(params.radius)
+    text = f"radius {radius}, depth {length(depth)}{own}, samples {params.samples}"
+    return text + (", material loss" if params.material_loss else "")
 
 
 @contextlib.contextmanager
@@ -376,6 +510,10 @@ def run_app(
     with _quiet_stdout():  # viser prints its own banner; the URL is logged and returned
         server = viser.ViserServer(host=host, port=port, label="filletfold", verbose=False)
     try:
+        # every design is drawn scaled to the same box, so one initial camera frames them all;
+        # set before any page connects (moving a connected page's camera can blank its canvas)
+        server.initial_camera.position = CAMERA_POSITION
+        server.initial_camera.look_at = CAMERA_LOOK_AT
         app = AppServer(server, session, host)
         app._draw()
     except BaseException:

@@ -183,9 +183,18 @@ class AppSession:
             return Request(self._next_id, mesh, self.name if name is None else name, params)
 
     @staticmethod
-    def compute(request: Request) -> Design:
-        """The design of a request (slow; no session state is touched)."""
-        design = round_mesh(request.mesh, **request.params)
+    def compute(request: Request, progress=None) -> Design:
+        """The design of a request (slow; no session state is touched).
+
+        Parameters
+        ----------
+        request : Request
+        progress : callable, optional
+            ``progress(stage, done, total)``, passed on to
+            :func:`~filletfold.design.round_mesh` (called during its long stages, in the
+            computing thread). An exception it raises stops the computation and propagates.
+        """
+        design = round_mesh(request.mesh, **request.params, progress=progress)
         design.source = request.name
         return design
 
@@ -212,7 +221,7 @@ class AppSession:
         return self._next_id
 
     # -- state changes --------------------------------------------------------------------
-    def load(self, source, content: bytes | None = None) -> Design:
+    def load(self, source, content: bytes | None = None, *, progress=None) -> Design:
         """Load a mesh and compute its design; on any error keep the current one.
 
         Parameters
@@ -221,6 +230,9 @@ class AppSession:
             A built-in example name, a file path, or (with ``content``) the uploaded file name.
         content : bytes, optional
             The uploaded file's bytes.
+        progress : callable, optional
+            ``progress(stage, done, total)`` during the design's long stages (see
+            :meth:`compute`).
 
         Returns
         -------
@@ -254,7 +266,7 @@ class AppSession:
                 request = self.begin(mesh=mesh, name=name)
             finally:
                 self.vertex_depth = saved
-        design = self.compute(request)
+        design = self.compute(request, progress)
         with self._lock:
             if self.commit(request, design):
                 self.vertex_depth = {}
@@ -293,8 +305,14 @@ class AppSession:
             else:
                 self.vertex_depth[int(u)] = depth
 
-    def recompute(self) -> Design:
+    def recompute(self, *, progress=None) -> Design:
         """Recompute the design of the current state.
+
+        Parameters
+        ----------
+        progress : callable, optional
+            ``progress(stage, done, total)`` during the design's long stages (see
+            :meth:`compute`).
 
         Returns
         -------
@@ -307,7 +325,7 @@ class AppSession:
             When the design fails; the current design stays.
         """
         request = self.begin()
-        design = self.compute(request)
+        design = self.compute(request, progress)
         self.commit(request, design)
         return self.design
 

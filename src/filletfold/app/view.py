@@ -92,6 +92,49 @@ def triangulate_polygon(poly_2d: np.ndarray) -> np.ndarray:
     return np.array(out, dtype=np.int64)
 
 
+def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of many simple counter-clockwise polygons at once.
+
+    Faces of one corner count are handled together: convex ones become fans in one array
+    operation, the others go through :func:`triangulate_polygon`.
+
+    Parameters
+    ----------
+    points_2d : (n, 2) float
+    faces : sequence of (k,) int
+        Corner indices into ``points_2d``.
+
+    Returns
+    -------
+    triangles : (t, 3) int
+        Indices into ``points_2d``.
+    face : (t,) int
+        The face each triangle came from.
+    """
+    p = np.asarray(points_2d, dtype=float)
+    sizes = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+    tris, owner = [np.zeros((0, 3), np.int64)], [np.zeros(0, np.int64)]
+    for k in np.unique(sizes):
+        which = np.flatnonzero(sizes == k)
+        f = np.array([faces[i] for i in which], dtype=np.int64).reshape(len(which), k)
+        if k < 3:
+            continue
+        q = p[f]
+        turn = _cross(q - np.roll(q, 1, axis=1), np.roll(q, -1, axis=1) - q)
+        scale = np.maximum(np.ptp(q, axis=1).max(axis=1) ** 2, 1e-300)
+        convex = np.all(turn >= -1e-12 * scale[:, None], axis=1)
+        fan = np.array([[0, i, i + 1] for i in range(1, k - 1)], dtype=np.int64)
+        tris.append(f[convex][:, fan].reshape(-1, 3))
+        owner.append(np.repeat(which[convex], k - 2))
+        for row, i in zip(f[~convex], which[~convex], strict=True):
+            t = row[triangulate_polygon(p[row])]
+            tris.append(t)
+            owner.append(np.full(len(t), i))
+    triangles, face = np.vstack(tris), np.concatenate(owner)
+    order = np.argsort(face, kind="stable")
+    return triangles[order], face[order]
+
+
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """z-component of the cross product of 2D vectors (broadcasting)."""
     return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
@@ -108,9 +151,28 @@ def _inside(q: np.ndarray, tri: np.ndarray) -> np.ndarray:
     return (s1 >= 0) & (s2 >= 0) & (s3 >= 0) & ~corner
 
 
+#: Width of the drawn scene (model, gap and pattern) in scene units: every design is scaled to
+#: it and centred at the origin, so one fixed camera (:data:`CAMERA_POSITION`) frames them all.
+SCENE_WIDTH = 4.0
+#: Largest side of the drawn crease pattern, in multiples of the folded model's size (a
+#: larger pattern, e.g. many modules side by side, is drawn smaller than true scale).
+PATTERN_MAX_SIZE = 2.0
+#: Gap between the model and the pattern, in multiples of the model's size.
+PATTERN_GAP = 0.15
+#: The initial camera (scene units, z up): in front of the scene (-y) and above it, looking
+#: a little to the right of its centre so the scene clears the GUI panel on the right.
+CAMERA_POSITION = (1.0, -2.9, 2.9)
+#: Where the initial camera looks.
+CAMERA_LOOK_AT = (1.0, 0.0, -0.4)
+
+
 @dataclass
 class SceneArrays:
-    """Everything the 3D view shows of a design.
+    """Everything the 3D view shows of a design, in scene coordinates.
+
+    Scene coordinates are the design's, scaled by ``scale`` about ``centre`` and moved to the
+    origin (:data:`SCENE_WIDTH` wide); the crease pattern is also scaled by
+    ``pattern_scale`` (1 = true size beside the model).
 
     Attributes
     ----------
@@ -125,6 +187,12 @@ class SceneArrays:
     vertex_colors : (n_vertices, 3) uint8
     point_size : float
         Marker size in scene units.
+    scale : float
+        Scene units per design unit.
+    centre : (3,) float
+        The design point drawn at the origin.
+    pattern_scale : float
+        Drawn size of the pattern relative to the model (at most 1).
     """
 
     folded: dict = field(default_factory=dict)
@@ -134,34 +202,51 @@ class SceneArrays:
     vertex_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     vertex_colors: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.uint8))
     point_size: float = 0.05
+    scale: float = 1.0
+    centre: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    pattern_scale: float = 1.0
+
+    def to_scene(self, points) -> np.ndarray:
+        """Design coordinates (..., 3) to scene coordinates."""
+        return (np.asarray(points, dtype=float) - self.centre) * self.scale
 
 
 def scene_arrays(design: Design) -> SceneArrays:
-    """Triangles, crease segments and vertex markers of a design.
+    """Triangles, crease segments and vertex markers of a design, in scene coordinates.
 
-    The crease pattern is placed in the plane through the lowest folded point, to the right
-    (+x) of the folded form with a gap of a tenth of the form's size, centred in y.
+    The crease pattern lies in the plane through the lowest folded point, to the right (+x)
+    of the folded form with a gap of :data:`PATTERN_GAP` times the form's size, centred in y,
+    drawn at most :data:`PATTERN_MAX_SIZE` times the form's size. Model and pattern together
+    are scaled to :data:`SCENE_WIDTH` and centred at the origin.
     """
     pattern = design.pattern
     v2, v3 = pattern.vertices_2d, pattern.vertices_3d
     lo, hi = v3.min(axis=0), v3.max(axis=0)
     size = float(np.max(hi - lo)) or 1.0
     p_lo, p_hi = v2.min(axis=0), v2.max(axis=0)
+    p_size = float(np.max(p_hi - p_lo)) or 1.0
+    shrink = min(1.0, PATTERN_MAX_SIZE * size / p_size)
+    flat2 = (v2 - p_lo) * shrink  # from (0, 0)
     shift = np.array(
-        [hi[0] + 0.1 * size - p_lo[0], 0.5 * (lo[1] + hi[1]) - 0.5 * (p_lo[1] + p_hi[1])]
+        [hi[0] + PATTERN_GAP * size, 0.5 * (lo[1] + hi[1]) - 0.5 * shrink * (p_hi[1] - p_lo[1])]
     )
-    flat3 = np.column_stack([v2 + shift, np.full(len(v2), lo[2])])
+    flat3 = np.column_stack([flat2 + shift, np.full(len(v2), lo[2])])
+    all_lo = np.minimum(lo, flat3.min(axis=0))
+    all_hi = np.maximum(hi, flat3.max(axis=0))
+    out = SceneArrays(
+        scale=SCENE_WIDTH / (float(np.max(all_hi - all_lo)) or 1.0),
+        centre=0.5 * (all_lo + all_hi),
+        pattern_scale=shrink,
+    )
+    v3, flat3 = out.to_scene(v3), out.to_scene(flat3)
 
-    tris: dict[str, list] = {k: [] for k in PATCH_RGB}
-    for face, patch in zip(pattern.faces, pattern.face_patch, strict=True):
-        face = np.asarray(face, dtype=np.int64)
-        kind = patch.split()[0]
-        tris.setdefault(kind, []).append(face[triangulate_polygon(v2[face])])
-    out = SceneArrays()
-    for kind, parts in tris.items():
-        if not parts:
+    triangles, owner = triangulate_faces(v2, pattern.faces)
+    kinds = np.array([patch.split()[0] for patch in pattern.face_patch])
+    tri_kind = kinds[owner] if len(owner) else np.zeros(0, dtype=kinds.dtype)
+    for kind in [*PATCH_RGB, *sorted(set(kinds) - set(PATCH_RGB))]:
+        t = triangles[tri_kind == kind]
+        if not len(t):
             continue
-        t = np.vstack(parts)
         used, inverse = np.unique(t, return_inverse=True)
         local = inverse.reshape(t.shape)
         out.folded[kind] = (v3[used], local)
@@ -173,12 +258,13 @@ def scene_arrays(design: Design) -> SceneArrays:
             out.folded_creases[a] = v3[e]
         out.flat_creases[a] = flat3[e]
     mesh = design.mesh
-    out.vertex_points = np.asarray(mesh.vertices, dtype=float)
+    out.vertex_points = out.to_scene(mesh.vertices)
     out.vertex_colors = np.array(
         [STATUS_RGB.get(s, (0, 0, 0)) for s in design.vertices.status], dtype=np.uint8
     ).reshape(-1, 3)
     lengths = np.linalg.norm(
         mesh.vertices[mesh.edges[:, 1]] - mesh.vertices[mesh.edges[:, 0]], axis=1
     )
-    out.point_size = 0.08 * float(lengths.mean()) if len(lengths) else 0.05 * size
+    marker = 0.08 * float(lengths.mean()) if len(lengths) else 0.05 * size
+    out.point_size = marker * out.scale
     return out
