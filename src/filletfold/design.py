@@ -7,6 +7,7 @@ lay them out, and derive the crease pattern.
 
 from __future__ import annotations
 
+import copy
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,7 +27,7 @@ from .rounding import EdgeRounding, clamp_radii, round_edges
 from .sheet import glue_pieces
 from .tabs import add_tabs_and_labels
 from .tolerances import tol
-from .vertex.solve import STATUSES, VertexResult, classify_vertex, solve_apices
+from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
 
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
@@ -127,6 +128,66 @@ class Parameters:
 
 
 @dataclass
+class Stages:
+    """What one design computed before its layout, for ``round_mesh(..., reuse=design)``.
+
+    A later call on the same mesh with the same rounding parameters takes over the rounding,
+    frames and vertex normals; vertices whose depth did not change keep their apex, and their
+    modules are kept when ``samples`` did not change either. Only the changed vertices are
+    re-solved and rebuilt; the layout stage always runs.
+
+    Attributes
+    ----------
+    key : tuple
+        The mesh and the rounding parameters (radius, clamp, material loss, max loss,
+        coplanar tolerance) the stages belong to.
+    loss : MaterialLoss or None
+    conical : bool
+        Whether the radii came from the conical-mesh offset (cone axes as normals).
+    rounding : EdgeRounding
+    centres : (n_faces, 3) float
+    frames : list of VertexFrame
+    classified : VertexResult
+        Classification and normals, before any apex.
+    depths : (n_vertices,) float
+    vertices : VertexResult
+        The final per-vertex results.
+    solved : list of (VertexFrame, apex or None, developed apex or None)
+    samples : int
+    modules : list of list of Piece
+        Each vertex's module pieces, before the layout.
+    """
+
+    key: tuple
+    loss: MaterialLoss | None
+    conical: bool
+    rounding: EdgeRounding
+    centres: np.ndarray
+    frames: list
+    classified: VertexResult
+    depths: np.ndarray
+    vertices: VertexResult
+    solved: list
+    samples: int
+    modules: list
+
+
+def _stage_key(pm: PolyMesh, *params) -> tuple:
+    """Hashable identity of a mesh and parameters (arrays compared by their bytes)."""
+
+    def plain(x):
+        if isinstance(x, dict):
+            return tuple(sorted((str(k), plain(v)) for k, v in x.items()))
+        if isinstance(x, np.ndarray | list | tuple):
+            a = np.asarray(x, dtype=float)
+            return (a.shape, a.tobytes())
+        return repr(x)
+
+    faces = tuple(tuple(int(i) for i in f) for f in pm.faces)
+    return (pm.vertices.tobytes(), faces, *(plain(p) for p in params))
+
+
+@dataclass
 class Design:
     """A curved-crease design: the cleaned mesh, its rounding, vertex results and pattern.
 
@@ -151,6 +212,8 @@ class Design:
     fabrication : dict
         Counts of cut borders, glue tabs placed, tabs at a reduced height, and cut borders
         left without a tab.
+    stages : Stages or None
+        Intermediate results a later ``round_mesh(..., reuse=design)`` takes over.
     """
 
     mesh: PolyMesh
@@ -165,6 +228,7 @@ class Design:
     layout: str = "modules"
     layout_note: str = ""
     fabrication: dict = field(default_factory=dict)
+    stages: Stages | None = field(default=None, repr=False, compare=False)
 
     @property
     def vertex_status(self) -> list:
@@ -314,6 +378,41 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
             res.apex_2d[u] = pattern.vertices_2d[k]
 
 
+def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg):
+    """Radii (given, clamped, or from the material-loss programme) and the edge rounding.
+
+    Returns
+    -------
+    loss : MaterialLoss or None
+    rounding : EdgeRounding
+    conical : bool
+        True when the radii came from a conical mesh's face offset.
+    """
+    ref = pm.mean_edge_length
+    loss, conical = None, False
+    if material_loss:
+        cap = None if max_loss is None else float(parse_length(max_loss, ref, "max loss"))
+        developable = np.all(
+            np.abs(pm.vertex_angle_sum[~pm.is_boundary_vertex] - 2 * np.pi) < tol.developable
+        )
+        conical = not developable and is_conical(pm)
+        r_cap = parse_length(radius, ref, "radius", count=pm.n_edges)
+        if conical:
+            loss, _ = conical_material_loss(
+                pm, max_loss=cap, max_radius=r_cap, flat_deg=coplanar_deg
+            )
+        else:
+            loss = solve_material_loss(pm, max_loss=cap, max_radius=r_cap, flat_deg=coplanar_deg)
+        if not loss.ok:
+            raise SolverError(loss.message)
+        r = loss.edge_radius
+    else:
+        r = parse_length(radius, ref, "radius", count=pm.n_edges)
+        if clamp:
+            r = clamp_radii(pm, r, flat_deg=coplanar_deg)
+    return loss, round_edges(pm, r, flat_deg=coplanar_deg), conical
+
+
 def round_mesh(
     mesh,
     radius=DEFAULT_RADIUS,
@@ -330,6 +429,7 @@ def round_mesh(
     tabs: bool = True,
     coplanar_deg: float = tol.coplanar_deg,
     progress=None,
+    reuse: Design | None = None,
 ) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
@@ -375,6 +475,10 @@ def round_mesh(
         Merge neighbouring faces whose normals differ by less than this (degrees).
     progress : callable, optional
         ``progress(stage, done, total)`` called during long stages.
+    reuse : Design, optional
+        An earlier design of the same mesh: when the rounding parameters are the same, its
+        rounding, frames and normals are taken over and only the vertices whose depth changed
+        are re-solved and rebuilt (see :class:`Stages`); the result is the same as without.
 
     Returns
     -------
@@ -419,51 +523,71 @@ def round_mesh(
     )
     ref = pm.mean_edge_length
 
-    t = time.perf_counter()
-    loss, conical = None, False
-    if material_loss:
-        cap = None if max_loss is None else float(parse_length(max_loss, ref, "max loss"))
-        developable = np.all(
-            np.abs(pm.vertex_angle_sum[~pm.is_boundary_vertex] - 2 * np.pi) < tol.developable
-        )
-        conical = not developable and is_conical(pm)
-        r_cap = parse_length(radius, ref, "radius", count=pm.n_edges)
-        if conical:
-            loss, _ = conical_material_loss(
-                pm, max_loss=cap, max_radius=r_cap, flat_deg=coplanar_deg
-            )
-        else:
-            loss = solve_material_loss(pm, max_loss=cap, max_radius=r_cap, flat_deg=coplanar_deg)
-        if not loss.ok:
-            raise SolverError(loss.message)
-        r = loss.edge_radius
-    else:
-        r = parse_length(radius, ref, "radius", count=pm.n_edges)
-        if clamp:
-            r = clamp_radii(pm, r, flat_deg=coplanar_deg)
-    rounding = round_edges(pm, r, flat_deg=coplanar_deg)
-    timings["rounding"] = time.perf_counter() - t
-    depths = _resolve_depth(depth, ref, pm.n_vertices)
-    centres = face_piece_centres(pm, rounding)
+    key = _stage_key(pm, radius, clamp, material_loss, max_loss, coplanar_deg)
+    st = reuse.stages if reuse is not None and reuse.stages is not None else None
+    if st is not None and st.key != key:
+        st = None
 
     t = time.perf_counter()
-    res = VertexResult.empty(pm.n_vertices)
-    frames = [classify_vertex(pm, rounding, u, res) for u in range(pm.n_vertices)]
-    if material_loss and conical:
-        use_cone_axes(pm, frames, res)
+    if st is not None:
+        loss, rounding, centres, conical = st.loss, st.rounding, st.centres, st.conical
+    else:
+        loss, rounding, conical = _round(pm, radius, clamp, material_loss, max_loss, coplanar_deg)
+        centres = face_piece_centres(pm, rounding)
+    timings["rounding"] = time.perf_counter() - t
+    depths = _resolve_depth(depth, ref, pm.n_vertices)
+
+    t = time.perf_counter()
+    if st is not None:
+        frames = st.frames
+        res = copy.deepcopy(st.classified)
+    else:
+        res = VertexResult.empty(pm.n_vertices)
+        frames = classify_vertices(pm, rounding, res)
+        if conical:
+            use_cone_axes(pm, frames, res)
+    classified = copy.deepcopy(res)
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    apices = solve_apices(frames, depths, res, centres, progress)
-    solved = [(frame, *apices.get(u, (None, None))) for u, frame in enumerate(frames)]
+    pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
+    kept = set()
+    if st is not None:
+        kept = {u for u in range(pm.n_vertices) if st.depths[u] == depths[u]}
+        res.take(st.vertices, sorted(kept))
+        pending = [u for u in pending if u not in kept]
+    apices = solve_apices(frames, depths, res, centres, progress, vertices=pending)
+    solved = [
+        st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
+        for u, frame in enumerate(frames)
+    ]
     timings["apices"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    pieces = []
+    same_samples = st is not None and st.samples == int(samples)
+    modules = []
     for u, (frame, apex, v) in enumerate(solved):
-        pieces.extend(build_module(pm, frame, centres, int(samples), apex, v))
+        if same_samples and u in kept:
+            modules.append(st.modules[u])
+        else:
+            modules.append(build_module(pm, frame, centres, int(samples), apex, v))
         if progress is not None:
             progress("surface", u + 1, pm.n_vertices)
+    stages = Stages(
+        key=key,
+        loss=loss,
+        conical=conical,
+        rounding=rounding,
+        centres=centres,
+        frames=frames,
+        classified=classified,
+        depths=depths,
+        vertices=res,
+        solved=solved,
+        samples=int(samples),
+        modules=modules,
+    )
+    pieces = [piece for module in modules for piece in module]
     layout_used, layout_note = "modules", ""
     eps = 1e-9 * ref
     if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
@@ -547,4 +671,5 @@ def round_mesh(
         layout=layout_used,
         layout_note=layout_note,
         fabrication=fab,
+        stages=stages,
     )

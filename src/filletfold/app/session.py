@@ -53,12 +53,16 @@ class Request:
     params : dict
         Keyword arguments of :func:`~filletfold.design.round_mesh` (``depth`` already merged
         with the per-vertex overrides).
+    reuse : Design or None
+        The current design when the request was made: what it shares with the request (same
+        mesh and rounding) is taken over, so a per-vertex depth re-solves only that vertex.
     """
 
     id: int
     mesh: PolyMesh
     name: str
     params: dict = field(default_factory=dict)
+    reuse: Design | None = None
 
 
 def _plain(x):
@@ -180,7 +184,9 @@ class AppSession:
             params = dict(self.params)
             if self.vertex_depth:
                 params["depth"] = {"default": params["depth"], **self.vertex_depth}
-            return Request(self._next_id, mesh, self.name if name is None else name, params)
+            return Request(
+                self._next_id, mesh, self.name if name is None else name, params, self.design
+            )
 
     @staticmethod
     def compute(request: Request, progress=None) -> Design:
@@ -194,7 +200,7 @@ class AppSession:
             :func:`~filletfold.design.round_mesh` (called during its long stages, in the
             computing thread). An exception it raises stops the computation and propagates.
         """
-        design = round_mesh(request.mesh, **request.params, progress=progress)
+        design = round_mesh(request.mesh, **request.params, progress=progress, reuse=request.reuse)
         design.source = request.name
         return design
 

@@ -144,85 +144,75 @@ def build_constraints(
         Factors on ``l_max`` at the start and end of each side (default 1): shorter creases
         keep the straight crease on a face away from the face piece's centre.
     """
-    scale = float(np.mean([s.length for s in frame.sides]))
+    sa = frame.arrays
+    k = len(sa.arc)
+    scale = float(sa.length.mean())
     if lmax_scale is None:
-        lmax_scale = np.ones((len(frame.sides), 2))
-    quad = {k: [] for k in ("c", "R", "M", "Q", "t", "s", "coef", "sign", "const")}
-    kind, elem = [], []
-    la, lb, lkind, lelem = [], [], [], []
-
-    def add(C, side, Q, t, s, coef, sign, const, k, e):
-        n = len(s)
-        quad["c"].append(C)
-        quad["R"].append(np.repeat(side.R[None], n, 0))
-        quad["M"].append(np.repeat(side.M[None], n, 0))
-        quad["Q"].append(np.repeat(Q[None], n, 0))
-        quad["t"].append(np.repeat(t[None], n, 0))
-        quad["s"].append(s)
-        quad["coef"].append(np.full(n, coef))
-        quad["sign"].append(np.full(n, sign))
-        quad["const"].append(np.full(n, const))
-        kind.extend([k] * n)
-        elem.extend([e] * n)
-
-    for i, side in enumerate(frame.sides):
-        e = f"edge {side.edge}"
-        inv = invert(frame.cyl_map[i])
-        Q, t = inv[:2, :2], inv[:2, 2]
-        k_s = n_samples if side.arc > 0 else 1
-        s = np.linspace(0.0, side.arc, k_s)
-        C = side.base(s)
-        N = side.normal(s)
-        # l >= m at every sample:  num - 2 m Dn >= 0
-        add(C, side, Q, t, s, 2 * margin, 1.0, 0.0, "l_min", e)
-        # l <= l_max - m at both ends:  2 Dn (l_max - m) - num >= 0
-        for idx, lmax in (
-            (0, frame.lmax_start[i] * lmax_scale[i, 0]),
-            (-1, frame.lmax_end[i] * lmax_scale[i, 1]),
-        ):
-            add(C[[idx]], side, Q, t, s[[idx]], -2 * (lmax - margin), -1.0, 0.0, "l_max", e)
-        # valid patch: Dn - m >= 0
-        add(C[[0]], side, Q, t, s[[0]], -scale, 0.0, -margin, "patch", e)
-        # non-intersection along the arc
-        la.append(sigma * N)
-        lb.append(-sigma * np.einsum("ij,ij->i", N, C) - margin)
-        lkind += ["nonint"] * k_s
-        lelem += [e] * k_s
-        if side.arc == 0:
-            continue
-        # chord plane through C(0), C(a), T_0
-        ne = np.cross(C[-1] - C[0], side.R)
-        ne /= np.linalg.norm(ne)
-        la.append(sigma * ne[None])
-        lb.append(np.array([-sigma * ne @ frame.T_start[i] - margin]))
-        lkind.append("chord")
-        lelem.append(e)
-    for i, f in enumerate(frame.ring.faces):
-        n = np.cross(frame.face_frames[i][1], frame.face_frames[i][2])
-        la.append(sigma * n[None])
-        lb.append(np.array([-sigma * n @ frame.T_end[i] - margin]))
-        lkind.append("face")
-        lelem.append(f"face {int(f)}")
-    cat = {
-        k: (np.vstack(v_) if k in ("c", "R", "M", "t") else np.concatenate(v_))
-        for k, v_ in quad.items()
-    }
+        lmax_scale = np.ones((k, 2))
+    lmax = np.stack([frame.lmax_start, frame.lmax_end], axis=1) * lmax_scale
+    ks = np.where(sa.arc > 0, n_samples, 1)
+    side = np.repeat(np.arange(k), ks)
+    first = np.concatenate([[0], np.cumsum(ks)[:-1]])
+    j = np.arange(len(side)) - first[side]
+    s = sa.arc[side] * j / np.maximum(ks[side] - 1, 1)
+    C = sa.base(side, s)
+    N = sa.normal(side, s)
+    last = first + ks - 1
+    ends = np.arange(k)
+    # quadratic rows: l >= m at every sample, l <= l_max - m at both ends, Dn >= m
+    q_side = np.concatenate([side, ends, ends, ends])
+    q_sample = np.concatenate([np.arange(len(side)), first, last, first])
+    coef = np.concatenate(
+        [np.full(len(side), 2 * margin), -2 * (lmax[:, 0] - margin), -2 * (lmax[:, 1] - margin),
+         np.full(k, -scale)]
+    )  # fmt: skip
+    sign = np.concatenate([np.ones(len(side)), -np.ones(2 * k), np.zeros(k)])
+    const = np.concatenate([np.zeros(len(side) + 2 * k), np.full(k, -margin)])
+    # linear rows: non-intersection along the arc, the chord plane, every face
+    chord = np.nonzero(sa.arc > 0)[0]
+    ne = np.cross(C[last[chord]] - C[first[chord]], sa.R[chord])
+    ne /= np.linalg.norm(ne, axis=1)[:, None]
+    n_f = sa.face_normal
+    lin_a = sigma * np.concatenate([N, ne, n_f])
+    lin_b = (
+        -np.concatenate(
+            [
+                np.einsum("ij,ij->i", lin_a[: len(side)], C),
+                np.einsum(
+                    "ij,ij->i", lin_a[len(side) : len(side) + len(chord)], frame.T_start[chord]
+                ),
+                np.einsum("ij,ij->i", lin_a[len(side) + len(chord) :], frame.T_end[: len(n_f)]),
+            ]
+        )
+        - margin
+    )
+    edge_name = [f"edge {e}" for e in sa.edge]
+    kind = (
+        ["l_min"] * len(side) + ["l_max"] * (2 * k) + ["patch"] * k
+        + ["nonint"] * len(side) + ["chord"] * len(chord) + ["face"] * len(n_f)
+    )  # fmt: skip
+    element = (
+        [edge_name[i] for i in q_side]
+        + [edge_name[i] for i in side]
+        + [edge_name[i] for i in chord]
+        + [f"face {int(f)}" for f in frame.ring.faces]
+    )
     return ApexConstraints(
         scale=scale,
         v_fixed=None if v is None else np.asarray(v, dtype=float),
-        quad_c=cat["c"],
-        quad_R=cat["R"],
-        quad_M=cat["M"],
-        quad_Q=cat["Q"],
-        quad_t=cat["t"],
-        quad_s=cat["s"],
-        quad_coef=cat["coef"],
-        quad_sign=cat["sign"],
-        quad_const=cat["const"],
-        lin_a=np.vstack(la),
-        lin_b=np.concatenate(lb),
-        kind=kind + lkind,
-        element=elem + lelem,
+        quad_c=C[q_sample],
+        quad_R=sa.R[q_side],
+        quad_M=sa.M[q_side],
+        quad_Q=sa.Q[q_side],
+        quad_t=sa.t[q_side],
+        quad_s=s[q_sample],
+        quad_coef=coef,
+        quad_sign=sign,
+        quad_const=const,
+        lin_a=lin_a,
+        lin_b=lin_b,
+        kind=kind,
+        element=element,
     )
 
 
@@ -240,12 +230,16 @@ class ApexSolution:
         Constraints that cannot be met (when not ok).
     at_target : bool
         True when the target itself was feasible.
+    solver : str
+        What found it: ``"target"``, ``"ipm"`` (the batched interior-point method),
+        ``"ipm+slsqp"`` (finished by SLSQP), ``"slsqp"`` (the reference solver).
     """
 
     ok: bool
     x: np.ndarray
     failing: list
     at_target: bool
+    solver: str = "slsqp"
 
     @property
     def apex(self) -> np.ndarray:
@@ -319,48 +313,64 @@ def validate_apex(
     ``centres`` ((n_faces, 3) float), the straight crease on every face runs between the
     corner T and the centre, so the vertex's share of the face stays a simple polygon.
     """
-    scale = float(np.mean([s.length for s in frame.sides]))
+    sa = frame.arrays
+    k = len(sa.arc)
+    scale = float(sa.length.mean())
     eps = tol.validate * scale
-    slack, failing = [], []
-    for i, side in enumerate(frame.sides):
-        s = np.linspace(0.0, side.arc, n_samples if side.arc > 0 else 1)
-        l, dn = crease_length(frame, i, V, v, s)
-        C = side.base(s)
-        N = side.normal(s)
-        checks = {
-            "patch": dn,
-            "l_min": l.min() if dn > 0 else -np.inf,
-            "l_max": min(frame.lmax_start[i] - l[0], frame.lmax_end[i] - l[-1])
-            if dn > 0
-            else -np.inf,
-            "nonint": float(np.min(sigma * np.einsum("ij,ij->i", V - C, N))),
-        }
-        for k, val in checks.items():
-            slack.append(val)
-            strict = k in ("patch", "nonint")
-            if val < (eps if strict else -eps):
-                failing.append(f"{KINDS[k]} at edge {side.edge}")
+    ks = np.where(sa.arc > 0, n_samples, 1)
+    side = np.repeat(np.arange(k), ks)
+    first = np.concatenate([[0], np.cumsum(ks)[:-1]])
+    last = first + ks - 1
+    s = sa.arc[side] * (np.arange(len(side)) - first[side]) / np.maximum(ks[side] - 1, 1)
+    C = sa.base(side, s)
+    N = sa.normal(side, s)
+    vi = np.einsum("kij,j->ki", sa.Q, v) + sa.t  # developed apex in each cylinder's chart
+    d = V - C
+    num = (vi[side, 0] - s) ** 2 + vi[side, 1] ** 2 - np.einsum("ij,ij->i", d, d)
+    dn = vi[:, 1] - np.einsum("ij,ij->i", V - sa.M, sa.R)
+    valid = dn > 0
+    l = 0.5 * num / np.where(valid, dn, 1.0)[side]
+    checks = np.stack(
+        [
+            dn,
+            np.where(valid, np.minimum.reduceat(l, first), -np.inf),
+            np.where(
+                valid,
+                np.minimum(frame.lmax_start - l[first], frame.lmax_end - l[last]),
+                -np.inf,
+            ),
+            np.minimum.reduceat(sigma * np.einsum("ij,ij->i", d, N), first),
+        ],
+        axis=1,
+    )  # (k, 4): patch, l_min, l_max, nonint
+    slack = [checks.ravel()]
+    failing = []
+    strict = np.array([True, False, False, True])
+    bad = np.where(strict, checks < eps, checks < -eps)
+    names = ("patch", "l_min", "l_max", "nonint")
+    for i, c in zip(*np.nonzero(bad), strict=True):
+        failing.append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
+    nf = len(frame.ring.faces)
+    n = sa.face_normal
+    face_val = sigma * np.einsum("ij,ij->i", V - frame.T_end[:nf], n)
+    slack.append(face_val)
+    centre_val = np.full(nf, np.inf)
+    if centres is not None:
+        # the straight crease on face i runs from side i's end to side i+1's start
+        nxt = (np.arange(nf) + 1) % k
+        p0 = C[last[:nf]] + l[last[:nf], None] * sa.R[:nf]
+        p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
+        dvec = p1 - p0
+        length = np.linalg.norm(dvec, axis=1)
+        dvec = dvec / np.where(length > eps, length, 1.0)[:, None]
+        side_t = np.einsum("ij,ij->i", np.cross(dvec, frame.T_end[:nf] - p0), n)
+        side_c = np.einsum("ij,ij->i", np.cross(dvec, centres[frame.ring.faces] - p0), n)
+        centre_val = np.where(side_t != 0, -side_c * np.sign(side_t), np.abs(side_c))
+        centre_val = np.where(length > eps, centre_val, np.inf)
+        slack.append(centre_val[length > eps])
     for i, f in enumerate(frame.ring.faces):
-        n = np.cross(frame.face_frames[i][1], frame.face_frames[i][2])
-        val = float(sigma * (V - frame.T_end[i]) @ n)
-        slack.append(val)
-        if val < eps:
+        if face_val[i] < eps:
             failing.append(f"{KINDS['face']} at face {int(f)}")
-        if centres is None:
-            continue
-        j = (i + 1) % len(frame.sides)
-        ends = []
-        for k, s_ in ((i, frame.sides[i].arc), (j, 0.0)):
-            l_end, _ = crease_length(frame, k, V, v, np.array([s_]))
-            ends.append(frame.sides[k].base([s_])[0] + l_end[0] * frame.sides[k].R)
-        d = ends[1] - ends[0]
-        if np.linalg.norm(d) <= eps:
-            continue
-        d = d / np.linalg.norm(d)
-        side_t = float(np.cross(d, frame.T_end[i] - ends[0]) @ n)
-        side_c = float(np.cross(d, centres[f] - ends[0]) @ n)
-        val = -side_c * np.sign(side_t) if side_t != 0 else abs(side_c)
-        slack.append(val)
-        if val < eps:
+        if centre_val[i] < eps:
             failing.append(f"{KINDS['centre']} on face {int(f)}")
-    return ApexCheck(not failing, float(np.min(slack)), failing)
+    return ApexCheck(not failing, float(np.min(np.concatenate(slack))), failing)

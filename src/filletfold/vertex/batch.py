@@ -31,11 +31,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from .apex import ApexConstraints, ApexSolution
+from .reference import project_slsqp, solve_apex_slsqp
 
-#: Vertices per chunk (keeps the padded arrays small and in cache).
+#: Most vertices per chunk, and most padded rows per chunk (keeps the arrays in cache).
 CHUNK = 2048
+ROW_BUDGET = 150_000
 #: Phase 1 stops once the smallest slack exceeds half of this (in units of the scale).
 T_CAP = 1e-3
+#: Stationarity (gradient of the Lagrangian over the size of its terms) at which a problem
+#: is done.
+STAT_TOL = 1e-8
 #: Starts tried at once in phase 1 before the remaining ones.
 PARALLEL_STARTS = 3
 
@@ -113,8 +118,9 @@ def interior_point(
     *,
     stop_slack: int | None = None,
     groups: np.ndarray | None = None,
+    give_up: bool = False,
     max_iter: int = 80,
-    tol: float = 1e-13,
+    tol: float = 1e-12,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Minimise ``0.5 y.q.y + c.y`` subject to ``rows(y) > 0`` from strictly feasible ``y``.
 
@@ -130,15 +136,18 @@ def interior_point(
     stop_slack : int, optional
         Index of a variable (phase 1's ``t``): a problem is done once it exceeds
         ``T_CAP / 2`` or is positive and at least the duality gap (within a factor 2 of the
-        largest), or once ``t`` plus the duality gap is negative (infeasible, for the convex
-        part of the problem).
+        largest).
     groups : (B,) int, optional
         With ``stop_slack``: problems with the same group are copies from different starts;
         all are done when one reaches ``T_CAP / 2``.
+    give_up : bool
+        With ``stop_slack``: also stop once ``t`` plus the duality gap is negative (a proof of
+        infeasibility for a convex problem; only a hint for this one, whose ``l <= l_max``
+        rows are reverse-convex).
     max_iter : int
     tol : float
-        Mean complementarity ``lambda g`` at which a problem is done (and stationarity
-        ``1e-2 sqrt(tol)``).
+        Mean complementarity ``lambda g`` at which a problem is done (with stationarity
+        :data:`STAT_TOL`).
 
     Returns
     -------
@@ -157,21 +166,34 @@ def interior_point(
     count = mf.sum(axis=1)
     yl = y
     g = a + _matvec(A, yl) + al * (yl * e * yl).sum(axis=1)[:, None]
-    lam = mf * np.maximum(1e-2, np.abs(yl * q + cl).max(axis=1))[:, None] / g
+    # phase 1: multipliers that balance the objective's gradient, spread over the rows;
+    # phase 2: a barrier-like start, larger on the rows close to their boundary
+    scale = np.maximum(1e-2, np.abs(yl * q + cl).max(axis=1))
+    lam = mf * (scale / count)[:, None] if stop_slack is not None else mf * scale[:, None] / g
     stuck = np.zeros(B, dtype=bool)
+    mu = 0.1 * (lam * g).sum(axis=1) / count
     for _ in range(max_iter):
         ey = e * yl
         lam_al = (lam * al).sum(axis=1)
-        stat = yl * q + cl - _vecmat(lam, A) - 2 * lam_al[:, None] * ey
+        grad_f = yl * q + cl
+        lam_A = _vecmat(lam, A)
+        # stationarity, relative to the size of the terms that cancel in it
+        size = 1.0 + np.abs(grad_f).max(axis=1) + np.abs(lam_A).max(axis=1)
+        stat = (grad_f - lam_A - 2 * lam_al[:, None] * ey) / size[:, None]
         comp = (lam * g).sum(axis=1)
-        mu = 0.1 * comp / count
-        done = (np.abs(stat).max(axis=1) <= 1e-2 * tol**0.5) & (comp / count <= tol)
+        # monotone barrier: lower mu once the iterate is close to its central-path point
+        central = np.maximum(np.abs(stat).max(axis=1), np.abs(mf * (lam * g - mu[:, None])).max(1))
+        near = (central <= 10 * mu) | (central <= STAT_TOL)  # (stationarity ends at rounding)
+        mu = np.where(near, np.maximum(0.1 * tol, 0.2 * mu), mu)
+        done = (np.abs(stat).max(axis=1) <= STAT_TOL) & (comp / count <= tol)
         if stop_slack is not None:
             t = yl[:, stop_slack]
             reached = (t >= 0.5 * T_CAP) | ((t > 0) & (comp <= t))
             if groups is not None and reached.any():
                 reached = np.isin(groups[live], groups[live[reached]])
-            done |= reached | (t + comp < -1e-9)
+            done |= reached
+            if give_up:
+                done |= t + comp < -1e-9
         new = done & ~converged[live]
         y[live[new]], converged[live[new]] = yl[new], True
         done |= stuck  # no step possible: keep the point (not converged)
@@ -189,13 +211,21 @@ def interior_point(
             )  # fmt: skip
             ey, lam_al, mu = ey[k], lam_al[k], mu[k]
         # Newton matrix: sum_j w_j grad g_j grad g_j^T (grad g_j = A_j + 2 alpha_j e*y) + diag
-        w = lam / g
+        # curvature weights: lambda, or the primal mu / g where lambda lags behind (rows that
+        # just became nearly active would otherwise be crossed by every step)
+        # (late on, the exact lambda again, for fast local convergence)
+        lam_h = np.where((mu > 1e-8)[:, None], np.maximum(lam, mf * mu[:, None] / g), lam)
+        w = lam_h / g
         wa = w * al
         u = _vecmat(wa, A)
         H = _vecmat(w, outer).reshape(-1, n, n)
         H += 2 * (u[:, :, None] * ey[:, None, :] + ey[:, :, None] * u[:, None, :])
         H += 4 * (wa * al).sum(axis=1)[:, None, None] * ey[:, :, None] * ey[:, None, :]
-        H[:, diag_idx, diag_idx] += np.maximum(q - 2 * lam_al[:, None] * e, 1e-8)
+        H[:, diag_idx, diag_idx] += q - 2 * (lam_h * al).sum(axis=1)[:, None] * e
+        # the reverse-convex rows make H indefinite at times: shift it to positive definite
+        low = np.linalg.eigvalsh(H)[:, 0]
+        floor = 1e-8 * np.maximum(1.0, np.abs(H[:, diag_idx, diag_idx]).max(axis=1))
+        H[:, diag_idx, diag_idx] += np.maximum(floor - low, 0.0)[:, None]
         v = mu[:, None] / g
         rhs = -(yl * q + cl) + _vecmat(v, A) + 2 * (v * al).sum(axis=1)[:, None] * ey
         bad = ~(np.isfinite(H).all(axis=(1, 2)) & np.isfinite(rhs).all(axis=1))
@@ -259,7 +289,9 @@ def _vecmat(x: np.ndarray, A: np.ndarray) -> np.ndarray:
     return np.matmul(x[:, None, :], A)[:, 0, :]
 
 
-def _phase1(rows: RowBlock, y0: np.ndarray, groups: np.ndarray, max_iter: int) -> np.ndarray:
+def _phase1(
+    rows: RowBlock, y0: np.ndarray, groups: np.ndarray, max_iter: int, give_up: bool = True
+) -> np.ndarray:
     """(B, n) points of larger smallest slack, maximised from ``y0`` (see :func:`interior_point`
     for ``groups``)."""
     B, R, n = rows.A.shape
@@ -278,7 +310,7 @@ def _phase1(rows: RowBlock, y0: np.ndarray, groups: np.ndarray, max_iter: int) -
     c = np.concatenate([-1e-6 * y0, -np.ones((B, 1))], axis=1)
     z, _ = interior_point(
         ext, q, c, np.concatenate([y0, t0[:, None]], axis=1), stop_slack=n, groups=groups,
-        max_iter=max_iter,
+        give_up=give_up, max_iter=max_iter,
     )  # fmt: skip
     return z[:, :n]
 
@@ -288,6 +320,7 @@ def solve_apex_batch(
     targets: Sequence[np.ndarray],
     starts: Sequence[Sequence[np.ndarray]] | None = None,
     *,
+    thorough=True,
     max_iter: int = 80,
 ) -> list[ApexSolution]:
     """Project every target onto its problem's feasible set, all problems at once.
@@ -300,6 +333,13 @@ def solve_apex_batch(
         ``P = U + d D`` (followed by the developed apex's target for 5 variables).
     starts : sequence of sequences of (3,) or (5,) float, optional
         Further starting points per problem for the feasibility phase.
+    thorough : bool or sequence of bool
+        Per problem (or for all): before calling a problem infeasible, try every start,
+        continue the feasibility phase from the best point without the give-up rule, and last
+        run the reference SLSQP solver (:func:`~filletfold.vertex.reference.solve_apex_slsqp`)
+        from every start. Without it only the :data:`PARALLEL_STARTS` best starts are tried
+        and a problem is given up once it looks infeasible: for attempts that have a more
+        permissive one after them.
     max_iter : int
         Interior-point iterations per phase.
 
@@ -310,14 +350,20 @@ def solve_apex_batch(
         and ``failing`` then names the violated constraints at the best point found.
     """
     out: list[ApexSolution | None] = [None] * len(problems)
+    thorough = np.broadcast_to(np.asarray(thorough, dtype=bool), (len(problems),))
+    sizes = np.array([len(p.lin_b) + len(p.quad_s) for p in problems])
     for n in (3, 5):
-        idx = [i for i, p in enumerate(problems) if p.n_vars == n]
-        for k in range(0, len(idx), CHUNK):
-            chunk = idx[k : k + CHUNK]
+        idx = [i for i in np.argsort(sizes, kind="stable") if problems[i].n_vars == n]
+        # chunks of similar row counts, within the row budget
+        while idx:
+            k = max(1, min(len(idx), ROW_BUDGET // int(sizes[idx[min(len(idx), CHUNK) - 1]])))
+            k = min(k, CHUNK)
+            chunk, idx = idx[:k], idx[k:]
             sols = _solve_chunk(
                 [problems[i] for i in chunk],
                 [np.asarray(targets[i], dtype=float) for i in chunk],
                 [list(starts[i]) if starts is not None else [] for i in chunk],
+                thorough[chunk],
                 n,
                 max_iter,
             )
@@ -331,7 +377,7 @@ def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSo
     return solve_apex_batch([cons], [target], [list(starts) if starts is not None else []])[0]
 
 
-def _solve_chunk(problems, targets, starts, n, max_iter) -> list[ApexSolution]:
+def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexSolution]:
     B = len(problems)
     rows = pack([rows_of(p, t) for p, t in zip(problems, targets, strict=True)], n)
     L = np.array([p.scale for p in problems])
@@ -364,7 +410,7 @@ def _solve_chunk(problems, targets, starts, n, max_iter) -> list[ApexSolution]:
     for lo, hi in ((0, PARALLEL_STARTS), (PARALLEL_STARTS, n_s)):
         todo_b, todo_j = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]
         for j in range(lo, min(hi, n_s)):
-            b = np.nonzero(need & ~feasible & valid[ar, order[:, j]])[0]
+            b = np.nonzero(need & ~feasible & valid[ar, order[:, j]] & (thorough | (lo == 0)))[0]
             todo_b.append(b)
             todo_j.append(order[b, j])
         todo_b, todo_j = np.concatenate(todo_b), np.concatenate(todo_j)
@@ -378,21 +424,41 @@ def _solve_chunk(problems, targets, starts, n, max_iter) -> list[ApexSolution]:
                 best[b], best_g[b] = y[k], g_y[k]
         feasible |= need & (best_g > 0)
         y0[feasible] = best[feasible]
+    # the give-up rule is only a hint here: the rest continue from their best point, longer
+    rest = np.nonzero(need & ~feasible & thorough)[0]
+    if len(rest):
+        y = _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False)
+        g_y = np.where(rows.mask[rest], rows.take(rest).values(y), np.inf).min(axis=1)
+        better = g_y > best_g[rest]
+        best[rest[better]], best_g[rest[better]] = y[better], g_y[better]
+        feasible |= need & (best_g > 0)
+        y0[feasible] = best[feasible]
     solve = np.nonzero(need & feasible)[0]
     y = np.zeros((B, n))
+    converged = np.ones(B, dtype=bool)
     if len(solve):
-        y[solve], _ = interior_point(
+        y[solve], converged[solve] = interior_point(
             rows.take(solve), np.full(n, 2.0), np.zeros((len(solve), n)), y0[solve],
             max_iter=max_iter,
         )  # fmt: skip
     result = []
     for b, p in enumerate(problems):
         if at_target[b]:
-            result.append(ApexSolution(True, T[b].copy(), [], True))
+            result.append(ApexSolution(True, T[b].copy(), [], True, "target"))
         elif feasible[b]:
-            result.append(ApexSolution(True, T[b] + L[b] * y[b], [], False))
+            x, how = T[b] + L[b] * y[b], "ipm"
+            if not converged[b]:  # rare: finish with SLSQP from the feasible point
+                x_s = project_slsqp(p, T[b], x)
+                if np.sum((x_s - T[b]) ** 2) < np.sum((x - T[b]) ** 2):
+                    x, how = x_s, "ipm+slsqp"
+            result.append(ApexSolution(True, x, [], False, how))
+        elif thorough[b]:
+            # the feasibility phase can stall at a local maximum of the smallest slack (the
+            # l <= l_max rows are reverse-convex): SLSQP from every start decides
+            result.append(solve_apex_slsqp(p, T[b], [T[b] + L[b] * best[b], *starts[b]]))
         else:
             x = T[b] + L[b] * best[b]
             vals = p.values(x)
-            result.append(ApexSolution(False, x, p.describe(np.nonzero(vals < 0)[0]), False))
+            rows_failing = p.describe(np.nonzero(vals < 0)[0])
+            result.append(ApexSolution(False, x, rows_failing, False, "ipm"))
     return result

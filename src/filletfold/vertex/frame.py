@@ -15,6 +15,7 @@ angle defect; the developed apex is its fixed point (METHOD-NOTES, "one common 2
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -131,6 +132,48 @@ def invert(m: np.ndarray) -> np.ndarray:
 
 
 @dataclass
+class SideArrays:
+    """The sides of a closed ring as arrays (see :class:`Side`), for vectorised constraints.
+
+    Attributes
+    ----------
+    edge : (k,) int
+    R, M, O, N0, B : (k, 3) float
+    radius, kappa, arc, length : (k,) float
+    Q : (k, 2, 2) float
+        Linear part of the map from the common frame into each cylinder's chart.
+    t : (k, 2) float
+        Its translation.
+    face_normal : (n_faces, 3) float
+        Front normal of each ring face.
+    """
+
+    edge: np.ndarray
+    R: np.ndarray
+    M: np.ndarray
+    O: np.ndarray
+    N0: np.ndarray
+    B: np.ndarray
+    radius: np.ndarray
+    kappa: np.ndarray
+    arc: np.ndarray
+    length: np.ndarray
+    Q: np.ndarray
+    t: np.ndarray
+    face_normal: np.ndarray
+
+    def normal(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """(m, 3) front normals at arc parameters ``s`` (m,) of sides ``i`` (m,)."""
+        r = self.radius[i]
+        ang = np.where(r > 0, s / np.where(r > 0, r, 1.0), 0.0)[:, None]
+        return np.cos(ang) * self.N0[i] + np.sin(ang) * self.B[i]
+
+    def base(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """(m, 3) base-curve points ``C(s)`` of sides ``i``."""
+        return self.O[i] + (self.kappa[i] * self.radius[i])[:, None] * self.normal(i, s)
+
+
+@dataclass
 class VertexFrame:
     """Sides, charts and 2D maps of one vertex.
 
@@ -177,6 +220,27 @@ class VertexFrame:
     @property
     def n_sides(self) -> int:
         return len(self.sides)
+
+    @functools.cached_property
+    def arrays(self) -> SideArrays:
+        """The sides' and faces' data stacked into arrays (closed rings)."""
+        sides = self.sides
+        inv = [invert(m) for m in self.cyl_map]
+        return SideArrays(
+            edge=np.array([s.edge for s in sides], dtype=np.int64),
+            R=np.array([s.R for s in sides]),
+            M=np.array([s.M for s in sides]),
+            O=np.array([s.O for s in sides]),
+            N0=np.array([s.N0 for s in sides]),
+            B=np.array([s.B for s in sides]),
+            radius=np.array([s.radius for s in sides]),
+            kappa=np.array([s.kappa for s in sides], dtype=float),
+            arc=np.array([s.arc for s in sides]),
+            length=np.array([s.length for s in sides]),
+            Q=np.array([m[:2, :2] for m in inv]),
+            t=np.array([m[:2, 2] for m in inv]),
+            face_normal=np.array([np.cross(f[1], f[2]) for f in self.face_frames]),
+        )
 
     def rotation_angle(self) -> float:
         """Rotation angle of ``rho`` (radians, in (-pi, pi])."""

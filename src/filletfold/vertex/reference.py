@@ -1,8 +1,9 @@
 """Reference apex solver: scipy SLSQP per vertex, with a feasibility phase from several starts.
 
-Not used by the pipeline (which uses :func:`filletfold.vertex.batch.solve_apex_batch`); kept
-as the independent reference that tests and ``benchmarks/apex_solvers.py`` compare the batched
-solver with.
+The pipeline uses :func:`filletfold.vertex.batch.solve_apex_batch`, which calls
+:func:`project_slsqp` only to finish the rare problems its interior-point iteration did not
+converge on. :func:`solve_apex_slsqp` is the independent reference that tests and
+``benchmarks/apex_solvers.py`` compare the batched solver with.
 """
 
 from __future__ import annotations
@@ -60,8 +61,7 @@ def solve_apex_slsqp(cons: ApexConstraints, target: np.ndarray, starts=None) -> 
     """
     g0 = cons.values(target)
     if g0.min() >= 0:
-        return ApexSolution(True, target.copy(), [], True)
-    L = cons.scale
+        return ApexSolution(True, target.copy(), [], True, "target")
     # phase 1: maximise the smallest slack t, from the target and then from further starts
     # (the l <= l_max constraints are reverse-convex, so one start can stall)
     best_start, best_t = target, g0.min()
@@ -77,6 +77,15 @@ def solve_apex_slsqp(cons: ApexConstraints, target: np.ndarray, starts=None) -> 
         rows = np.nonzero(g1 < 0)[0]
         return ApexSolution(False, start, cons.describe(rows), False)
     # phase 2: closest feasible point to the target
+    return ApexSolution(True, project_slsqp(cons, target, start), [], False)
+
+
+def project_slsqp(cons: ApexConstraints, target: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """SLSQP from the feasible ``start`` to the closest feasible point to ``target``.
+
+    Returns the point, or ``start`` when SLSQP ends on an infeasible one.
+    """
+    L = cons.scale
     res = minimize(
         lambda x: ((x - target) @ (x - target)) / L**2,
         start,
@@ -85,5 +94,4 @@ def solve_apex_slsqp(cons: ApexConstraints, target: np.ndarray, starts=None) -> 
         method="SLSQP",
         options={"ftol": 1e-15, "maxiter": 500},
     )
-    best = res.x if cons.values(res.x).min() >= -1e-12 * L else start
-    return ApexSolution(True, best, [], False)
+    return res.x if cons.values(res.x).min() >= -1e-12 * L else start

@@ -16,7 +16,7 @@ from ..tolerances import tol
 from .apex import build_constraints, validate_apex
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frame
-from .normal import is_developable, solid_angle_front, vertex_normal
+from .normal import is_developable, solid_angle_front, vertex_normals
 
 STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
 
@@ -66,6 +66,17 @@ class VertexResult:
     apex_2d: np.ndarray
     margin: np.ndarray
 
+    def take(self, other: VertexResult, vertices) -> None:
+        """Copy every per-vertex field of ``other`` at ``vertices`` into this result."""
+        idx = np.asarray(list(vertices), dtype=np.int64)
+        for name, value in vars(self).items():
+            src = getattr(other, name)
+            if isinstance(value, list):
+                for u in idx:
+                    value[u] = src[u]
+            else:
+                value[idx] = src[idx]
+
     @classmethod
     def empty(cls, n: int) -> VertexResult:
         nan = np.full(n, np.nan)
@@ -88,55 +99,94 @@ class VertexResult:
         )
 
 
-def classify_vertex(
-    mesh: PolyMesh, rounding: EdgeRounding, u: int, res: VertexResult, start_edge: int | None = None
-) -> VertexFrame:
-    """Build vertex ``u``'s frame, classify it and find its normal (sec. 2.5, 3.1).
+def classify_vertices(
+    mesh: PolyMesh, rounding: EdgeRounding, res: VertexResult, vertices=None, start_edge=None
+) -> list[VertexFrame]:
+    """Build the vertices' frames, classify them and find their normals (sec. 2.5, 3.1).
 
-    Fills ``res`` at ``u``: angle sum, defect, solid angle, normal, bound, sigma, kind, and the
-    status for every vertex that cannot get a cone (``status`` stays ``""`` otherwise).
-    ``start_edge`` chooses the incident edge along which the module is cut (see
-    :func:`~filletfold.vertex.frame.vertex_frame`).
+    Fills ``res`` at each vertex: angle sum, defect, solid angle, normal, bound, sigma, kind,
+    and the status of every vertex that cannot get a cone (``status`` stays ``""``
+    otherwise). The normals of all vertices are found at once
+    (:func:`~filletfold.vertex.normal.vertex_normals`).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+    res : VertexResult
+    vertices : sequence of int, optional
+        Default: every vertex.
+    start_edge : sequence of (int or None), optional
+        Per listed vertex, the incident edge along which its module is cut (see
+        :func:`~filletfold.vertex.frame.vertex_frame`).
 
     Returns
     -------
-    VertexFrame
+    list of VertexFrame
+        In the order of ``vertices``.
     """
-    frame = vertex_frame(mesh, rounding, u, start_edge)
-    ring = frame.ring
-    res.angle_sum[u] = mesh.vertex_angle_sum[u]
-    res.defect[u] = 2 * np.pi - res.angle_sum[u]
-    if not ring.closed:
-        res.kind[u] = res.status[u] = "boundary"
-        res.reason[u] = "boundary vertex: no cone; its module ends at the sheet's edge"
-        return frame
-    kappa = rounding.kappa[ring.edges]
-    res.solid_angle[u] = solid_angle_front(kappa, rounding.half_angle[ring.edges])
-    edge_dirs = np.array([s.R for s in frame.sides])
-    D, b, sigma = vertex_normal(edge_dirs, mesh.face_normal[ring.faces])
-    res.normal[u], res.normal_bound[u], res.sigma[u] = D, b, sigma
-    if is_developable(res.angle_sum[u]):
-        res.kind[u] = "developable"
-        gap = float(np.linalg.norm(frame.rho[:2, 2]))
-        scale = float(np.mean([s.length for s in frame.sides]))
-        if gap > tol.closure * scale or b <= tol.normal_bound:
-            res.status[u] = "developable"
+    if vertices is None:
+        vertices = range(mesh.n_vertices)
+    vertices = [int(u) for u in vertices]
+    if start_edge is None:
+        start_edge = [None] * len(vertices)
+    frames = [vertex_frame(mesh, rounding, u, e) for u, e in zip(vertices, start_edge, strict=True)]
+    closed = [k for k, f in enumerate(frames) if f.ring.closed]
+    for k, frame in enumerate(frames):
+        u = vertices[k]
+        res.angle_sum[u] = mesh.vertex_angle_sum[u]
+        res.defect[u] = 2 * np.pi - res.angle_sum[u]
+        if not frame.ring.closed:
+            res.kind[u] = res.status[u] = "boundary"
+            res.reason[u] = "boundary vertex: no cone; its module ends at the sheet's edge"
+    if not closed:
+        return frames
+    width = max(len(frames[k].sides) for k in closed)
+    edge_dir = np.zeros((len(closed), width, 3))
+    face_normal = np.zeros((len(closed), width, 3))
+    count = np.zeros(len(closed), dtype=np.int64)
+    for j, k in enumerate(closed):
+        ring = frames[k].ring
+        n = len(frames[k].sides)
+        edge_dir[j, :n] = [s.R for s in frames[k].sides]
+        face_normal[j, : len(ring.faces)] = mesh.face_normal[ring.faces]
+        count[j] = n
+    D, bound, sigma = vertex_normals(edge_dir, face_normal, count, count)
+    for j, k in enumerate(closed):
+        frame, u = frames[k], vertices[k]
+        ring = frame.ring
+        kappa = rounding.kappa[ring.edges]
+        res.solid_angle[u] = solid_angle_front(kappa, rounding.half_angle[ring.edges])
+        b = float(bound[j])
+        res.normal[u], res.normal_bound[u], res.sigma[u] = D[j], b, sigma[j]
+        if is_developable(res.angle_sum[u]):
+            res.kind[u] = "developable"
+            gap = float(np.linalg.norm(frame.rho[:2, 2]))
+            scale = float(np.mean([s.length for s in frame.sides]))
+            if gap > tol.closure * scale or b <= tol.normal_bound:
+                res.status[u] = "developable"
+                res.reason[u] = (
+                    "developable vertex (angle sum 2 pi) whose rounded development does not "
+                    f"close (gap {gap:.3g}): it needs consistent material loss (--material-loss)"
+                    if b > tol.normal_bound
+                    else "developable vertex (angle sum 2 pi) with no vertex normal"
+                )
+        elif b <= tol.normal_bound:
+            res.kind[u] = res.status[u] = "saddle"
             res.reason[u] = (
-                "developable vertex (angle sum 2 pi) whose rounded development does not close "
-                f"(gap {gap:.3g}): it needs consistent material loss (--material-loss)"
-                if b > tol.normal_bound
-                else "developable vertex (angle sum 2 pi) with no vertex normal"
+                f"saddle vertex: no plane through it has all its faces on one side "
+                f"(max-min bound {b:.3g} <= 0); no cone possible"
             )
-        return frame
-    if b <= tol.normal_bound:
-        res.kind[u] = res.status[u] = "saddle"
-        res.reason[u] = (
-            f"saddle vertex: no plane through it has all its faces on one side "
-            f"(max-min bound {b:.3g} <= 0); no cone possible"
-        )
-        return frame
-    res.kind[u] = "cone"
-    return frame
+        else:
+            res.kind[u] = "cone"
+    return frames
+
+
+def classify_vertex(
+    mesh: PolyMesh, rounding: EdgeRounding, u: int, res: VertexResult, start_edge: int | None = None
+) -> VertexFrame:
+    """One vertex through :func:`classify_vertices` (``start_edge``: where its module is cut)."""
+    return classify_vertices(mesh, rounding, res, [u], [start_edge])[0]
 
 
 def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
@@ -206,10 +256,12 @@ class ApexProblem:
         return build_constraints(self.frame, v, self.sigma, n_samples, m, self.shrink)
 
 
-#: Attempts per vertex: (samples per arc, margin scale). After an infeasible attempt only
-#: :data:`THIN_ATTEMPT` follows (a tenth of the margin, for thin windows).
+#: Attempts per vertex: (samples per arc, margin scale), the next one after a failed dense
+#: validation. After an infeasible attempt :data:`THIN_ATTEMPTS` follow instead (a tenth of
+#: the margin, for thin windows); an infeasible thin attempt ends the vertex (more samples
+#: only add constraints).
 ATTEMPTS = [(9, 1.0), (33, 2.0), (65, 4.0)]
-THIN_ATTEMPT = (129, 0.1)
+THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
 
 
 def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexProblem | None:
@@ -282,9 +334,9 @@ def solve_apices(
     :func:`~filletfold.vertex.batch.solve_apex_batch`; a vertex whose attempt fails the
     dense validation :func:`validate_apex` goes to its next attempt in the next round (more
     samples and margin, shorter creases when a straight crease passes a face piece's centre,
-    a tenth of the margin when the sampled problem is infeasible). Sets ``res.status`` to
-    ``ok`` (with apex, depth used and margin) or ``infeasible`` (with the constraints that
-    fail).
+    a tenth of the margin when the sampled problem is infeasible: see :data:`ATTEMPTS`).
+    Sets ``res.status`` to ``ok`` (with apex, depth used and margin) or ``infeasible`` (with
+    the constraints that fail).
 
     Parameters
     ----------
@@ -320,13 +372,16 @@ def solve_apices(
         tries = [pending[u].attempts.pop(0) for u in order]
         cons = [pending[u].constraints(*t) for u, t in zip(order, tries, strict=True)]
         sols = solve_apex_batch(
-            cons, [pending[u].target for u in order], [pending[u].starts for u in order]
+            cons,
+            [pending[u].target for u in order],
+            [pending[u].starts for u in order],
+            thorough=[t[1] < 1.0 for t in tries],  # only the thin attempts end a vertex
         )
         for u, attempt, sol in zip(order, tries, sols, strict=True):
             p = pending[u]
             if not sol.ok:
                 p.failing = sol.failing
-                p.attempts = [] if attempt[1] < 1.0 else [THIN_ATTEMPT]
+                p.attempts = [] if attempt[1] < 1.0 else list(THIN_ATTEMPTS)
             else:
                 v_sol = sol.developed if p.closed else p.v
                 check = validate_apex(p.frame, sol.apex, v_sol, p.sigma, centres=centres)

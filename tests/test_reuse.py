@@ -1,0 +1,72 @@
+"""``round_mesh(..., reuse=design)``: only what changed is recomputed, and the result is the
+same as a fresh computation (issue 5: a per-vertex depth re-solves one vertex)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import filletfold
+import filletfold.design as design_module
+
+
+@pytest.fixture
+def solved_vertices(monkeypatch):
+    """Record which vertices every ``solve_apices`` call was asked to solve."""
+    calls = []
+    original = design_module.solve_apices
+
+    def spy(*args, vertices=None, **kwargs):
+        calls.append(list(vertices) if vertices is not None else None)
+        return original(*args, vertices=vertices, **kwargs)
+
+    monkeypatch.setattr(design_module, "solve_apices", spy)
+    return calls
+
+
+def same_design(a: filletfold.Design, b: filletfold.Design) -> None:
+    va, vb = a.vertices, b.vertices
+    assert va.status == vb.status
+    np.testing.assert_array_equal(va.apex, vb.apex)
+    np.testing.assert_array_equal(va.depth, vb.depth)
+    np.testing.assert_array_equal(va.normal, vb.normal)
+    np.testing.assert_array_equal(a.pattern.vertices_2d, b.pattern.vertices_2d)
+    np.testing.assert_array_equal(a.pattern.vertices_3d, b.pattern.vertices_3d)
+    assert [list(f) for f in a.pattern.faces] == [list(f) for f in b.pattern.faces]
+
+
+def test_one_vertex_depth_resolves_only_that_vertex(solved_vertices):
+    first = filletfold.round_mesh("icosahedron", depth="30%")
+    depth = {"default": "30%", 3: 0.4 * first.mesh.mean_edge_length}
+    again = filletfold.round_mesh("icosahedron", depth=depth, reuse=first)
+    assert solved_vertices[-1] == [3]
+    same_design(again, filletfold.round_mesh("icosahedron", depth=depth))
+    assert again.vertices.depth[3] != first.vertices.depth[3]
+
+
+def test_global_depth_reuses_rounding_and_normals(solved_vertices):
+    first = filletfold.round_mesh("dodecahedron", depth="30%")
+    again = filletfold.round_mesh("dodecahedron", depth="40%", reuse=first)
+    assert again.stages.frames is first.stages.frames
+    assert len(solved_vertices[-1]) == first.mesh.n_vertices
+    same_design(again, filletfold.round_mesh("dodecahedron", depth="40%"))
+
+
+def test_a_new_radius_recomputes_everything():
+    first = filletfold.round_mesh("cube", radius="10%")
+    again = filletfold.round_mesh("cube", radius="12%", reuse=first)
+    assert again.stages.frames is not first.stages.frames
+    same_design(again, filletfold.round_mesh("cube", radius="12%"))
+
+
+def test_new_samples_rebuild_modules_but_keep_apices(solved_vertices):
+    first = filletfold.round_mesh("octahedron", samples=16)
+    again = filletfold.round_mesh("octahedron", samples=32, reuse=first)
+    assert solved_vertices[-1] == []
+    same_design(again, filletfold.round_mesh("octahedron", samples=32))
+
+
+def test_reuse_with_a_different_mesh_is_a_fresh_design():
+    first = filletfold.round_mesh("cube")
+    other = filletfold.round_mesh("tetrahedron", reuse=first)
+    same_design(other, filletfold.round_mesh("tetrahedron"))
