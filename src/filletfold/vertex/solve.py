@@ -264,6 +264,14 @@ ATTEMPTS = [(9, 1.0), (33, 2.0), (65, 4.0)]
 THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
 
 
+def _margin_length(frame: VertexFrame) -> float:
+    """The length the safety margin is a fraction of: the shortest incident edge, or four times
+    the shortest rounded arc when that is shorter (nearly flat vertices have thin windows)."""
+    arcs = np.array([s.arc for s in frame.sides])
+    length = min(s.length for s in frame.sides)
+    return float(min(length, 4 * arcs[arcs > 0].min())) if np.any(arcs > 0) else length
+
+
 def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexProblem | None:
     """Set up the apex problem of a cone vertex, or mark it infeasible and return None.
 
@@ -311,7 +319,7 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
         v=np.asarray(v, dtype=float),
         target=target,
         starts=starts,
-        margin=tol.margin * lengths.min(),
+        margin=tol.margin * _margin_length(frame),
         low=low,
         shrink=np.ones((len(frame.sides), 2)),
         attempts=list(ATTEMPTS),
