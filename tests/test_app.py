@@ -153,6 +153,16 @@ def test_export_zip_holds_the_files_and_they_parse(cube_session):
     assert "SECTION" in dxf and "EOF" in dxf
 
 
+def test_shown_design_has_no_tabs_but_the_download_does(cube_session):
+    """Glue tabs are off in the live view (speed) and added for the download (reuse)."""
+    assert cube_session.design.fabrication["tabs"] == 0
+    files = cube_session.export_files()
+    report = json.loads(files["report.json"])
+    assert report["fabrication"]["tabs"] > 0
+    assert "assembly.txt" in files
+    assert report["source"] == "cube"
+
+
 def test_nearest_vertex_to_ray():
     points = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
     assert nearest_vertex_to_ray(points, (1, 0, 5), (0, 0, -1)) == 1

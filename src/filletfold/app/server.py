@@ -249,6 +249,7 @@ class AppServer:
             self._depth = gui.add_slider("Depth (% edge)", 1.0, 150.0, 1.0, DEFAULT_DEPTH_PERCENT)
             self._samples = gui.add_slider("Samples", 3, 64, 1, DEFAULT_SAMPLES)
             self._loss = gui.add_checkbox("Material loss", False)
+            self._tabs = gui.add_checkbox("Glue tabs (always in the download)", False)
             self._show_pattern = gui.add_checkbox("Show crease pattern", True)
         with gui.add_folder("Vertex"):
             self._vertex = gui.add_number("Vertex index", 0, min=0, step=1)
@@ -268,7 +269,7 @@ class AppServer:
             f = event.target.value
             self.request_load(f.name, f.content)
 
-        for handle in (self._radius, self._depth, self._samples, self._loss):
+        for handle in (self._radius, self._depth, self._samples, self._loss, self._tabs):
             handle.on_update(lambda _event: self._params_changed())
 
         @self._show_pattern.on_update
@@ -310,6 +311,7 @@ class AppServer:
             depth=f"{float(self._depth.value)}%",
             samples=int(self._samples.value),
             material_loss=bool(self._loss.value),
+            tabs=bool(self._tabs.value),
         )
         self.request_update()
 

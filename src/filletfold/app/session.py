@@ -36,7 +36,7 @@ UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
 #: Files in the zip from :meth:`AppSession.export_zip`, besides ``report.json``.
 ZIP_FORMATS = ("fold", "obj", "svg", "dxf")
 #: Parameters :meth:`AppSession.set_params` accepts.
-PARAM_NAMES = ("radius", "depth", "samples", "material_loss", "clamp")
+PARAM_NAMES = ("radius", "depth", "samples", "material_loss", "clamp", "tabs")
 
 
 @dataclass(frozen=True)
@@ -160,6 +160,7 @@ class AppSession:
             "samples": samples,
             "material_loss": material_loss,
             "clamp": True,
+            "tabs": False,  # the download always has them (see export_files)
         }
         self.vertex_depth: dict = {}
         self.design: Design | None = None
@@ -279,7 +280,8 @@ class AppSession:
         return self.design
 
     def set_params(self, **kw) -> None:
-        """Change parameters (``radius``, ``depth``, ``samples``, ``material_loss``, ``clamp``).
+        """Change parameters (``radius``, ``depth``, ``samples``, ``material_loss``, ``clamp``,
+        ``tabs``: glue tabs in the shown pattern, off by default for speed).
 
         Raises
         ------
@@ -374,6 +376,24 @@ class AppSession:
             design = self.design
         if design is None:
             raise ParameterError("no design computed yet", name="design")
+        if design.fabrication.get("tabs", 0) == 0 and design.stages is not None:
+            # the shown design was computed without glue tabs: add them (layout stage only)
+            p = design.params
+            source = design.source
+            design = round_mesh(
+                design.mesh,
+                radius=p.radius,
+                depth=p.depth,
+                samples=p.samples,
+                clamp=p.clamp,
+                material_loss=p.material_loss,
+                max_loss=p.max_loss,
+                layout=p.layout,
+                coplanar_deg=p.coplanar_deg,
+                tabs=True,
+                reuse=design,
+            )
+            design.source = source
         files = dict(
             cut_files(
                 design.pattern,
