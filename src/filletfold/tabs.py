@@ -149,12 +149,19 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
     stats = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
     seams = []
 
+    tab_boxes = np.zeros((0, 4))  # bounds of the placed tabs, to test only the nearby ones
+
     def clear(tab: shapely.Polygon) -> bool:
         shrunk = tab.buffer(-1e-9 * tab_height)
         for i in tree.query(shrunk):
             if polys[int(i)].intersection(shrunk).area > 1e-12 * tab.area:
                 return False
-        return not any(t.intersects(shrunk) for t in placed_tabs)
+        x0, y0, x1, y1 = shrunk.bounds
+        near = np.nonzero(
+            (tab_boxes[:, 0] <= x1) & (tab_boxes[:, 2] >= x0)
+            & (tab_boxes[:, 1] <= y1) & (tab_boxes[:, 3] >= y0)
+        )[0]  # fmt: skip
+        return not any(placed_tabs[int(i)].intersects(shrunk) for i in near)
 
     runs, run_edges = [], []
     for side_a, side_b in _runs(p, _seam_pairs(p)):
@@ -181,6 +188,7 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
                     ann.tabs.append(poly)
                     ann.tab_hinges.append(sub.copy())
                     placed_tabs.append(tab)
+                    tab_boxes = np.vstack([tab_boxes, tab.bounds])
                     stats["tabs"] += 1
                     stats["tabs_reduced"] += scale < 1
                     tab_on = 0 if ends is sides[0][0] else 1
@@ -200,11 +208,13 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
             ann.labels.append(
                 Label(pos, f"{n}", _readable(np.degrees(np.arctan2(d[1], d[0]))), label_h, "tab")
             )
+    area = shapely.area(polys) if polys else np.zeros(0)
     for k in range(p.n_pieces):
-        faces = [polys[i] for i in np.nonzero(p.face_piece == k)[0]]
-        if not faces:
+        faces = np.nonzero(p.face_piece == k)[0]
+        if not len(faces):
             continue
-        where = shapely.union_all(shapely.make_valid(faces)).representative_point()
+        # the part number goes inside the piece's largest face
+        where = polys[int(faces[np.argmax(area[faces])])].representative_point()
         ann.labels.append(Label(np.array([where.x, where.y]), names[k], 0.0, 2 * label_h, "part"))
     p.annotations = ann
     stats["seams"] = seams
