@@ -41,6 +41,9 @@ T_CAP = 1e-3
 #: Stationarity (gradient of the Lagrangian over the size of its terms) at which a problem
 #: is done.
 STAT_TOL = 1e-8
+#: Proximal weight of phase 1 (maximise t - PROX / 2 |y - y0|^2): keeps the search near its
+#: start, where the developed apex of a closed development would otherwise drift away.
+PROX = 1e-2
 #: Starts tried at once in phase 1 before the remaining ones.
 PARALLEL_STARTS = 3
 
@@ -306,8 +309,8 @@ def _phase1(
     alpha = np.concatenate([rows.alpha, np.zeros((B, 1))], axis=1)
     mask = np.concatenate([rows.mask, np.ones((B, 1), dtype=bool)], axis=1)
     ext = RowBlock(a, A, alpha, np.append(rows.e, 0.0), mask)
-    q = np.append(np.full(n, 1e-6), 0.0)
-    c = np.concatenate([-1e-6 * y0, -np.ones((B, 1))], axis=1)
+    q = np.append(np.full(n, PROX), 0.0)
+    c = np.concatenate([-PROX * y0, -np.ones((B, 1))], axis=1)
     z, _ = interior_point(
         ext, q, c, np.concatenate([y0, t0[:, None]], axis=1), stop_slack=n, groups=groups,
         give_up=give_up, max_iter=max_iter,
