@@ -45,7 +45,7 @@ STAT_TOL = 1e-8
 #: start, where the developed apex of a closed development would otherwise drift away.
 PROX = 1e-2
 #: Starts tried at once in phase 1 before the remaining ones.
-PARALLEL_STARTS = 3
+PARALLEL_STARTS = 1
 
 
 @dataclass
@@ -340,9 +340,9 @@ def solve_apex_batch(
         Per problem (or for all): before calling a problem infeasible, try every start,
         continue the feasibility phase from the best point without the give-up rule, and last
         run the reference SLSQP solver (:func:`~filletfold.vertex.reference.solve_apex_slsqp`)
-        from every start. Without it only the :data:`PARALLEL_STARTS` best starts are tried
-        and a problem is given up once it looks infeasible: for attempts that have a more
-        permissive one after them.
+        from the best point, the target and the first two starts. Without it only the
+        :data:`PARALLEL_STARTS` best starts are tried and a problem is given up once it looks
+        infeasible: for attempts that have a more permissive one after them.
     max_iter : int
         Interior-point iterations per phase.
 
@@ -458,7 +458,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
         elif thorough[b]:
             # the feasibility phase can stall at a local maximum of the smallest slack (the
             # l <= l_max rows are reverse-convex): SLSQP from every start decides
-            result.append(solve_apex_slsqp(p, T[b], [T[b] + L[b] * best[b], *starts[b]]))
+            result.append(solve_apex_slsqp(p, T[b], [T[b] + L[b] * best[b], *starts[b][:2]]))
         else:
             x = T[b] + L[b] * best[b]
             vals = p.values(x)
