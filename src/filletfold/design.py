@@ -21,7 +21,7 @@ from .layout import shelf_layout
 from .material_loss import MaterialLoss, solve_material_loss
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
-from .module import Piece, build_module, face_piece_centres, piece_area
+from .module import Piece, assemble_pattern, build_module, face_piece_centres, piece_area
 from .pattern import CreasePattern
 from .rounding import EdgeRounding, clamp_radii, round_edges
 from .sheet import glue_pieces
@@ -328,40 +328,6 @@ def shelf_offsets(pieces: list[Piece], gap: float) -> np.ndarray:
         p2, _ = piece.arrays()
         boxes.append([*p2.min(axis=0), *p2.max(axis=0)])
     return shelf_layout(np.array(boxes), gap)
-
-
-def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
-    """Merge translated pieces into one crease pattern.
-
-    Parameters
-    ----------
-    pieces : list of Piece
-    offsets : (n_pieces, 2) float
-        Translation of each piece.
-
-    Returns
-    -------
-    CreasePattern
-    """
-    v2, v3, faces, patches, face_piece = [], [], [], [], []
-    base = 0
-    for k, piece in enumerate(pieces):
-        p2, p3 = piece.arrays()
-        v2.append(p2 + offsets[k])
-        v3.append(p3)
-        for f, patch in zip(piece.faces, piece.patches, strict=True):
-            faces.append(np.asarray(f, dtype=np.int64) + base)
-            patches.append(patch)
-            face_piece.append(k)
-        base += len(p2)
-    return CreasePattern(
-        vertices_2d=np.vstack(v2) if v2 else np.zeros((0, 2)),
-        vertices_3d=np.vstack(v3) if v3 else np.zeros((0, 3)),
-        faces=faces,
-        face_patch=patches,
-        face_piece=np.array(face_piece, dtype=np.int64),
-        piece_vertex=np.array([p.vertex for p in pieces], dtype=np.int64),
-    )
 
 
 def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:

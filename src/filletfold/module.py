@@ -17,15 +17,20 @@ into runs of consecutive sectors, each its own piece.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .errors import MeshError
 from .mesh.polymesh import PolyMesh
+from .pattern import CreasePattern
 from .rounding import EdgeRounding
+from .tolerances import tol
 from .vertex.apex import crease_length
 from .vertex.frame import VertexFrame, apply, to_chart
 
@@ -63,6 +68,23 @@ class Piece:
             self.points_3d.append(np.asarray(p3, dtype=float).reshape(3))
         return self._keys[key]
 
+    def add_points(self, p2: np.ndarray, p3: np.ndarray) -> np.ndarray:
+        """Append points without keys; return their indices.
+
+        Parameters
+        ----------
+        p2 : (k, 2) float
+        p3 : (k, 3) float
+
+        Returns
+        -------
+        (k,) int
+        """
+        start = len(self.points_2d)
+        self.points_2d.extend(p2)
+        self.points_3d.extend(p3)
+        return np.arange(start, start + len(p2))
+
     def face(self, idx, patch: str, min_area: float = 0.0):
         """Add a polygon (duplicate consecutive indices dropped), made counter-clockwise.
 
@@ -94,50 +116,107 @@ class Piece:
         This happens where a crease runs exactly through a tangent-line crossing T
         (``l = l_max``, METHOD-NOTES 11): the straight crease on the face has zero length.
         """
+        self._merge_coincident(eps)
+
+    def _merge_coincident(self, eps: float) -> np.ndarray:
+        """:meth:`merge_coincident`; returns ``points_2d`` (k, 2) as an array afterwards."""
         p2, p3 = self.arrays()
+        x = np.sort(p2[:, 0])
+        if not (np.diff(x) <= eps).any() and np.isfinite(x).all():
+            return p2  # no two points within eps even in x alone
         pairs = cKDTree(p2).query_pairs(eps, output_type="ndarray")
         if len(pairs) == 0:
-            return
+            return p2
         pairs = pairs[np.linalg.norm(p3[pairs[:, 0]] - p3[pairs[:, 1]], axis=1) < eps]
-        root = np.arange(len(p2))
-        for a, b in sorted(map(tuple, pairs)):
-            ra, rb = root[a], root[b]
-            while root[ra] != ra:
-                ra = root[ra]
-            while root[rb] != rb:
-                rb = root[rb]
-            root[max(ra, rb)] = min(ra, rb)
-        for i in range(len(root)):
-            r = i
-            while root[r] != r:
-                r = root[r]
-            root[i] = r
-        faces, patches = self.faces, self.patches
-        self.faces, self.patches = [], []
-        for f, patch in zip(faces, patches, strict=True):
-            self.face([int(root[i]) for i in f], patch, min_area=eps * eps)
-        used = sorted({i for f in self.faces for i in f})
-        new = {old: k for k, old in enumerate(used)}
-        self.points_2d = [self.points_2d[i] for i in used]
-        self.points_3d = [self.points_3d[i] for i in used]
-        self.faces = [[new[i] for i in f] for f in self.faces]
-        self._keys = {k: new[root[i]] for k, i in self._keys.items() if root[i] in new}
+        # each point goes to the lowest point of its group of coincident points
+        n = len(p2)
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        _, group = connected_components(graph, directed=False)
+        lowest = np.full(group.max(initial=0) + 1, n)
+        np.minimum.at(lowest, group, np.arange(n))
+        root = lowest[group]
+        flat, size, kept = _merged_faces(p2, self.faces, root, min_area=eps * eps)
+        used = np.unique(flat)
+        new = np.full(n, -1)
+        new[used] = np.arange(len(used))
+        self.points_2d = [self.points_2d[i] for i in used.tolist()]
+        self.points_3d = [self.points_3d[i] for i in used.tolist()]
+        index = new[flat].tolist()
+        bounds = np.concatenate([[0], np.cumsum(size)]).tolist()
+        self.faces = [index[a:b] for a, b in itertools.pairwise(bounds)]
+        self.patches = [p for p, k in zip(self.patches, kept.tolist(), strict=True) if k]
+        self._keys = {k: int(new[root[i]]) for k, i in self._keys.items() if new[root[i]] >= 0}
         if self.apex_index is not None:
-            self.apex_index = new.get(int(root[self.apex_index]))
+            r = new[root[self.apex_index]]
+            self.apex_index = int(r) if r >= 0 else None
+        return self.arrays()[0]
 
     def arrays(self):
         """(points_2d (k, 2), points_3d (k, 3))."""
         return np.array(self.points_2d).reshape(-1, 2), np.array(self.points_3d).reshape(-1, 3)
 
     def overlaps(self, rel: float = 1e-9) -> bool:
-        """True when faces of the piece overlap in 2D (or one is not a valid polygon)."""
-        p2, _ = self.arrays()
-        polys = face_polygons(p2, self.faces)
-        if not shapely.is_valid(polys).all():
-            return True
-        total = shapely.area(polys).sum()
-        union = shapely.union_all(polys).area
-        return union < total * (1 - rel)
+        """True when faces of the piece overlap in 2D (or one is not a valid polygon).
+
+        Overlap means: the union of the faces is smaller than the sum of their areas by more
+        than ``rel`` of it. A piece that :func:`faces_interior_disjoint` proves free of
+        overlap is answered without computing the union.
+        """
+        return faces_overlap(self.arrays()[0], self.faces, rel)
+
+
+def faces_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9) -> bool:
+    """:meth:`Piece.overlaps` of the polygons ``faces`` (index lists) over ``points_2d`` (k, 2)."""
+    if faces_interior_disjoint(points_2d, faces):
+        return False
+    polys = face_polygons(points_2d, faces)
+    if not shapely.is_valid(polys).all():
+        return True
+    total = shapely.area(polys).sum()
+    union = shapely.union_all(polys).area
+    return bool(union < total * (1 - rel))
+
+
+def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: float):
+    """:meth:`Piece.face` of every face with its points replaced by ``root`` (k,), at once.
+
+    Consecutive repeats are dropped (and a last point equal to the first), faces of fewer than
+    3 points or twice-area ``<= 2 min_area`` vanish, clockwise ones are reversed; the areas are
+    summed as :meth:`Piece.face` does.
+
+    Returns
+    -------
+    flat : (h,) int
+        The kept faces' points, one face after the other.
+    size : (n_kept,) int
+    kept : (n_faces,) bool
+    """
+    n_faces = len(faces)
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=n_faces)
+    idx = root[np.fromiter(itertools.chain.from_iterable(faces), np.int64, int(size.sum()))]
+    face = np.repeat(np.arange(n_faces), size)
+    start = np.concatenate([[0], np.cumsum(size)])
+    keep = np.ones(len(idx), dtype=bool)
+    keep[1:] = idx[1:] != idx[:-1]
+    keep[start[:-1][size > 0]] = True  # a face's first point
+    count = np.bincount(face, weights=keep, minlength=n_faces).astype(np.int64)
+    last = np.full(n_faces, -1)
+    np.maximum.at(last, face[keep], np.flatnonzero(keep))
+    first = start[:-1]
+    pop = (count > 1) & (idx[np.maximum(last, 0)] == idx[np.minimum(first, len(idx) - 1)])
+    keep[last[pop]] = False
+    count[pop] -= 1
+    idx, face = idx[keep], face[keep]
+    start = np.concatenate([[0], np.cumsum(count)])
+    area = np.full(n_faces, np.nan)
+    for k in np.unique(count[count >= 3]).tolist():
+        which = np.flatnonzero(count == k)
+        area[which] = polygon_area2(points_2d[idx[start[which][:, None] + np.arange(k)]])
+    kept = (count >= 3) & ~(np.abs(area) <= 2 * min_area)
+    pos = np.arange(len(idx)) - start[face]
+    pos = np.where((area < 0)[face], count[face] - 1 - pos, pos)  # clockwise: reversed
+    sel = kept[face]
+    return idx[(start[face] + pos)[sel]], count[kept], kept
 
 
 def piece_area(piece: Piece) -> float:
@@ -152,6 +231,94 @@ def face_polygons(points_2d: np.ndarray, faces) -> np.ndarray:
     idx = np.concatenate(faces)
     rings = shapely.linearrings(points_2d[idx], indices=np.repeat(np.arange(len(faces)), sizes))
     return shapely.polygons(rings)
+
+
+def faces_interior_disjoint(points_2d: np.ndarray, faces) -> bool:
+    """Whether the polygons are proved to be valid and to overlap nowhere (a sufficient test).
+
+    The proof: every face is a simple counter-clockwise polygon (strictly convex, checked with
+    cross products, or else valid for shapely with a positive area), so its winding number is 0
+    or 1 everywhere; every directed edge ``a -> b`` occurs once, and those whose reverse
+    ``b -> a`` also occurs cancel in the sum of the face outlines, which therefore equals the
+    remaining *border* edges; these form one closed, simple, counter-clockwise polygon, whose
+    winding number is 0 or 1. The number of faces covering a point is the sum of the faces'
+    winding numbers, i.e. the border's, so no point is covered twice.
+
+    ``False`` means only that the proof did not go through (overlapping faces, a module cut
+    into a ring, a border touching itself...); the caller then measures the overlap.
+
+    Parameters
+    ----------
+    points_2d : (k, 2) float
+    faces : list of list of int
+        Index lists into ``points_2d``.
+
+    Returns
+    -------
+    bool
+    """
+    n_faces = len(faces)
+    if n_faces == 0:
+        return True
+    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=n_faces)
+    if sizes.min() < 3:
+        return False
+    a = np.fromiter(itertools.chain.from_iterable(faces), dtype=np.int64, count=int(sizes.sum()))
+    start = np.zeros(n_faces + 1, dtype=np.int64)
+    np.cumsum(sizes, out=start[1:])
+    nxt = np.arange(1, len(a) + 1)
+    nxt[start[1:] - 1] = start[:-1]
+    b = a[nxt]
+    # faces: strictly convex, turning once (robust margin tol.area of the corner's edges)
+    d = points_2d[b] - points_2d[a]
+    dn = d[nxt]
+    cross = d[:, 0] * dn[:, 1] - d[:, 1] * dn[:, 0]
+    length = np.hypot(d[:, 0], d[:, 1])
+    convex = cross > tol.area * length * length[nxt]
+    turn = np.arctan2(cross, np.einsum("ij,ij->i", d, dn))
+    face_ok = np.logical_and.reduceat(convex, start[:-1]) & (
+        np.add.reduceat(turn, start[:-1]) < 3 * np.pi
+    )
+    if not face_ok.all():
+        rest = np.flatnonzero(~face_ok)
+        p, q = points_2d[a], points_2d[b]
+        term = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]
+        area2 = np.add.reduceat(term, start[:-1])[rest]
+        scale = np.add.reduceat(np.abs(term), start[:-1])[rest]
+        if not (area2 > tol.area * scale).all():
+            return False
+        if not shapely.is_valid(face_polygons(points_2d, [faces[i] for i in rest])).all():
+            return False
+    # edges: each directed edge once; border = edges without their reverse
+    n = len(points_2d)
+    key = a * n + b
+    ks = np.sort(key)
+    if (ks[1:] == ks[:-1]).any():
+        return False
+    rev = b * n + a
+    pos = np.minimum(np.searchsorted(ks, rev), len(ks) - 1)
+    border = ks[pos] != rev
+    ba, bb = a[border], b[border]
+    m = len(ba)
+    if m < 3 or len(np.unique(ba)) != m or len(np.unique(bb)) != m:
+        return False
+    # the border is one loop
+    where = np.full(n, -1, dtype=np.int64)
+    where[ba] = np.arange(m)
+    succ = where[bb].tolist()
+    loop = [0]
+    h = succ[0]
+    while h > 0:
+        loop.append(h)
+        h = succ[h]
+    if h < 0 or len(loop) != m:
+        return False
+    ring = points_2d[ba[loop]]
+    q = np.roll(ring, -1, axis=0)
+    term = ring[:, 0] * q[:, 1] - q[:, 0] * ring[:, 1]
+    if not term.sum() > tol.area * np.abs(term).sum():
+        return False
+    return bool(shapely.is_valid(shapely.Polygon(ring)))
 
 
 def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
@@ -268,14 +435,15 @@ def build_module(
     nf = len(frame.ring.faces)
     if runs is not None:
         return [
-            _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1) for j0, j1 in runs
+            _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)[0]
+            for j0, j1 in runs
         ]
     pending = [(0, nf - 1)]
     pieces = []
     while pending:
         j0, j1 = pending.pop(0)
-        piece = _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)
-        if j1 > j0 and piece.overlaps():
+        piece, p2 = _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)
+        if j1 > j0 and faces_overlap(p2, piece.faces):
             mid = (j0 + j1) // 2
             pending[:0] = [(j0, mid), (mid + 1, j1)]
             continue
@@ -299,16 +467,164 @@ def _side_curves(frame: VertexFrame, i: int, n_samples: int, apex, dev_apex, hei
     return s, C, C + z[:, None] * side.R, z
 
 
-def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0, j1) -> Piece:
+def apply_rows(m: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """:func:`~filletfold.vertex.frame.apply` row by row, in one call.
+
+    Each row goes through the same 1-row matrix product as ``apply(m[k], p[k])``, so the
+    result is bitwise the one of ``k`` separate calls (one ``(k, 2) @ (2, 2)`` product may
+    round differently, and so would the patterns).
+
+    Parameters
+    ----------
+    m : (3, 3) or (k, 3, 3) float
+        Homogeneous 2D map, or one per row.
+    p : (k, 2) float
+
+    Returns
+    -------
+    (k, 2) float
+    """
+    lin = np.swapaxes(m[..., :2, :2], -1, -2)  # transposed views, as in apply
+    return (p[:, None, :] @ lin)[:, 0, :] + m[..., :2, 2]
+
+
+def polygon_area2(xy: np.ndarray) -> np.ndarray:
+    """Twice the signed area of polygons of one size, summed as :meth:`Piece.face` does.
+
+    Parameters
+    ----------
+    xy : (n, k, 2) float
+        Corners of ``n`` polygons.
+
+    Returns
+    -------
+    (n,) float
+        Positive for counter-clockwise polygons.
+    """
+    area = np.zeros(len(xy))
+    for j in range(xy.shape[1]):
+        x0, y0 = xy[:, j - 1, 0], xy[:, j - 1, 1]
+        x1, y1 = xy[:, j, 0], xy[:, j, 1]
+        area = area + (x0 * y1 - x1 * y0)
+    return area
+
+
+@dataclass
+class _Strip:
+    """One rounded side's half-cylinder in the run's 2D frame (see :func:`_strips`)."""
+
+    base_2d: np.ndarray  # (n, 2) base curve
+    base_3d: np.ndarray  # (n, 3)
+    top_2d: np.ndarray  # (n, 2) crease or hole border
+    top_3d: np.ndarray  # (n, 3)
+    quad_area: list  # (n - 1,) twice the area of quad k
+    tri_area: list | None  # (n - 1,) twice the area of cone triangle k (cones only)
+
+
+def _strips(frame: VertexFrame, sides: list, curves: dict, dev_apex) -> dict:
+    """The half-cylinders of ``sides`` (rounded side indices), computed together.
+
+    ``curves`` maps each side to :func:`_side_curves`; ``dev_apex`` is the developed apex, or
+    None without a cone. Returns a dict side -> :class:`_Strip`.
+    """
+    if not sides:
+        return {}
+    count = np.array([len(curves[i][0]) for i in sides])
+    s = np.concatenate([curves[i][0] for i in sides])
+    z = np.concatenate([curves[i][3] for i in sides])
+    maps = np.repeat(np.stack([frame.cyl_map[i] for i in sides]), count, axis=0)
+    base_2d = apply_rows(maps, np.stack([s, np.zeros(len(s))], axis=1))
+    top_2d = apply_rows(maps, np.stack([s, z], axis=1))
+    k = np.arange(len(s) - 1)  # quad k joins samples k and k + 1 of one side
+    quad = polygon_area2(np.stack([base_2d[k], base_2d[k + 1], top_2d[k + 1], top_2d[k]], axis=1))
+    quad = quad.tolist()
+    tri = None
+    if dev_apex is not None:
+        apex = np.broadcast_to(np.asarray(dev_apex, dtype=float).reshape(1, 2), (len(k), 2))
+        tri = polygon_area2(np.stack([apex, top_2d[k], top_2d[k + 1]], axis=1)).tolist()
+    out = {}
+    start = 0
+    for i, n in zip(sides, count.tolist(), strict=True):
+        end = start + n
+        out[i] = _Strip(
+            base_2d[start:end],
+            curves[i][1],
+            top_2d[start:end],
+            curves[i][2],
+            quad[start : end - 1],
+            None if tri is None else tri[start : end - 1],
+        )
+        start = end
+    return out
+
+
+def _curve_points(piece: Piece, key: tuple, p2: np.ndarray, p3: np.ndarray) -> list:
+    """Indices of the points ``k = 0 .. n-1`` of a sampled curve, added in order.
+
+    Only the two ends are keyed (``(*key, 0)`` and ``(*key, n - 1)``), the points where other
+    faces join; the first may exist already (it is then reused, as :meth:`Piece.point` does).
+    """
+    known = piece._keys
+    first = known.get((*key, 0))
+    if first is None:
+        idx = piece.add_points(p2, p3).tolist()
+        known[(*key, 0)] = idx[0]
+    else:
+        idx = [first, *piece.add_points(p2[1:], p3[1:]).tolist()]
+    known.setdefault((*key, len(idx) - 1), idx[-1])
+    return idx
+
+
+def _add_strip(piece: Piece, bs: list, tp: list, strip: _Strip, patch: str, cone: str) -> None:
+    """The quads of one half-cylinder and, with a cone, its triangles from the apex.
+
+    The same faces, in the same order, as ``piece.face`` on ``[bs[k], bs[k+1], tp[k+1], tp[k]]``
+    then ``[apex, tp[k], tp[k+1]]`` for each ``k``: the corners are distinct points, so a face
+    is dropped only when its area is zero and reversed when it is clockwise (NaN: kept as is).
+    """
+    faces, patches = piece.faces, piece.patches
+    a = piece.apex_index
+    tri = strip.tri_area
+    quad = strip.quad_area
+    if quad and min(quad) > 0 and (tri is None or min(tri) > 0):  # all kept as they are
+        pairs = zip(itertools.pairwise(bs), itertools.pairwise(tp), strict=True)
+        quads = [[b0, b1, t1, t0] for (b0, b1), (t0, t1) in pairs]
+        if tri is None:
+            faces.extend(quads)
+            patches.extend([patch] * len(quads))
+        else:
+            tris = [[a, t0, t1] for t0, t1 in itertools.pairwise(tp)]
+            faces.extend(itertools.chain.from_iterable(zip(quads, tris, strict=True)))
+            patches.extend([patch, cone] * len(quads))
+        return
+    for k, area in enumerate(quad):
+        if area != 0:
+            if area < 0:
+                faces.append([tp[k], tp[k + 1], bs[k + 1], bs[k]])
+            else:
+                faces.append([bs[k], bs[k + 1], tp[k + 1], tp[k]])
+            patches.append(patch)
+        if tri is not None and tri[k] != 0:
+            faces.append([tp[k + 1], tp[k], a] if tri[k] < 0 else [a, tp[k], tp[k + 1]])
+            patches.append(cone)
+
+
+def _build_run(
+    mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0, j1
+) -> tuple[Piece, np.ndarray]:
+    """The piece of sectors ``j0 .. j1`` and its ``points_2d`` (k, 2) as an array."""
     u = frame.vertex
     ring = frame.ring
     ne = len(frame.sides)
     heights = hole_heights(frame)
     piece = Piece(vertex=u)
     top_name = "cr" if apex is not None else "hole"
+    cone = f"cone {u}"
     if apex is not None:
         piece.apex_index = piece.point(("apex",), dev_apex, apex)
-    curves = {}
+    rounded = [i for i in range(j0, j1 + 1) if frame.sides[i].rounded]
+    curves = {i: _side_curves(frame, i, n_samples, apex, dev_apex, heights) for i in rounded}
+    strips = _strips(frame, rounded, curves, dev_apex if apex is not None else None)
 
     def curves_of(i):
         if i not in curves:
@@ -327,12 +643,18 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
             k = 0 if start else len(s) - 1
             if end_copy:
                 m = frame.face_map[face_i] @ frame.gluing_start(i)
-                key = ("end", i)
-            else:
+                b = piece.point(("end", i, "bs", k), apply(m, [s[k], 0.0]), C[k])
+                t = piece.point(("end", i, top_name, k), apply(m, [s[k], z[k]]), F[k])
+                return b, t
+            b = piece._keys.get(("side", i, "bs", k))
+            t = piece._keys.get(("side", i, top_name, k))
+            if b is None or t is None:
+                strip = strips.get(i)
                 m = frame.cyl_map[i]
-                key = ("side", i)
-            b = piece.point((*key, "bs", k), apply(m, [s[k], 0.0]), C[k])
-            t = piece.point((*key, top_name, k), apply(m, [s[k], z[k]]), F[k])
+                b2 = apply(m, [s[k], 0.0]) if strip is None else strip.base_2d[k]
+                t2 = apply(m, [s[k], z[k]]) if strip is None else strip.top_2d[k]
+                b = piece.point(("side", i, "bs", k), b2, C[k])
+                t = piece.point(("side", i, top_name, k), t2, F[k])
             return b, t
         # unrounded boundary side: points on the edge line, in the chart of face_i
         h = 0.5 * (frame.lmax_start[i] if start else frame.lmax_end[i])
@@ -349,21 +671,10 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
         side = frame.sides[i]
         # the half-cylinder of side i and the cone over its crease
         if side.rounded:
-            s, C, F, z = curves_of(i)
-            m = frame.cyl_map[i]
-            bs = [
-                piece.point(("side", i, "bs", k), apply(m, [s[k], 0.0]), C[k])
-                for k in range(len(s))
-            ]
-            tp = [
-                piece.point(("side", i, top_name, k), apply(m, [s[k], z[k]]), F[k])
-                for k in range(len(s))
-            ]
-            patch = f"cylinder {side.edge}"
-            for k in range(len(s) - 1):
-                piece.face([bs[k], bs[k + 1], tp[k + 1], tp[k]], patch)
-                if apex is not None:
-                    piece.face([piece.apex_index, tp[k], tp[k + 1]], f"cone {u}")
+            strip = strips[i]
+            bs = _curve_points(piece, ("side", i, "bs"), strip.base_2d, strip.base_3d)
+            tp = _curve_points(piece, ("side", i, top_name), strip.top_2d, strip.top_3d)
+            _add_strip(piece, bs, tp, strip, f"cylinder {side.edge}", cone)
         # the share of face f_i, between side i (end) and side i + 1 (start)
         face = int(ring.faces[i])
         b0, t0 = line_points(i, i, start=False)
@@ -380,6 +691,51 @@ def _build_run(mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0,
             corner.append(piece.point(("T", i), apply(frame.face_map[i], to_chart(fr, T3)), T3))
         piece.face(corner, f"face {face}")
         if apex is not None:
-            piece.face([piece.apex_index, t0, t1], f"cone {u}")
-    piece.merge_coincident(1e-9 * min(s.length for s in frame.sides))
-    return piece
+            piece.face([piece.apex_index, t0, t1], cone)
+    p2 = piece._merge_coincident(1e-9 * min(s.length for s in frame.sides))
+    return piece, p2
+
+
+def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
+    """Merge translated pieces into one crease pattern, all faces at once.
+
+    Parameters
+    ----------
+    pieces : list of Piece
+    offsets : (n_pieces, 2) float
+        Translation of each piece.
+
+    Returns
+    -------
+    CreasePattern
+        Vertices piece after piece (each piece's points in order, translated), faces as
+        ``(k,) int64`` arrays piece after piece, with their patches and pieces.
+    """
+    points = [piece.arrays() for piece in pieces]
+    n_points = np.array([len(p2) for p2, _ in points], dtype=np.int64)
+    n_faces = np.array([len(piece.faces) for piece in pieces], dtype=np.int64)
+    v2 = np.vstack([p2 for p2, _ in points]) if pieces else np.zeros((0, 2))
+    v3 = np.vstack([p3 for _, p3 in points]) if pieces else np.zeros((0, 3))
+    v2 = v2 + np.repeat(np.asarray(offsets, dtype=float).reshape(-1, 2), n_points, axis=0)
+    all_faces = list(itertools.chain.from_iterable(piece.faces for piece in pieces))
+    size = np.fromiter(map(len, all_faces), dtype=np.int64, count=len(all_faces))
+    flat = np.fromiter(
+        itertools.chain.from_iterable(all_faces), dtype=np.int64, count=int(size.sum())
+    )
+    base = np.concatenate([[0], np.cumsum(n_points)[:-1]])
+    flat += np.repeat(np.repeat(base, n_faces), size)
+    start = np.concatenate([[0], np.cumsum(size)])
+    faces = [None] * len(all_faces)
+    for k in np.unique(size).tolist():  # faces of k corners as rows of one (n_k, k) block
+        idx = np.flatnonzero(size == k)
+        block = flat[start[idx][:, None] + np.arange(k)]
+        for i, row in zip(idx.tolist(), block, strict=True):
+            faces[i] = row
+    return CreasePattern(
+        vertices_2d=v2,
+        vertices_3d=v3,
+        faces=faces,
+        face_patch=list(itertools.chain.from_iterable(piece.patches for piece in pieces)),
+        face_piece=np.repeat(np.arange(len(pieces)), n_faces),
+        piece_vertex=np.array([piece.vertex for piece in pieces], dtype=np.int64),
+    )

@@ -125,30 +125,46 @@ class CreasePattern:
         Border edges that are not cuts lie on the outline of the sheet.
         """
         b = np.nonzero(self.edge_assignment == "B")[0]
-        ends = np.round(self.vertices_3d[self.edges[b]], decimals)  # (k, 2, 3)
-        ends = np.sort(ends.view([("", ends.dtype)] * 3).reshape(len(b), 2), axis=1)
-        _, inv, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+        ends = np.round(self.vertices_3d[self.edges[b]], decimals) + 0.0  # (k, 2, 3), no -0.0
         mask = np.zeros(len(self.edges), dtype=bool)
-        mask[b] = counts[inv.ravel()] > 1
+        if len(b) == 0:
+            return mask
+        if not np.isfinite(ends).all():  # NaN is equal to nothing: compare as values
+            ends = np.sort(ends.view([("", ends.dtype)] * 3).reshape(len(b), 2), axis=1)
+            _, inv, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+            mask[b] = counts[inv.ravel()] > 1
+            return mask
+        # number the rounded points (equal values, equal bytes), then the unordered pairs
+        points = np.ascontiguousarray(ends.reshape(-1, 3)).view(np.dtype((np.void, 24)))
+        _, point = np.unique(points.ravel(), return_inverse=True)
+        point = point.reshape(-1, 2)
+        key = point.min(axis=1) * (int(point.max()) + 1) + point.max(axis=1)
+        _, inv, counts = np.unique(key, return_inverse=True, return_counts=True)
+        mask[b] = counts[inv] > 1
         return mask
 
     def face_normal_3d(self) -> np.ndarray:
         """(n_faces, 3) float: unit front normals of the folded faces (Newell's method)."""
-        a, b, start = self._halfedges()
+        return self._face_normal_3d(*self._halfedges())
+
+    def _face_normal_3d(self, a, b, start, nxt) -> np.ndarray:
+        """:meth:`face_normal_3d` from :meth:`_halfedges`."""
         p = self.vertices_3d[a]
-        centre = np.add.reduceat(p, start[:-1], axis=0) / np.diff(start)[:, None]
-        offset = np.repeat(centre, np.diff(start), axis=0)
-        n = np.add.reduceat(np.cross(p - offset, self.vertices_3d[b] - offset), start[:-1], axis=0)
+        size = np.diff(start)
+        q = p - np.repeat(np.add.reduceat(p, start[:-1]) / size[:, None], size, axis=0)
+        n = np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)  # q[nxt]: the next corner
         return n / np.linalg.norm(n, axis=1)[:, None]
 
     def _halfedges(self):
-        """(from (h,), to (h,), face_start (n_faces + 1,)) of the faces' half-edges."""
-        sizes = np.array([len(f) for f in self.faces], dtype=np.int64)
-        start = np.concatenate([[0], np.cumsum(sizes)])
+        """(from (h,), to (h,), face_start (n_faces + 1,), next (h,)) of the faces'
+        half-edges; ``next`` is the following half-edge of the same face."""
+        sizes = np.fromiter(map(len, self.faces), dtype=np.int64, count=len(self.faces))
+        start = np.zeros(len(sizes) + 1, dtype=np.int64)
+        np.cumsum(sizes, out=start[1:])
         a = np.concatenate(self.faces).astype(np.int64)
         nxt = np.arange(len(a)) + 1
         nxt[start[1:] - 1] = start[:-1]
-        return a, a[nxt], start
+        return a, a[nxt], start, nxt
 
     def _derive_edges(self):
         """Edges from faces; assignment and fold angle from the folded geometry.
@@ -159,7 +175,7 @@ class CreasePattern:
         with fold angle 0. Any other edge is a crease: M where the surface is convex seen from the
         front, V otherwise, with the fold angle between the two faces' 3D normals.
         """
-        a, b, start = self._halfedges()
+        a, b, start, _ = halfedges = self._halfedges()
         face_of = np.repeat(np.arange(len(self.faces)), np.diff(start))
         lo, hi = np.minimum(a, b), np.maximum(a, b)
         n = len(self.vertices_2d)
@@ -170,7 +186,7 @@ class CreasePattern:
         forward = a < b
         ef[inv[forward], 0] = face_of[forward]
         ef[inv[~forward], 1] = face_of[~forward]
-        normals = self.face_normal_3d()
+        normals = self._face_normal_3d(*halfedges)
         assign = np.full(len(uniq), "B", dtype="<U1")
         angle = np.zeros(len(uniq))
         inner = (ef >= 0).all(axis=1)
@@ -183,11 +199,16 @@ class CreasePattern:
         sin = np.einsum("ij,ij->i", cr, d)
         cos = np.einsum("ij,ij->i", na, nb)
         theta = np.degrees(np.arctan2(sin, cos))  # > 0: convex from the front (mountain)
-        patch = np.array(self.face_patch, dtype=object)
-        kind = np.array([p.split(" ")[0] for p in self.face_patch] or [""])
-        ka, kb = kind[fa], kind[fb]
-        tangent = ((ka == "cylinder") & (kb == "face")) | ((ka == "face") & (kb == "cylinder"))
-        coplanar = (ka == "face") & (kb == "face") & (np.abs(theta) < tol.coplanar_deg)
+        ids = dict.fromkeys(self.face_patch)  # patch name -> number, in order of first face
+        for k, name in enumerate(ids):
+            ids[name] = k
+        patch = np.fromiter(
+            map(ids.__getitem__, self.face_patch), dtype=np.int64, count=len(self.face_patch)
+        )
+        kind = np.array([p.split(" ")[0] for p in ids] or [""])
+        cyl, face = (kind == "cylinder")[patch], (kind == "face")[patch]
+        tangent = (cyl[fa] & face[fb]) | (face[fa] & cyl[fb])
+        coplanar = face[fa] & face[fb] & (np.abs(theta) < tol.coplanar_deg)
         smooth = (patch[fa] == patch[fb]) | tangent | coplanar
         a_in = np.where(smooth, "F", np.where(theta > 0, "M", "V"))
         assign[inner] = a_in

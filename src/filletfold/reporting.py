@@ -28,6 +28,29 @@ def _vec(x):
     return None if not np.all(np.isfinite(x)) else x.tolist()
 
 
+def _floats(x) -> list:
+    """``[float(v) for v in x]`` of a float array (n,)."""
+    return np.asarray(x, dtype=float).tolist()
+
+
+def _nums(x) -> list:
+    """``[_num(v) for v in x]``: floats, None for NaN and infinities."""
+    x = np.asarray(x, dtype=float)
+    out = x.tolist()
+    for i in np.flatnonzero(~np.isfinite(x)).tolist():
+        out[i] = None
+    return out
+
+
+def _vecs(x) -> list:
+    """``[_vec(row) for row in x]``: lists, None for a row with NaN or infinity."""
+    x = np.asarray(x, dtype=float)
+    out = x.tolist()
+    for i in np.flatnonzero(~np.isfinite(x).all(axis=1)).tolist():
+        out[i] = None
+    return out
+
+
 def design_report(design) -> dict:
     """The content of ``report.json`` (see the README for every key).
 
@@ -43,52 +66,87 @@ def design_report(design) -> dict:
     rd = design.rounding
     res = design.vertices
     pat = design.pattern
-    edges = []
-    for e, (a, b) in enumerate(mesh.edges):
-        f, g = mesh.edge_faces[e]
-        boundary = f < 0 or g < 0
-        edges.append(
-            {
-                "vertices": [int(a), int(b)],
-                "faces": None if boundary else [int(f), int(g)],
-                "length": float(mesh.edge_length[e]),
-                "radius": float(rd.radius[e]),
-                "half_angle": float(rd.half_angle[e]),
-                "assignment": "B" if boundary else ("M" if rd.kappa[e] > 0 else "V"),
-                "arc_length": float(rd.arc_length[e]),
-                "strip_width": float(rd.strip_width[e]),
-                "material_loss": float(rd.loss[e]),
-                "radius_limit": _num(rd.limit[e]),
-                "material_loss_limit": _num(loss_from_radius(rd.limit[e], rd.half_angle[e]))
-                if rd.half_angle[e] > 0
-                else None,
-            }
+    boundary = (mesh.edge_faces < 0).any(axis=1)
+    assignment = np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist()
+    bent = rd.half_angle > 0
+    loss_limit = np.full(mesh.n_edges, np.nan)
+    loss_limit[bent] = loss_from_radius(rd.limit[bent], rd.half_angle[bent])
+    edges = [
+        {
+            "vertices": ab,
+            "faces": None if bd else fg,
+            "length": length,
+            "radius": radius,
+            "half_angle": half,
+            "assignment": kind,
+            "arc_length": arc,
+            "strip_width": width,
+            "material_loss": loss,
+            "radius_limit": limit,
+            "material_loss_limit": limit_loss if bend else None,
+        }
+        for ab, fg, bd, length, radius, half, kind, arc, width, loss, limit, limit_loss, bend in (
+            zip(
+                mesh.edges.tolist(),
+                mesh.edge_faces.tolist(),
+                boundary.tolist(),
+                _floats(mesh.edge_length),
+                _floats(rd.radius),
+                _floats(rd.half_angle),
+                assignment,
+                _floats(rd.arc_length),
+                _floats(rd.strip_width),
+                _floats(rd.loss),
+                _nums(rd.limit),
+                _nums(loss_limit),
+                bent.tolist(),
+                strict=True,
+            )
         )
+    ]
     vertices = []
-    for u in range(mesh.n_vertices):
+    vertex_values = zip(
+        _nums(res.angle_sum),
+        _nums(res.defect),
+        _nums(res.solid_angle),
+        _vecs(res.normal),
+        _nums(res.normal_bound),
+        _vecs(res.apex),
+        _vecs(res.apex_developed),
+        _vecs(res.apex_2d),
+        _nums(res.depth_requested),
+        _nums(res.depth),
+        _nums(res.margin),
+        strict=True,
+    )
+    for u, values in enumerate(vertex_values):
         item = {
             "kind": res.kind[u],
             "status": res.status[u],
         }
         if res.status[u] != "ok":
             item["reason"] = res.reason[u]
+        angle_sum, defect, solid, normal, bound, apex, developed, apex_2d, asked, depth, margin = (
+            values
+        )
         item.update(
             {
-                "angle_sum": _num(res.angle_sum[u]),
-                "angle_defect": _num(res.defect[u]),
-                "solid_angle": _num(res.solid_angle[u]),
+                "angle_sum": angle_sum,
+                "angle_defect": defect,
+                "solid_angle": solid,
                 "sigma": int(res.sigma[u]) or None,
-                "normal": _vec(res.normal[u]),
-                "normal_bound": _num(res.normal_bound[u]),
-                "apex": _vec(res.apex[u]),
-                "apex_developed": _vec(res.apex_developed[u]),
-                "apex_2d": _vec(res.apex_2d[u]),
-                "depth_requested": _num(res.depth_requested[u]),
-                "depth": _num(res.depth[u]),
-                "margin": _num(res.margin[u]),
+                "normal": normal,
+                "normal_bound": bound,
+                "apex": apex,
+                "apex_developed": developed,
+                "apex_2d": apex_2d,
+                "depth_requested": asked,
+                "depth": depth,
+                "margin": margin,
             }
         )
         vertices.append(item)
+    mismatch, relative = _mismatches(pat)
     counts = {k: int(np.sum(pat.edge_assignment == k)) for k in ("M", "V", "B", "F")}
     return {
         "filletfold": __version__,
@@ -109,8 +167,8 @@ def design_report(design) -> dict:
             "vertices": len(pat.vertices_2d),
             "faces": len(pat.faces),
             "edges": counts,
-            "max_edge_mismatch": float(edge_mismatch(pat).max(initial=0.0)),
-            "max_relative_edge_mismatch": float(relative_mismatch(pat).max(initial=0.0)),
+            "max_edge_mismatch": float(mismatch.max(initial=0.0)),
+            "max_relative_edge_mismatch": float(relative.max(initial=0.0)),
         },
         "layout": {"kind": design.layout, "note": design.layout_note or None},
         "fabrication": _fabrication_report(design),
@@ -142,19 +200,29 @@ def _loss_report(loss) -> dict | None:
     }
 
 
-def edge_mismatch(pattern) -> np.ndarray:
-    """(n_edges,) 2D length minus 3D length of every pattern edge (>= 0 up to round-off)."""
+def _edge_lengths(pattern) -> tuple[np.ndarray, np.ndarray]:
+    """(n_edges,) 2D and 3D length of every pattern edge."""
     e = pattern.edges
     l2 = np.linalg.norm(pattern.vertices_2d[e[:, 0]] - pattern.vertices_2d[e[:, 1]], axis=1)
     l3 = np.linalg.norm(pattern.vertices_3d[e[:, 0]] - pattern.vertices_3d[e[:, 1]], axis=1)
+    return l2, l3
+
+
+def _mismatches(pattern) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`edge_mismatch` and :func:`relative_mismatch`, the lengths measured once."""
+    l2, l3 = _edge_lengths(pattern)
+    return l2 - l3, (l2 - l3) / np.where(l2 > 0, l2, 1.0)
+
+
+def edge_mismatch(pattern) -> np.ndarray:
+    """(n_edges,) 2D length minus 3D length of every pattern edge (>= 0 up to round-off)."""
+    l2, l3 = _edge_lengths(pattern)
     return l2 - l3
 
 
 def relative_mismatch(pattern) -> np.ndarray:
     """(n_edges,) edge mismatch divided by the 2D edge length (converges with order 2)."""
-    e = pattern.edges
-    l2 = np.linalg.norm(pattern.vertices_2d[e[:, 0]] - pattern.vertices_2d[e[:, 1]], axis=1)
-    return edge_mismatch(pattern) / np.where(l2 > 0, l2, 1.0)
+    return _mismatches(pattern)[1]
 
 
 def design_summary(design, max_listed: int = 8) -> str:
@@ -184,13 +252,14 @@ def design_summary(design, max_listed: int = 8) -> str:
         )
     if len(depth):
         lines.append(f"apex depth used: {depth.min():.4g}-{depth.max():.4g}")
+    mismatch, relative = _mismatches(pat)
     lines.append(
         f"pattern: {pat.n_pieces} piece{'s' if pat.n_pieces != 1 else ''} ({design.layout}), "
         f"{len(pat.faces)} faces, "
         f"{int(np.sum(pat.edge_assignment == 'M'))} mountain / "
         f"{int(np.sum(pat.edge_assignment == 'V'))} valley crease segments, "
-        f"max edge mismatch {edge_mismatch(pat).max(initial=0.0):.2e} "
-        f"(relative {relative_mismatch(pat).max(initial=0.0):.2e})"
+        f"max edge mismatch {mismatch.max(initial=0.0):.2e} "
+        f"(relative {relative.max(initial=0.0):.2e})"
     )
     if design.layout_note:
         lines.append(f"  no single sheet: {design.layout_note}")

@@ -33,12 +33,12 @@ import numpy as np
 from ..errors import ParameterError
 from ..pattern import Annotations, CreasePattern, Label
 from .dxf import DXF_INSUNITS, check_scale, pattern_dxf
-from .fold import fold_document, fold_json, validate_pattern
-from .obj import folded_obj
+from .fold import _fold_document, fold_json, validated_faces
+from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, page_size_mm, pattern_pdf
 from .png import pattern_png, preview_png
-from .svg import pattern_svg
+from .svg import _pattern_svg
 
 __all__ = [
     "ALL_FORMATS",
@@ -255,21 +255,21 @@ def cut_files(
             "(write it with 'filletfold round')",
             name="format",
         )
-    validate_pattern(pattern)
+    faces = validated_faces(pattern)  # checked once here for fold, obj and svg
 
     from .report import report_json
 
     out: dict[str, str | bytes] = {}
     for fmt in formats:
         if fmt == "fold":
-            doc = fold_document(pattern, title=title, description=description)
+            doc = _fold_document(pattern, faces, title=title, description=description, arrays=True)
             out["design.fold"] = fold_json(doc)
         elif fmt == "json":
             out["report.json"] = report if isinstance(report, str) else report_json(report)
         elif fmt == "obj":
-            out["folded.obj"] = folded_obj(pattern)
+            out["folded.obj"] = _folded_obj(pattern, faces)
         elif fmt == "svg":
-            out["pattern.svg"] = pattern_svg(scaled_pattern(pattern, scale), units=units)
+            out["pattern.svg"] = _pattern_svg(scaled_pattern(pattern, scale), units=units)
         elif fmt == "dxf":
             out["pattern.dxf"] = pattern_dxf(pattern, units=units, scale=scale)
         elif fmt == "pdf":

@@ -10,8 +10,10 @@ Also home of :func:`validate_pattern`, the entry check every exporter runs on a
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
+import operator
 from collections.abc import Mapping
 
 import numpy as np
@@ -24,12 +26,14 @@ __all__ = [
     "FOLD_SPEC",
     "NAMESPACE",
     "annotations_document",
+    "face_arrays",
     "face_signed_area_2d",
     "file_creator",
     "fold_document",
     "fold_json",
     "has_annotations",
     "validate_pattern",
+    "validated_faces",
 ]
 
 #: FOLD specification version written to ``file_spec``.
@@ -65,9 +69,14 @@ def face_signed_area_2d(vertices_2d: np.ndarray, faces: list) -> np.ndarray:
     """
     if len(faces) == 0:
         return np.zeros(0)
-    sizes = np.array([len(f) for f in faces], dtype=np.int64)
-    start = np.concatenate([[0], np.cumsum(sizes)])
-    a = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
+    a, start = face_arrays(faces)
+    return _signed_area(vertices_2d, a.astype(np.int64, copy=False), start)
+
+
+def _signed_area(vertices_2d: np.ndarray, a: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """:func:`face_signed_area_2d` of faces given as :func:`face_arrays`."""
+    if len(start) < 2:
+        return np.zeros(0)
     nxt = np.arange(len(a)) + 1
     nxt[start[1:] - 1] = start[:-1]
     p, q = vertices_2d[a], vertices_2d[a[nxt]]
@@ -75,8 +84,84 @@ def face_signed_area_2d(vertices_2d: np.ndarray, faces: list) -> np.ndarray:
     return 0.5 * np.add.reduceat(cross, start[:-1])
 
 
+def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
+    """Faces as one flat index array and their offsets.
+
+    Parameters
+    ----------
+    faces : list of (k,) int
+
+    Returns
+    -------
+    flat : (h,) int
+        The faces' vertex indices, one face after the other.
+    start : (n_faces + 1,) int
+        Face ``i`` is ``flat[start[i]:start[i + 1]]``.
+    """
+    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    start = np.zeros(len(faces) + 1, dtype=np.int64)
+    np.cumsum(sizes, out=start[1:])
+    if len(faces) == 0:
+        return np.zeros(0, dtype=np.int64), start
+    flat = np.concatenate(faces)
+    if np.issubdtype(flat.dtype, np.integer):
+        flat = flat.astype(np.int64, copy=False)
+    return flat, start
+
+
+def _face_arrays_if_valid(faces, n: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`face_arrays` when every face is a 1-D list of at least 3 integer indices in
+    ``0..n-1``, checked all at once; None otherwise (or when the faces cannot be read that
+    way): :func:`validate_pattern` then finds the first bad face."""
+    if not _integer_faces(faces):
+        return None
+    try:
+        flat, start = face_arrays(faces)
+    except (TypeError, ValueError):
+        return None
+    ok = (
+        flat.ndim == 1
+        and len(flat) == start[-1]
+        and np.issubdtype(flat.dtype, np.integer)
+        and (len(faces) == 0 or (np.diff(start).min() >= 3 and flat.min() >= 0 and flat.max() < n))
+    )
+    return (flat, start) if ok else None
+
+
+def _integer_faces(faces) -> bool:
+    """Whether every face is an integer array, or a list or tuple of integers (not booleans),
+    so that joining them keeps each face's values (no face of booleans read as 0 and 1)."""
+    kinds = set(map(type, faces))
+    if not kinds <= {np.ndarray, list, tuple}:
+        return False
+    if kinds == {np.ndarray}:
+        dtypes = set(map(operator.attrgetter("dtype"), faces))
+        return all(np.issubdtype(dtype, np.integer) for dtype in dtypes)
+    arrays = [f for f in faces if type(f) is np.ndarray]
+    if any(not np.issubdtype(f.dtype, np.integer) for f in arrays):
+        return False
+    items = [f for f in faces if type(f) is not np.ndarray] if arrays else faces
+    return all(
+        t is not bool and issubclass(t, int | np.integer)
+        for t in set(map(type, itertools.chain.from_iterable(items)))
+    )
+
+
 def validate_pattern(pattern: CreasePattern) -> None:
     """Check that a crease pattern is complete and consistent enough to export.
+
+    See :func:`validated_faces`, which this calls.
+
+    Raises
+    ------
+    ExportError
+        Naming the first offending element.
+    """
+    validated_faces(pattern)
+
+
+def validated_faces(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
+    """Check a crease pattern (see below) and return its faces as :func:`face_arrays`.
 
     Checks: matching vertex counts in 2D and 3D, finite coordinates, faces of at least three
     in-range vertex indices, one patch name and one piece per face, edge arrays of one length,
@@ -105,12 +190,18 @@ def validate_pattern(pattern: CreasePattern) -> None:
         if len(bad):
             raise ExportError(f"pattern {name}[{bad[0]}] is not finite")
     n_faces = len(pattern.faces)
-    for i, f in enumerate(pattern.faces):
-        idx = np.asarray(f)
-        if idx.ndim != 1 or len(idx) < 3 or not np.issubdtype(idx.dtype, np.integer):
-            raise ExportError(f"pattern face {i} must list at least 3 integer vertex indices")
-        if idx.min() < 0 or idx.max() >= n:
-            raise ExportError(f"pattern face {i} refers to a vertex outside 0..{n - 1}")
+    checked = _face_arrays_if_valid(pattern.faces, n)
+    if checked is None:
+        for i, f in enumerate(pattern.faces):
+            idx = np.asarray(f)
+            if idx.ndim != 1 or len(idx) < 3 or not np.issubdtype(idx.dtype, np.integer):
+                raise ExportError(f"pattern face {i} must list at least 3 integer vertex indices")
+            if idx.min() < 0 or idx.max() >= n:
+                raise ExportError(f"pattern face {i} refers to a vertex outside 0..{n - 1}")
+        sizes = np.fromiter(map(len, pattern.faces), dtype=np.int64, count=n_faces)
+        start = np.concatenate([[0], np.cumsum(sizes)])
+        flat = np.concatenate([np.asarray(f, dtype=np.int64) for f in pattern.faces] or [[]])
+        checked = flat.astype(np.int64), start
     if len(pattern.face_patch) != n_faces:
         raise ExportError(
             f"pattern has {n_faces} faces but {len(pattern.face_patch)} face_patch names"
@@ -150,11 +241,12 @@ def validate_pattern(pattern: CreasePattern) -> None:
             "(valley > 0, mountain < 0, border and flat 0)"
         )
     if n_faces:
-        area = face_signed_area_2d(v2, pattern.faces)
+        area = _signed_area(v2, *checked)
         scale = float(np.ptp(v2, axis=0).max()) if n else 0.0
         cw = np.flatnonzero(area < -tol.area * max(scale, 1.0) ** 2)
         if len(cw):
             raise ExportError(f"pattern face {cw[0]} is clockwise in the flat layout")
+    return checked
 
 
 def fold_document(
@@ -195,10 +287,37 @@ def fold_document(
         When ``title``/``description`` are not strings or an ``extra`` key is not namespaced or
         clashes with a key of the document.
     """
-    validate_pattern(pattern)
+    return _fold_document(
+        pattern, validated_faces(pattern), title=title, description=description, extra=extra
+    )
+
+
+def _fold_document(
+    pattern: CreasePattern,
+    faces: tuple[np.ndarray, np.ndarray],
+    *,
+    title: str = "",
+    description: str = "",
+    extra: Mapping | None = None,
+    arrays: bool = False,
+) -> dict:
+    """:func:`fold_document` of a pattern already checked (``faces`` from
+    :func:`validated_faces`); with ``arrays`` the numbers stay numpy arrays (and the faces
+    :class:`_RaggedInts`): the same text from :func:`fold_json`, without lists in between."""
     for name, value in (("title", title), ("description", description)):
         if not isinstance(value, str):
             raise ParameterError(f"{name} must be a string, got {type(value).__name__}", name=name)
+    flat, start = faces
+
+    def as_data(x: np.ndarray):
+        return x if arrays else x.tolist()
+
+    if arrays:
+        faces_vertices = _RaggedInts(flat, start)
+    else:
+        flat_list = flat.tolist()
+        faces_vertices = list(map(flat_list.__getitem__, map(slice, start[:-1], start[1:])))
+
     doc = {
         "file_spec": FOLD_SPEC,
         "file_creator": file_creator(),
@@ -208,21 +327,21 @@ def fold_document(
         "frame_classes": ["creasePattern"],
         "frame_attributes": ["2D"],
         "frame_unit": "unit",
-        "vertices_coords": pattern.vertices_2d.tolist(),
-        "edges_vertices": np.asarray(pattern.edges, dtype=np.int64).tolist(),
-        "edges_assignment": [str(a) for a in pattern.edge_assignment],
-        "edges_foldAngle": np.asarray(pattern.edge_fold_angle, dtype=np.float64).tolist(),
-        "faces_vertices": [[int(v) for v in f] for f in pattern.faces],
-        NAMESPACE + "faces_patch": [str(p) for p in pattern.face_patch],
-        NAMESPACE + "faces_piece": pattern.face_piece.tolist(),
-        NAMESPACE + "pieces_vertex": pattern.piece_vertex.tolist(),
+        "vertices_coords": as_data(pattern.vertices_2d),
+        "edges_vertices": as_data(np.asarray(pattern.edges, dtype=np.int64)),
+        "edges_assignment": _assignment_data(pattern.edge_assignment, arrays),
+        "edges_foldAngle": as_data(np.asarray(pattern.edge_fold_angle, dtype=np.float64)),
+        "faces_vertices": faces_vertices,
+        NAMESPACE + "faces_patch": list(map(str, pattern.face_patch)),
+        NAMESPACE + "faces_piece": as_data(pattern.face_piece),
+        NAMESPACE + "pieces_vertex": as_data(pattern.piece_vertex),
         "file_frames": [
             {
                 "frame_classes": ["foldedForm"],
                 "frame_parent": 0,
                 "frame_inherit": True,
                 "frame_attributes": ["3D"],
-                "vertices_coords": pattern.vertices_3d.tolist(),
+                "vertices_coords": as_data(pattern.vertices_3d),
             }
         ],
     }
@@ -239,6 +358,14 @@ def fold_document(
             )
         doc[key] = value
     return doc
+
+
+def _assignment_data(assignment, raw: bool) -> list | _Raw:
+    """The assignments (checked to be ``M V B F``) as a list, or with ``raw`` as JSON text."""
+    items = np.asarray(assignment, dtype=str).tolist()
+    if not raw:
+        return items
+    return _Raw('["' + '","'.join(items) + '"]' if items else "[]")
 
 
 def has_annotations(annotations: Annotations) -> bool:
@@ -293,10 +420,122 @@ def _round(x: float) -> float:
     return 0.0 if r == 0 else r
 
 
+class _RaggedInts:
+    """Integer lists of several lengths, as :func:`face_arrays` (``flat``, ``start``)."""
+
+    __slots__ = ("flat", "start")
+
+    def __init__(self, flat: np.ndarray, start: np.ndarray):
+        self.flat, self.start = flat, start
+
+    def text(self) -> str:
+        """Compact JSON: ``[[a,b,c],[d,e,f,g],...]``."""
+        size = np.diff(self.start).tolist()
+        spec = {k: "[" + ",".join(["%d"] * k) + "]" for k in set(size)}
+        return ("[" + ",".join([spec[k] for k in size]) + "]") % tuple(self.flat.tolist())
+
+
+class _Raw:
+    """Compact JSON text of a value, ready to write (see :func:`_float_text`, :func:`_dump`)."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str):
+        self.text = text
+
+
+#: Exact types :func:`_plain` passes through unchanged.
+_AS_IS = frozenset({int, str, bool, type(None)})
+
+
+def _float_text(a: np.ndarray) -> str:
+    """Compact JSON of a finite float array (1-D or 2-D), each value as :func:`_round` and
+    ``json.dumps`` would write it, formatted in bulk.
+
+    ``%.12g`` writes a normal float's 12-digit rounding with the digits of ``repr`` of that
+    rounding (two different 12-digit decimals are never one double). It differs from ``repr``
+    only for integral values (no ``.0``), from ``1e12`` on (exponent form) and below the normal
+    range (subnormals keep fewer digits): zeros are written ``0.0``, the other few with
+    ``repr`` of :func:`_round` itself.
+    """
+    x = np.asarray(a, dtype=np.float64).ravel() + 0.0  # -0.0 becomes 0.0
+    k = a.shape[1] if a.ndim == 2 else 1
+    open_, sep, close = ("[[", "],[", "]]") if a.ndim == 2 else ("[", ",", "]")
+    mag = np.abs(x)
+    special = (np.abs(x - np.rint(x)) <= 1e-11 * mag) | (mag >= 1e11) | (mag < 1e-300)
+    if not special.any():
+        row = ",".join(["%.12g"] * k)
+        return (open_ + sep.join([row] * (len(x) // k)) + close) % tuple(x.tolist())
+    zero = x == 0
+    other = special & ~zero
+    values = x[~zero].tolist()  # zeros are written as the literal 0.0
+    for i in (np.cumsum(~zero) - 1)[other].tolist():
+        values[i] = _round(values[i])
+    kind = np.zeros(len(x), dtype=np.int8)  # 0: %.12g, 1: 0.0, 2: %r
+    kind[zero], kind[other] = 1, 2
+    specs = ("%.12g", "0.0", "%r")
+    if a.ndim == 2:
+        rows = np.unique(np.flatnonzero(special) // k)
+        if 8 * len(rows) < len(a):  # few rows to change: a template per row
+            template = ["[" + ",".join(["%.12g"] * k) + "]"] * len(a)
+            for r, row in zip(rows.tolist(), kind.reshape(-1, k)[rows].tolist(), strict=True):
+                template[r] = "[" + ",".join([specs[j] for j in row]) + "]"
+            return ("[" + ",".join(template) + "]") % tuple(values)
+    spec = np.array(specs, dtype=object)[kind]
+    if a.ndim == 1:
+        return ("[" + ",".join(spec.tolist()) + "]") % tuple(values)
+    after = np.full(len(x), ",", dtype=object)
+    after[k - 1 :: k] = sep
+    parts = np.empty(2 * len(x), dtype=object)
+    parts[0::2], parts[1::2] = spec, after
+    return (open_ + "".join(parts[:-1].tolist()) + close) % tuple(values)
+
+
+def _int_text(a: np.ndarray) -> str:
+    """Compact JSON of an integer array (1-D or 2-D)."""
+    if a.ndim == 1:
+        return "[" + ",".join(map(str, a.tolist())) + "]"
+    row = "[" + ",".join(["%d"] * a.shape[1]) + "]"
+    return ("[" + ",".join([row] * len(a)) + "]") % tuple(a.ravel().tolist())
+
+
+def _plain_list(items) -> list | _Raw | None:
+    """:func:`_plain` of a list or tuple whose items (or items' items) are all of one simple
+    kind, without visiting them one by one in Python; None when they are not."""
+    if not items:
+        return []
+    kinds = set(map(type, items))
+    if kinds <= _AS_IS:
+        return list(items)
+    if kinds == {float}:
+        a = np.array(items, dtype=np.float64)
+        return _Raw(_float_text(a)) if np.isfinite(a).all() else None
+    if kinds <= {list, tuple}:
+        inner = set(map(type, itertools.chain.from_iterable(items)))
+        if inner <= _AS_IS:
+            return [v if type(v) is list else list(v) for v in items]
+        if inner == {float} and len(set(map(len, items))) == 1:
+            a = np.array(items, dtype=np.float64)
+            return _Raw(_float_text(a)) if np.isfinite(a).all() else None
+    return None
+
+
 def _plain(obj, where: str):
-    """JSON-ready copy of ``obj``: numpy to Python, floats rounded, tuples to lists."""
+    """JSON-ready copy of ``obj``: numpy to Python, floats rounded, tuples to lists.
+
+    Arrays and lists of floats become :class:`_Raw` text (written as is by :func:`_dump`).
+    """
     if isinstance(obj, np.ndarray):
+        if obj.ndim in (1, 2) and obj.size:
+            if obj.dtype.kind == "f" and np.isfinite(obj).all():
+                return _Raw(_float_text(obj))
+            if obj.dtype.kind in "iu":
+                return _Raw(_int_text(obj))
         obj = obj.tolist()
+    elif isinstance(obj, _RaggedInts):
+        return _Raw(obj.text())
+    elif isinstance(obj, _Raw):
+        return obj
     elif isinstance(obj, np.generic):
         obj = obj.item()
     if obj is None or isinstance(obj, bool | str):
@@ -316,10 +555,26 @@ def _plain(obj, where: str):
             out[k] = _plain(v, f"{where}.{k}" if where else k)
         return out
     if isinstance(obj, list | tuple):
+        fast = _plain_list(obj)
+        if fast is not None:
+            return fast
         return [_plain(v, f"{where}[{i}]") for i, v in enumerate(obj)]
     raise ExportError(
         f"FOLD value at {where or 'top level'} has unsupported type {type(obj).__name__}"
     )
+
+
+def _compact(obj) -> str:
+    """``json.dumps(obj, separators=(",", ":"))``, with :class:`_Raw` text inside written as is."""
+    if isinstance(obj, _Raw):
+        return obj.text
+    try:
+        return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+    except TypeError:  # a _Raw inside
+        pass
+    if isinstance(obj, dict):
+        return "{" + ",".join(json.dumps(k) + ":" + _compact(v) for k, v in obj.items()) + "}"
+    return "[" + ",".join(map(_compact, obj)) + "]"
 
 
 def _dump(obj, depth: int) -> str:
@@ -328,10 +583,10 @@ def _dump(obj, depth: int) -> str:
     if isinstance(obj, dict) and obj:
         items = [f"{pad}  {json.dumps(k)}: {_dump(v, depth + 1)}" for k, v in obj.items()]
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
-    if isinstance(obj, list) and any(isinstance(v, dict) for v in obj):
+    if isinstance(obj, list) and dict in set(map(type, obj)):  # _plain made mappings dicts
         items = [f"{pad}  {_dump(v, depth + 1)}" for v in obj]
         return "[\n" + ",\n".join(items) + "\n" + pad + "]"
-    return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+    return _compact(obj)
 
 
 def fold_json(doc: Mapping) -> str:

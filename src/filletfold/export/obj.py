@@ -8,7 +8,7 @@ import numpy as np
 
 from ..pattern import CreasePattern
 from ..tolerances import tol
-from .fold import file_creator, validate_pattern
+from .fold import face_arrays, file_creator, validated_faces
 
 __all__ = ["folded_obj", "obj_group_name", "vertex_normal_3d"]
 
@@ -34,24 +34,22 @@ def vertex_normal_3d(vertices_3d: np.ndarray, faces: list) -> np.ndarray:
         faces; ``(0, 0, 1)`` for a vertex in no face or where the sum vanishes.
     """
     acc = np.zeros((len(vertices_3d), 3))
-    for f in faces:
-        idx = np.asarray(f, dtype=np.int64)
-        p = vertices_3d[idx]
-        p = p - p.mean(axis=0)
-        area_normal = 0.5 * np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0)
-        np.add.at(acc, idx, area_normal)
+    if len(faces):
+        flat, start = face_arrays(faces)
+        flat = flat.astype(np.int64, copy=False)
+        size = np.diff(start)
+        p = vertices_3d[flat]
+        p = p - np.repeat(np.add.reduceat(p, start[:-1], axis=0) / size[:, None], size, axis=0)
+        nxt = np.arange(1, len(flat) + 1)
+        nxt[start[1:] - 1] = start[:-1]
+        area_normal = 0.5 * np.add.reduceat(np.cross(p, p[nxt]), start[:-1], axis=0)
+        np.add.at(acc, flat, np.repeat(area_normal, size, axis=0))
     norm = np.linalg.norm(acc, axis=1)
     scale = norm.max() if len(norm) else 0.0
     ok = norm > tol.area * scale if scale > 0 else np.zeros(len(norm), dtype=bool)
     out = np.tile([0.0, 0.0, 1.0], (len(acc), 1))
     out[ok] = acc[ok] / norm[ok, None]
     return out
-
-
-def _num(x: float) -> str:
-    """12 significant digits, ``-0`` written as ``0``."""
-    s = f"{x:.12g}"
-    return "0" if s in ("-0", "0") else s
 
 
 def folded_obj(pattern: CreasePattern, *, vertex_normals: bool = False) -> str:
@@ -79,26 +77,49 @@ def folded_obj(pattern: CreasePattern, *, vertex_normals: bool = False) -> str:
     ExportError
         When the pattern is inconsistent.
     """
-    validate_pattern(pattern)
-    v3 = pattern.vertices_3d
-    lines = [
-        f"# {file_creator()}: folded form",
-        f"# {len(v3)} vertices, {len(pattern.faces)} faces, {len(set(pattern.face_patch))} patches",
-    ]
-    lines.extend(f"v {_num(a)} {_num(b)} {_num(c)}" for a, b, c in v3)
-    if vertex_normals:
-        vn = vertex_normal_3d(v3, pattern.faces)
-        lines.extend(f"vn {_num(a)} {_num(b)} {_num(c)}" for a, b, c in vn)
+    return _folded_obj(pattern, validated_faces(pattern), vertex_normals=vertex_normals)
 
-    groups: dict[str, list[int]] = {}
-    for i, patch in enumerate(pattern.face_patch):
-        groups.setdefault(obj_group_name(patch), []).append(i)
-    for name, face_ids in groups.items():
-        lines.append(f"g {name}")
-        for i in face_ids:
-            ids = [int(k) + 1 for k in pattern.faces[i]]
-            if vertex_normals:
-                lines.append("f " + " ".join(f"{k}//{k}" for k in ids))
-            else:
-                lines.append("f " + " ".join(str(k) for k in ids))
-    return "\n".join(lines) + "\n"
+
+def _xyz_lines(tag: str, xyz: np.ndarray) -> str:
+    """``"<tag> x y z\\n"`` per row of ``xyz`` (n, 3), numbers with 12 significant digits
+    (``-0`` written as ``0``)."""
+    return (f"{tag} %.12g %.12g %.12g\n" * len(xyz)) % tuple((xyz + 0.0).ravel().tolist())
+
+
+def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) -> str:
+    """:func:`folded_obj` of a pattern already checked (``faces`` from
+    :func:`~filletfold.export.fold.validated_faces`)."""
+    v3 = pattern.vertices_3d
+    flat, start = faces
+    patches = dict.fromkeys(pattern.face_patch)  # in order of their first face
+    head = (
+        f"# {file_creator()}: folded form\n"
+        f"# {len(v3)} vertices, {len(pattern.faces)} faces, {len(patches)} patches\n"
+    )
+    parts = [head, _xyz_lines("v", v3)]
+    if vertex_normals:
+        parts.append(_xyz_lines("vn", vertex_normal_3d(v3, pattern.faces)))
+    # groups in order of their first face; faces in pattern order within a group
+    group_id: dict[str, int] = {}
+    for p in patches:
+        patches[p] = group_id.setdefault(obj_group_name(p), len(group_id))
+    group = np.fromiter(
+        map(patches.__getitem__, pattern.face_patch), dtype=np.int64, count=len(pattern.face_patch)
+    )
+    order = np.argsort(group, kind="stable")
+    size = np.diff(start)[order]
+    first = np.concatenate([[0], np.cumsum(size)])
+    corner = np.repeat(start[:-1][order] - first[:-1], size) + np.arange(first[-1])
+    ids = flat[corner] + 1
+    if vertex_normals:
+        ids = np.repeat(ids, 2)
+    spec = " %d//%d" if vertex_normals else " %d"
+    face_line = {k: "f" + spec * k + "\n" for k in set(size.tolist())}
+    lines = [face_line[k] for k in size.tolist()]
+    ends = np.flatnonzero(np.diff(group[order], append=len(group_id))).tolist()
+    template = [
+        "g " + name.replace("%", "%%") + "\n" + "".join(lines[a + 1 : b + 1])
+        for name, a, b in zip(group_id, [-1, *ends[:-1]], ends, strict=True)
+    ]
+    parts.append("".join(template) % tuple(ids.tolist()))
+    return "".join(parts)

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import itertools
 import json
 import math
 from collections.abc import Mapping
+from json.encoder import encode_basestring_ascii as _quote
 from pathlib import PurePath
 
 import numpy as np
@@ -65,6 +67,9 @@ def to_json_data(obj, where: str = ""):
             out[key] = to_json_data(v, f"{where}.{key}" if where else key)
         return out
     if isinstance(obj, list | tuple):
+        fast = _plain_list(obj)
+        if fast is not None:
+            return fast
         return [to_json_data(v, f"{where}[{i}]") for i, v in enumerate(obj)]
     if isinstance(obj, set | frozenset):
         items = [to_json_data(v, f"{where}{{}}") for v in obj]
@@ -75,6 +80,29 @@ def to_json_data(obj, where: str = ""):
     raise ExportError(
         f"report value at {where or 'top level'} has no JSON form ({type(obj).__name__})"
     )
+
+
+#: Exact types :func:`to_json_data` passes through unchanged.
+_AS_IS = frozenset({int, str, bool, type(None)})
+
+
+def _plain_list(items) -> list | None:
+    """:func:`to_json_data` of a list or tuple of numbers, strings, booleans and None, or of
+    lists of those, all at once; None for anything else."""
+    kinds = set(map(type, items))
+    if kinds <= _AS_IS:
+        return list(items)
+    if kinds <= _AS_IS | {float}:
+        return [v if type(v) is not float or math.isfinite(v) else None for v in items]
+    if kinds <= {list, tuple}:
+        inner = set(map(type, itertools.chain.from_iterable(items)))
+        if inner <= _AS_IS:
+            return [list(v) for v in items]
+        if inner <= _AS_IS | {float}:
+            return [
+                [x if type(x) is not float or math.isfinite(x) else None for x in v] for v in items
+            ]
+    return None
 
 
 def _key(k, where: str) -> str:
@@ -110,4 +138,37 @@ def report_json(report: Mapping) -> str:
     ExportError
         When a value has no JSON form.
     """
-    return json.dumps(to_json_data(report), indent=2, allow_nan=False) + "\n"
+    return _indented(to_json_data(report), "\n") + "\n"
+
+
+#: Exact types whose JSON text is their ``repr`` (finite floats only, see :func:`_indented`).
+_REPR_TYPES = frozenset({int, float})
+
+
+def _indented(obj, newline: str) -> str:
+    """``json.dumps(obj, indent=2, allow_nan=False)`` of JSON data (dicts with string keys,
+    lists, strings, numbers, booleans, None), with lists of numbers or strings written in one
+    go; ``newline`` is a newline and the indentation of ``obj``'s line."""
+    inner = newline + "  "
+    if isinstance(obj, dict):
+        if not obj:
+            return "{}"
+        items = [_quote(k) + ": " + _indented(v, inner) for k, v in obj.items()]
+        return "{" + inner + ("," + inner).join(items) + newline + "}"
+    if isinstance(obj, list):
+        if not obj:
+            return "[]"
+        kinds = set(map(type, obj))
+        if kinds <= _REPR_TYPES and (float not in kinds or all(map(math.isfinite, obj))):
+            items = map(repr, obj)
+        elif kinds == {str}:
+            items = map(_quote, obj)
+        else:
+            items = (_indented(v, inner) for v in obj)
+        return "[" + inner + ("," + inner).join(items) + newline + "]"
+    kind = type(obj)
+    if kind is str:
+        return _quote(obj)
+    if kind is int or (kind is float and math.isfinite(obj)):
+        return repr(obj)
+    return json.dumps(obj, allow_nan=False)

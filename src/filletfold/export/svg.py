@@ -88,6 +88,20 @@ def _formatter(decimals: int):
     return fmt
 
 
+def _format_all(x: np.ndarray, decimals: int) -> list[str]:
+    """``_formatter(decimals)`` of every value of ``x`` (k,), formatted in bulk."""
+    if len(x) == 0:
+        return []
+    out = ((f"%.{decimals}f\n" * len(x)) % tuple(x.tolist()))[:-1].split("\n")
+    if decimals > 0:  # strip trailing zeros and a trailing point
+        out = [t.rstrip("0").rstrip(".") for t in out]
+    # "-0" (a small negative) and "" are written "0"
+    for i in np.flatnonzero(np.signbit(x) & (x > -(10.0**-decimals))).tolist():
+        if out[i] in ("-0", ""):
+            out[i] = "0"
+    return out
+
+
 def pattern_svg(
     pattern: CreasePattern,
     *,
@@ -135,7 +149,11 @@ def pattern_svg(
             f"stroke_mm must be a positive number, got {stroke_mm!r}", name="stroke_mm"
         )
     validate_pattern(pattern)
+    return _pattern_svg(pattern, units, stroke_mm, flat_edges, angle_opacity)
 
+
+def _pattern_svg(pattern, units="", stroke_mm=0.3, flat_edges=False, angle_opacity=False) -> str:
+    """:func:`pattern_svg` of a pattern and arguments already checked."""
     v = pattern.vertices_2d
     lo, hi = pattern_extent(pattern)
     size = hi - lo
@@ -152,8 +170,12 @@ def pattern_svg(
     # drawing coordinates: x right, y down, pattern's top-left at (margin, margin)
     x = v[:, 0] - lo[0] + margin
     y = hi[1] - v[:, 1] + margin
-    xs = [fmt(t) for t in x]
-    ys = [fmt(t) for t in y]
+    used = np.zeros(len(v), dtype=bool)  # only the ends of edges are drawn
+    used[np.asarray(pattern.edges, dtype=np.int64).ravel()] = True
+    xs = np.full(len(v), "", dtype=object)
+    ys = np.full(len(v), "", dtype=object)
+    xs[used] = _format_all(x[used], decimals)
+    ys[used] = _format_all(y[used], decimals)
 
     edges = np.asarray(pattern.edges, dtype=np.int64)
     assign = np.asarray(pattern.edge_assignment)
@@ -168,12 +190,16 @@ def pattern_svg(
         color = ASSIGNMENT_COLOR[code]
         legend.append((color, label))
         body.append(f'<g id="{gid}" stroke-width="{sw}" stroke-linecap="round" fill="none">')
-        for e in np.flatnonzero(assign == code):
-            a, b = edges[e]
-            attrs = f'x1="{xs[a]}" y1="{ys[a]}" x2="{xs[b]}" y2="{ys[b]}" stroke="{color}"'
+        sel = np.flatnonzero(assign == code)
+        if len(sel):
+            a, b = edges[sel, 0], edges[sel, 1]
+            cols = [xs[a], ys[a], xs[b], ys[b]]
+            line = f'<line x1="%s" y1="%s" x2="%s" y2="%s" stroke="{color}"/>\n'
             if angle_opacity and code in ("M", "V"):
-                attrs += f' opacity="{min(abs(angle[e]) / 180.0, 1.0):.4f}"'
-            body.append(f"<line {attrs}/>")
+                line = line[:-3] + ' opacity="%.4f"/>\n'
+                cols.append(np.minimum(np.abs(angle[sel]) / 180.0, 1.0))
+            values = np.stack(cols, axis=1).ravel().tolist()
+            body.append((line * len(sel))[:-1] % tuple(values))
         body.append("</g>")
     body.extend(_annotation_groups(pattern, lo, hi, margin, fmt, sw))
 

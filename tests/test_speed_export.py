@@ -1,0 +1,297 @@
+"""The vectorised exporters (issue 6) write the bytes of the plain per-element loops."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from filletfold.errors import ExportError
+from filletfold.export import (
+    cut_files,
+    fold_document,
+    fold_json,
+    folded_obj,
+    pattern_svg,
+    report_json,
+    validate_pattern,
+)
+from filletfold.export.fold import _float_text, _round, validated_faces
+from filletfold.export.obj import obj_group_name
+from filletfold.export.report import to_json_data
+from filletfold.pattern import CreasePattern
+
+from .conftest import design_of
+
+NAMES = ["cube", "torus", "house", "open-box", "miura"]
+
+
+# ---------------------------------------------------------------- reference loops
+
+
+def ref_plain(obj):
+    """FOLD values one by one: numpy to Python, floats to 12 digits, -0 to 0."""
+    obj = obj.tolist() if isinstance(obj, np.ndarray | np.generic) else obj
+    if isinstance(obj, float):
+        return _round(obj)
+    if isinstance(obj, Mapping):
+        return {k: ref_plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [ref_plain(v) for v in obj]
+    return obj
+
+
+def ref_dump(obj, depth=0) -> str:
+    pad = "  " * depth
+    if isinstance(obj, dict) and obj:
+        items = [f"{pad}  {json.dumps(k)}: {ref_dump(v, depth + 1)}" for k, v in obj.items()]
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if isinstance(obj, list) and any(isinstance(v, dict) for v in obj):
+        items = [f"{pad}  {ref_dump(v, depth + 1)}" for v in obj]
+        return "[\n" + ",\n".join(items) + "\n" + pad + "]"
+    return json.dumps(obj, separators=(",", ":"), allow_nan=False)
+
+
+def ref_fold_json(doc) -> str:
+    return ref_dump(ref_plain(doc)) + "\n"
+
+
+def ref_obj(pattern: CreasePattern) -> str:
+    def num(x):
+        s = f"{x:.12g}"
+        return "0" if s in ("-0", "0") else s
+
+    lines = [
+        "# header",
+        f"# {len(pattern.vertices_3d)} vertices, {len(pattern.faces)} faces, "
+        f"{len(set(pattern.face_patch))} patches",
+    ]
+    lines.extend(f"v {num(a)} {num(b)} {num(c)}" for a, b, c in pattern.vertices_3d)
+    groups: dict[str, list[int]] = {}
+    for i, patch in enumerate(pattern.face_patch):
+        groups.setdefault(obj_group_name(patch), []).append(i)
+    for name, ids in groups.items():
+        lines.append(f"g {name}")
+        lines.extend("f " + " ".join(str(int(k) + 1) for k in pattern.faces[i]) for i in ids)
+    return "\n".join(lines) + "\n"
+
+
+def ref_svg_number(x: float, decimals: int) -> str:
+    s = f"{x:.{decimals}f}"
+    if "." in s:
+        s = s.rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+# ---------------------------------------------------------------- FOLD
+
+
+SPECIAL = [0.0, -0.0, 1.0, -7.0, 0.5, 1e-5, 1e-4, 1 / 3, 0.1 + 0.2, 1e11, 1e12, 999999999999.5]
+SPECIAL += [1.5e15, 1e16, 1e17, 5e-324, 1e-310, 2.2250738585072014e-308, 123456789012.4]
+SPECIAL += [2.0**52, 1e-11, 1.00000000000001, 0.99999999999999, 12345678901.99999]
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(
+        st.one_of(
+            st.floats(allow_nan=False, allow_infinity=False),
+            st.sampled_from(SPECIAL),
+            st.integers(-(10**6), 10**6).map(float),
+        ),
+        min_size=1,
+        max_size=60,
+    ),
+    st.sampled_from([1, 2, 3]),
+)
+def test_float_text_is_round_then_repr(values, k):
+    x = np.array(values[: len(values) // k * k] or values[:1] * k, dtype=float)
+    assert _float_text(x) == json.dumps([_round(v) for v in x.tolist()], separators=(",", ":"))
+    m = x.reshape(-1, k)
+    rows = [[_round(v) for v in r] for r in m.tolist()]
+    assert _float_text(m) == json.dumps(rows, separators=(",", ":"))
+
+
+def test_float_text_many_zeros_and_few_zeros():
+    rng = np.random.default_rng(3)
+    for share in (0.001, 0.3, 1.0):
+        x = np.where(rng.random(3000) < share, 0.0, rng.normal(size=3000)).reshape(-1, 3)
+        x[::5, 1] = -0.0
+        ref = json.dumps([[_round(v) for v in r] for r in x.tolist()], separators=(",", ":"))
+        assert _float_text(x) == ref
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_fold_text_is_the_loops_text(name):
+    p = design_of(name).pattern
+    doc = fold_document(p, title="t", extra={"filletfold:x": [np.arange(3.0), {"y": (1.5, 2)}]})
+    assert fold_json(doc) == ref_fold_json(doc)
+    files = cut_files(p, "fold", title="t")
+    assert files["design.fold"] == fold_json(fold_document(p, title="t"))
+
+
+def test_fold_json_mixed_and_nested_values():
+    doc = {
+        "a": [1, 2.0, True, None, "s"],
+        "b": [[1.0, 2.0], [3.0]],
+        "c": [[{"d": np.array([0.25, -0.0])}], np.array([[1, 2], [3, 4]])],
+        "e": (np.float32(0.1), np.int64(3)),
+        "f": [],
+        "g": [[], []],
+        "h": np.zeros((0, 2)),
+        "i": {"j": [np.array([1e20, 1e-320])]},
+    }
+    assert fold_json(doc) == ref_fold_json(doc)
+
+
+def test_fold_json_still_rejects_non_finite_inside_arrays():
+    with pytest.raises(ExportError, match=r"a\[1\] is not finite"):
+        fold_json({"a": np.array([1.0, np.inf])})
+    with pytest.raises(ExportError, match=r"a\[0\]\[1\] is not finite"):
+        fold_json({"a": [[1.0, float("nan")]]})
+
+
+# ---------------------------------------------------------------- OBJ
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_obj_is_the_loops_text(name):
+    p = design_of(name).pattern
+    text = folded_obj(p)
+    assert text.split("\n", 1)[1] == ref_obj(p).split("\n", 1)[1]
+    assert cut_files(p, "obj")["folded.obj"] == text
+
+
+def test_obj_group_names_with_percent_and_minus_zero():
+    v2 = np.array([[0, 0], [1, 0], [0, 1], [1, 1]], dtype=float)
+    v3 = np.array([[-0.0, 0, 0], [1, -0.0, 0], [0, 1, 0], [1, 1, 1e-20]])
+    p = CreasePattern(v2, v3, [[0, 1, 2], [1, 3, 2]], ["face 5%d", "cone  7"], [0, 0], [0])
+    text = folded_obj(p)
+    assert text.split("\n", 1)[1] == ref_obj(p).split("\n", 1)[1]
+    assert "g face_5%d\n" in text and "-0 " not in text
+
+
+# ---------------------------------------------------------------- SVG
+
+
+def ref_svg_lines(pattern: CreasePattern, flat_edges: bool, opacity: bool) -> list[str]:
+    """The ``<line>`` elements as the per-edge loop wrote them (unitless drawing)."""
+    from filletfold.export import svg
+    from filletfold.export.paths import pattern_extent
+
+    lo, hi = pattern_extent(pattern)
+    extent = float((hi - lo).max()) or 1.0
+    user = 1.0 / (svg._UNITLESS_MM / extent)
+    margin = svg._MARGIN_MM * user
+    decimals = max(0, 8 - math.floor(math.log10(extent + 2 * margin)))
+    x = pattern.vertices_2d[:, 0] - lo[0] + margin
+    y = hi[1] - pattern.vertices_2d[:, 1] + margin
+    xs = [ref_svg_number(t, decimals) for t in x]
+    ys = [ref_svg_number(t, decimals) for t in y]
+    out = []
+    for code in ("F", "B", "V", "M"):
+        if code == "F" and not flat_edges:
+            continue
+        color = svg.ASSIGNMENT_COLOR[code]
+        for e in np.flatnonzero(pattern.edge_assignment == code):
+            a, b = pattern.edges[e]
+            attrs = f'x1="{xs[a]}" y1="{ys[a]}" x2="{xs[b]}" y2="{ys[b]}" stroke="{color}"'
+            if opacity and code in ("M", "V"):
+                attrs += f' opacity="{min(abs(pattern.edge_fold_angle[e]) / 180.0, 1.0):.4f}"'
+            out.append(f"<line {attrs}/>")
+    return out
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize(("flat", "opacity"), [(False, False), (True, True)])
+def test_svg_lines_are_the_loops_lines(name, flat, opacity):
+    p = design_of(name).pattern
+    text = pattern_svg(p, flat_edges=flat, angle_opacity=opacity)
+    lines = [s for s in re.findall(r"<line x1[^\n]*", text) if 'stroke="#00a000"' not in s]
+    assert lines == ref_svg_lines(p, flat, opacity)  # tab hinges aside
+    if not flat and not opacity:
+        assert cut_files(p, "svg")["pattern.svg"] == text
+
+
+def test_svg_numbers_match_the_formatter():
+    from filletfold.export.svg import _format_all
+
+    rng = np.random.default_rng(0)
+    x = np.concatenate(
+        [rng.normal(size=500) * 50, [0.0, -0.0, -1e-12, 1e-12, -4e-9, 5e-9, 100.0, -0.5e-7]]
+    )
+    for d in (0, 1, 3, 7, 9):
+        assert _format_all(x, d) == [ref_svg_number(v, d) for v in x.tolist()]
+
+
+# ---------------------------------------------------------------- report.json
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_report_json_is_json_dumps_indent_2(name):
+    report = design_of(name).report()
+    assert report_json(report) == json.dumps(to_json_data(report), indent=2) + "\n"
+
+
+def test_report_json_odd_values():
+    doc = {
+        "a": [1, 2.5, float("nan"), None, True, 'é"q'],
+        "b": [[1.0, float("inf")], [2, 3], []],
+        "c": {},
+        "d": [],
+        "e": [[], {}, {"k": [1, {"z": np.arange(3)}]}],
+        "f": np.array([[1.0, np.nan]]),
+        "g": ("x", "\u2028"),
+        "h": {1: 2, 2.5: "z", None: False},
+    }
+    assert report_json(doc) == json.dumps(to_json_data(doc), indent=2, allow_nan=False) + "\n"
+
+
+# ---------------------------------------------------------------- validation
+
+
+def _square(faces) -> CreasePattern:
+    p = CreasePattern(
+        [[0, 0], [1, 0], [1, 1], [0, 1]],
+        [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]],
+        [[0, 1, 2], [0, 2, 3]],
+        ["face 0", "face 0"],
+        [0, 0],
+        [0],
+    )
+    p.faces = faces
+    return p
+
+
+def test_validated_faces_of_mixed_integer_types():
+    faces = [np.array([0, 1, 2], dtype=np.uint64), np.array([0, 2, 3], dtype=np.int32)]
+    flat, start = validated_faces(_square(faces))
+    assert flat.dtype == np.int64 and flat.tolist() == [0, 1, 2, 0, 2, 3]
+    assert start.tolist() == [0, 3, 6]
+    plain = _square([[0, 1, 2], [0, 2, 3]])
+    assert fold_json(fold_document(_square(faces))) == fold_json(fold_document(plain))
+    assert cut_files(_square(faces), "fold,obj") == cut_files(plain, "fold,obj")
+
+
+@pytest.mark.parametrize(
+    ("faces", "match"),
+    [
+        ([[0, 1, 2], np.array([[0, 2, 3]])], "face 1 must list at least 3 integer"),
+        ([[0, 1, 2], [0.0, 2.0, 3.0]], "face 1 must list at least 3 integer"),
+        ([[0, 1, 2], [True, False, True]], "face 1 must list at least 3 integer"),
+        ([[0, 1, 2], [0, 2]], "face 1 must list at least 3 integer"),
+        ([[0, 1, 2], [0, 2, -1]], "face 1 refers to a vertex outside"),
+        ([[0, 1, 2], (0, 2, 4)], "face 1 refers to a vertex outside"),
+    ],
+)
+def test_validate_pattern_still_names_the_face(faces, match):
+    with pytest.raises(ExportError, match=match):
+        validate_pattern(_square(faces))
+    with pytest.raises(ExportError, match=match):
+        cut_files(_square(faces), "fold,obj,svg")
