@@ -60,8 +60,21 @@ class Piece:
     apex_index: int | None = None
     _keys: dict = field(default_factory=dict)
 
+    def compact(self) -> Piece:
+        """Store the points as two arrays and forget the point keys (a built piece); returns
+        the piece. Adding points afterwards still works (the arrays become lists again)."""
+        self.points_2d, self.points_3d = self.arrays()
+        self.faces = [np.asarray(f, dtype=np.int64) for f in self.faces]
+        self._keys = {}
+        return self
+
+    def _growable(self) -> None:
+        if isinstance(self.points_2d, np.ndarray):
+            self.points_2d, self.points_3d = list(self.points_2d), list(self.points_3d)
+
     def point(self, key, p2, p3) -> int:
         """Index of the point with ``key``, adding it on first use."""
+        self._growable()
         if key not in self._keys:
             self._keys[key] = len(self.points_2d)
             self.points_2d.append(np.asarray(p2, dtype=float).reshape(2))
@@ -80,6 +93,7 @@ class Piece:
         -------
         (k,) int
         """
+        self._growable()
         start = len(self.points_2d)
         self.points_2d.extend(p2)
         self.points_3d.extend(p3)
@@ -153,7 +167,9 @@ class Piece:
 
     def arrays(self):
         """(points_2d (k, 2), points_3d (k, 3))."""
-        return np.array(self.points_2d).reshape(-1, 2), np.array(self.points_3d).reshape(-1, 3)
+        p2 = np.array(self.points_2d, dtype=float).reshape(-1, 2)
+        p3 = np.array(self.points_3d, dtype=float).reshape(-1, 3)
+        return p2, p3
 
     def overlaps(self, rel: float = 1e-9) -> bool:
         """True when faces of the piece overlap in 2D (or one is not a valid polygon).
@@ -447,7 +463,7 @@ def build_module(
             mid = (j0 + j1) // 2
             pending[:0] = [(j0, mid), (mid + 1, j1)]
             continue
-        pieces.append(piece)
+        pieces.append(piece.compact())
     return pieces
 
 
