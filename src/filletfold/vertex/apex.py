@@ -394,7 +394,10 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.nd
     ok = r > 0
     if not ok.any():
         return best
-    arg = np.array([a + np.argmin(values[a:b]) for a, b in zip(first, ends, strict=True)])
+    # the first sample of each side that attains its smallest value
+    side = np.repeat(np.arange(len(first)), ends - first)
+    hit = np.flatnonzero(values == best[side])
+    arg = hit[np.unique(side[hit], return_index=True)[1]]
     t = s[arg].copy()
     rr = np.where(ok, r, 1.0)
     P = np.einsum("ij,ij->i", V - sa.O, sa.N0)

@@ -225,7 +225,9 @@ class VertexFrame:
     def arrays(self) -> SideArrays:
         """The sides' and faces' data stacked into arrays (closed rings)."""
         sides = self.sides
-        inv = [invert(m) for m in self.cyl_map]
+        maps = np.array(self.cyl_map)  # (k, 3, 3) rigid: the inverse is [Q^T, -Q^T t]
+        Q = maps[:, :2, :2].transpose(0, 2, 1)
+        faces = np.array(self.face_frames)
         return SideArrays(
             edge=np.array([s.edge for s in sides], dtype=np.int64),
             R=np.array([s.R for s in sides]),
@@ -237,9 +239,9 @@ class VertexFrame:
             kappa=np.array([s.kappa for s in sides], dtype=float),
             arc=np.array([s.arc for s in sides]),
             length=np.array([s.length for s in sides]),
-            Q=np.array([m[:2, :2] for m in inv]),
-            t=np.array([m[:2, 2] for m in inv]),
-            face_normal=np.array([np.cross(f[1], f[2]) for f in self.face_frames]),
+            Q=Q,
+            t=-np.einsum("kij,kj->ki", Q, maps[:, :2, 2]),
+            face_normal=np.cross(faces[:, 1], faces[:, 2]),
         )
 
     def rotation_angle(self) -> float:
