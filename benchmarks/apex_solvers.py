@@ -54,9 +54,7 @@ from scipy.spatial import ConvexHull
 from filletfold.design import parse_length
 from filletfold.mesh import load_mesh
 from filletfold.rounding import clamp_radii, round_edges
-from filletfold.tolerances import tol
-from filletfold.vertex.apex import build_constraints
-from filletfold.vertex.solve import VertexResult, central_rulings_crossing, classify_vertex
+from filletfold.vertex.solve import apex_problems
 
 sys.path.insert(0, os.path.dirname(__file__))
 from examples import machine
@@ -76,56 +74,9 @@ class Problem:
     vertex: int
 
 
-def _apex_problem_fallback(frame, depth: float, res: VertexResult):
-    """The first attempt of ``solve_vertex_apex`` (9 samples, the margin), or None.
-
-    A copy of the construction in :func:`filletfold.vertex.solve.solve_vertex_apex`, used
-    until ``filletfold.vertex.solve.apex_problem`` exists.
-    """
-    u = frame.vertex
-    D, sigma = res.normal[u], int(res.sigma[u])
-    closed = res.kind[u] == "developable"
-    v = central_rulings_crossing(frame) if closed else frame.developed_apex()
-    if v is None or np.any(frame.corner_angle > np.pi):
-        return None
-    lengths = np.array([s.length for s in frame.sides])
-    target = frame.U + depth * D
-    starts = [frame.U + t * lengths.mean() * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
-    if closed:
-        target = np.concatenate([target, v])
-        starts = [np.concatenate([x, v]) for x in starts]
-    low = np.fmin(frame.lmax_start, frame.lmax_end).min()
-    if not low > 0:
-        return None
-    m = min(tol.margin * lengths.min(), 0.25 * low)
-    cons = build_constraints(frame, None if closed else v, sigma, 9, m)
-    return Problem(cons, target, starts, u)
-
-
-def _problem_builder():
-    """``apex_problem(frame, depth, res)`` from the library when present, else the copy."""
-    from filletfold.vertex import solve
-
-    lib = getattr(solve, "apex_problem", None)
-    if lib is None:
-        return _apex_problem_fallback, "benchmark copy of solve_vertex_apex's first attempt"
-
-    def build(frame, depth, res):
-        p = lib(frame, depth, res)
-        if p is None:
-            return None
-        # ``cons`` of the first attempt, or built from the problem's first attempt
-        cons = getattr(p, "cons", None)
-        if cons is None:
-            cons = p.constraints(*p.attempts[0])
-        starts = list(p.starts) if p.starts is not None else []
-        return Problem(cons, np.asarray(p.target, float), starts, frame.vertex)
-
-    return build, "filletfold.vertex.solve.apex_problem"
-
-
-def mesh_problems(mesh, radius, depth, clamp: bool, build) -> list[Problem]:
-    """The apex problems of every vertex that reaches the apex stage, as in ``round_mesh``.
+def mesh_problems(mesh, radius, depth, clamp: bool) -> list[Problem]:
+    """The first attempt (9 samples, the margin) of every vertex that reaches the apex stage,
+    set up as in ``round_mesh`` (:func:`filletfold.vertex.solve.apex_problems`).
 
     ``radius``: a value for :func:`parse_length`; ``depth``: a value or an array per vertex.
     """
@@ -134,18 +85,12 @@ def mesh_problems(mesh, radius, depth, clamp: bool, build) -> list[Problem]:
     r = parse_length(radius, ref, "radius", count=pm.n_edges)
     if clamp:
         r = clamp_radii(pm, r)
-    rounding = round_edges(pm, r)
     depths = np.broadcast_to(np.asarray(parse_length(depth, ref, "depth"), float), pm.n_vertices)
-    res = VertexResult.empty(pm.n_vertices)
-    out = []
-    for u in range(pm.n_vertices):
-        frame = classify_vertex(pm, rounding, u, res)
-        if res.status[u] != "":
-            continue
-        p = build(frame, float(depths[u]), res)
-        if p is not None:
-            out.append(p)
-    return out
+    return [
+        Problem(p.constraints(*p.attempts[0]), np.asarray(p.target, float), list(p.starts),
+                p.frame.vertex)
+        for p in apex_problems(pm, round_edges(pm, r), depths)
+    ]  # fmt: skip
 
 
 def random_convex(rng, n_points: int):
@@ -167,7 +112,7 @@ def random_convex(rng, n_points: int):
     return p[used], faces
 
 
-def random_problems(rng, count: int, n_range: tuple[int, int], build):
+def random_problems(rng, count: int, n_range: tuple[int, int]):
     probs, notes = [], []
     for _ in range(count):
         n = int(rng.integers(n_range[0], n_range[1] + 1))
@@ -176,7 +121,7 @@ def random_problems(rng, count: int, n_range: tuple[int, int], build):
         d_frac = rng.uniform(0.05, 1.0, size=len(v))
         pm, _ = load_mesh((v, f))
         depth = d_frac * pm.mean_edge_length
-        probs += mesh_problems((v, f), f"{100 * r_frac:.2f}%", depth, True, build)
+        probs += mesh_problems((v, f), f"{100 * r_frac:.2f}%", depth, True)
         notes.append(f"{len(v)}v r{100 * r_frac:.0f}%")
     return probs, ", ".join(notes)
 
@@ -423,10 +368,9 @@ def main(argv=None) -> int:
 
     print(f"# machine: {machine()}")
     print(f"# command: {' '.join([os.path.basename(sys.executable), *sys.argv])}")
-    build, build_note = _problem_builder()
     ref_fn, ref_note = reference_solver()
     batch = batched_solver()
-    print(f"# problems: {build_note}; reference: {ref_note}")
+    print(f"# problems: filletfold.vertex.solve.apex_problems; reference: {ref_note}")
     print(
         f"# µs per vertex: median of {repeat} run(s) after one warm-up; feasible: some method "
         f"meets every row within {FEAS_TOL:g} L; gap = (f - f_best) / max(f_best, 1e-12)"
@@ -460,10 +404,10 @@ def main(argv=None) -> int:
     for case in [*cases, ("random", None, None, None, None)]:
         name, mesh, radius, depth, clamp = case
         if mesh is None:
-            probs, note = random_problems(rng, n_random, n_range, build)
+            probs, note = random_problems(rng, n_random, n_range)
             note = f"{n_random} random convex polyhedra ({note}), depth 5-100 %"
         else:
-            probs = mesh_problems(mesh, radius, depth, clamp, build)
+            probs = mesh_problems(mesh, radius, depth, clamp)
             note = f"radius {radius}{' clamped' if clamp else ''}, depth {depth}"
         if cap is not None and len(probs) > cap:
             pick = np.sort(rng.choice(len(probs), cap, replace=False))

@@ -23,12 +23,12 @@ from filletfold.mesh import load_mesh
 from filletfold.rounding import clamp_radii, round_edges
 from filletfold.vertex.batch import pack, rows_of, solve_apex, solve_apex_batch
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
-from filletfold.vertex.solve import VertexResult, apex_problem, classify_vertex
+from filletfold.vertex.solve import apex_problems
 
 from .conftest import random_convex
 
 
-def apex_problems(
+def first_attempts(
     mesh, radius_frac: float, depth_frac: float, margin_scale: float = 1.0, loss: bool = False
 ):
     """(cons, target, starts) of every cone vertex's first attempt (9 samples per arc).
@@ -43,17 +43,11 @@ def apex_problems(
         r = r.edge_radius
     else:
         r = clamp_radii(pm, np.full(pm.n_edges, radius_frac * ref))
-    rounding = round_edges(pm, r)
-    res = VertexResult.empty(pm.n_vertices)
-    out = []
-    for u in range(pm.n_vertices):
-        frame = classify_vertex(pm, rounding, u, res)
-        if res.status[u] != "":
-            continue
-        p = apex_problem(frame, depth_frac * ref, res)
-        if p is not None:
-            out.append((p.constraints(9, margin_scale), p.target, p.starts))
-    return out
+    depths = np.full(pm.n_vertices, depth_frac * ref)
+    return [
+        (p.constraints(9, margin_scale), p.target, p.starts)
+        for p in apex_problems(pm, round_edges(pm, r), depths)
+    ]
 
 
 def objective(cons, target, x) -> float:
@@ -89,7 +83,7 @@ def check_against_reference(problems) -> None:
     margin=st.sampled_from([0.0, 0.1, 1.0, 2.0]),
 )
 def test_batched_matches_reference_on_random_vertices(seed, radius, depth, margin):
-    problems = apex_problems(random_convex(seed), radius, depth, margin)
+    problems = first_attempts(random_convex(seed), radius, depth, margin)
     if problems:
         check_against_reference(problems)
 
@@ -97,7 +91,7 @@ def test_batched_matches_reference_on_random_vertices(seed, radius, depth, margi
 @pytest.mark.parametrize("depth", [0.05, 0.3, 1.0])
 def test_batched_matches_reference_on_closed_developments(depth):
     """Developable vertices: the developed apex is a variable too (5 variables)."""
-    problems = apex_problems("miura", 0.1, depth, loss=True)
+    problems = first_attempts("miura", 0.1, depth, loss=True)
     assert problems and all(c.n_vars == 5 for c, _, _ in problems)
     check_against_reference(problems)
 
@@ -106,7 +100,7 @@ def test_rows_reproduce_the_constraints():
     """The dimensionless rows a + A.y + alpha (|v|^2 - |V|^2) equal ``values`` everywhere."""
     rng = np.random.default_rng(3)
     for mesh, loss in (("icosahedron", False), ("miura", True)):
-        for cons, target, _ in apex_problems(mesh, 0.1, 0.3, loss=loss)[:4]:
+        for cons, target, _ in first_attempts(mesh, 0.1, 0.3, loss=loss)[:4]:
             a, A, alpha = rows_of(cons, target)
             block = pack([(a, A, alpha)], cons.n_vars)
             for _ in range(5):
@@ -118,7 +112,7 @@ def test_rows_reproduce_the_constraints():
 
 def test_infeasible_problem_names_its_constraints():
     """Two contradictory face rows: no feasible point; the failing rows are named."""
-    cons, target, starts = apex_problems("icosahedron", 0.15, 0.3)[0]
+    cons, target, starts = first_attempts("icosahedron", 0.15, 0.3)[0]
     k = cons.kind.index("face") - len(cons.quad_s)
     gap = 0.01 * cons.scale
     bad = dataclasses.replace(
@@ -136,7 +130,7 @@ def test_infeasible_problem_names_its_constraints():
 
 def test_mixed_batch_equals_separate_solves():
     """Chunking, padding and mixing 3- and 5-variable problems do not change any answer."""
-    problems = apex_problems("blob", 0.1, 0.3)[:30] + apex_problems("miura", 0.1, 0.3, loss=True)
+    problems = first_attempts("blob", 0.1, 0.3)[:30] + first_attempts("miura", 0.1, 0.3, loss=True)
     together = solve_apex_batch(*zip(*problems, strict=True))
     for (cons, target, starts), t in zip(problems, together, strict=True):
         alone = solve_apex(cons, target, starts)

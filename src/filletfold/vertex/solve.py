@@ -328,6 +328,27 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
     return problem
 
 
+def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) -> list[ApexProblem]:
+    """The apex problems of every vertex that reaches the apex stage, set up as in
+    :func:`~filletfold.design.round_mesh` (for tests and benchmarks of the solvers).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+    depths : (n_vertices,) float
+    """
+    res = VertexResult.empty(mesh.n_vertices)
+    frames = classify_vertices(mesh, rounding, res)
+    problems = []
+    for u, frame in enumerate(frames):
+        if res.status[u] == "":
+            p = apex_problem(frame, float(depths[u]), res)
+            if p is not None:
+                problems.append(p)
+    return problems
+
+
 def solve_apices(
     frames: list[VertexFrame],
     depths: np.ndarray,
