@@ -30,7 +30,8 @@ class Tolerances:
     normal_bound : float
         The max-min vertex-normal bound ``b`` must exceed this for a cone to exist.
     margin : float
-        Safety margin of the sampled apex constraints, as a share of the shortest incident edge.
+        Safety margin of the sampled apex constraints, as a share of the shortest incident edge
+        or of four times the shortest rounded arc when that is shorter (nearly flat vertices).
     closure : float
         A developable vertex's rounded development closes when the gap of ``rho`` is below
         ``closure * mean incident edge length``.
