@@ -122,7 +122,7 @@ def conical_material_loss(
     u = np.where(rounded[he_edge], 0.5 * w[he_edge], 0.0)
     A, rows = cycle_equalities(mesh, ~mesh.is_boundary_vertex)
     closure = np.zeros(mesh.n_vertices)
-    if len(A):
+    if A.shape[0]:
         for (vtx, _), r in zip(rows, np.abs(A @ u), strict=True):
             closure[vtx] = max(closure[vtx], r)
     radius = np.where(rounded & (w > 0), radius_from_loss(w, np.where(rounded, g, 1.0)), 0.0)

@@ -32,7 +32,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
 from scipy.optimize import linprog
+from scipy.sparse.linalg import lsqr
 
 from .errors import ParameterError
 from .mesh.polymesh import PolyMesh
@@ -91,7 +93,7 @@ def _corner_rows(mesh: PolyMesh):
 
 
 def cycle_equalities(mesh: PolyMesh, interior: np.ndarray):
-    """The cycle equalities ``x_(e,f)(U) = x_(e,g)(U)`` as a dense matrix over half-edges.
+    """The cycle equalities ``x_(e,f)(U) = x_(e,g)(U)`` as a sparse matrix over half-edges.
 
     Parameters
     ----------
@@ -101,31 +103,39 @@ def cycle_equalities(mesh: PolyMesh, interior: np.ndarray):
 
     Returns
     -------
-    A : (n_rows, n_halfedges) float
+    A : (n_rows, n_halfedges) scipy.sparse.csr_matrix
     rows : list of (int, int)
         ``(vertex, edge)`` of each row.
     """
     h_out, h_in, alpha = _corner_rows(mesh)
     sin, cos = np.sin(alpha), np.cos(alpha)
     n_h = len(h_out)
-    # x along the edge of h_out: (u[h_in] + u[h_out] cos) / sin; along h_in's edge: symmetric
-    exprs: dict[tuple[int, int], list[np.ndarray]] = {}
-    for h in range(n_h):
+    # x along the edge of h_out: (u[h_in] + u[h_out] cos) / sin; along h_in's edge: symmetric.
+    # Each expression is two entries (own, other); a row is the difference of the two
+    # expressions that meet at (vertex, edge).
+    keys, entries = [], []
+    for h in np.nonzero(interior[mesh.halfedge_from])[0]:
         u = int(mesh.halfedge_from[h])
-        if not interior[u]:
-            continue
         for own, other in ((h_out[h], h_in[h]), (h_in[h], h_out[h])):
-            row = np.zeros(n_h)
-            row[own] += cos[h] / sin[h]
-            row[other] += 1.0 / sin[h]
-            exprs.setdefault((u, int(mesh.halfedge_edge[own])), []).append(row)
-    rows, mat = [], []
-    for key in sorted(exprs):
-        pair = exprs[key]
-        if len(pair) == 2:
-            rows.append(key)
-            mat.append(pair[0] - pair[1])
-    return (np.array(mat) if mat else np.zeros((0, n_h))), rows
+            keys.append((u, int(mesh.halfedge_edge[own])))
+            entries.append((own, cos[h] / sin[h], other, 1.0 / sin[h]))
+    order = sorted(range(len(keys)), key=keys.__getitem__)
+    rows, r_idx, c_idx, vals = [], [], [], []
+    i = 0
+    while i < len(order):
+        j = i
+        while j < len(order) and keys[order[j]] == keys[order[i]]:
+            j += 1
+        if j - i == 2:
+            for k, sign in ((order[i], 1.0), (order[i + 1], -1.0)):
+                own, a, other, b = entries[k]
+                r_idx += [len(rows), len(rows)]
+                c_idx += [own, other]
+                vals += [sign * a, sign * b]
+            rows.append(keys[order[i]])
+        i = j
+    A = sparse.csr_matrix((vals, (r_idx, c_idx)), shape=(len(rows), n_h))
+    return A, rows
 
 
 def solve_material_loss(
@@ -173,12 +183,31 @@ def solve_material_loss(
 
     # offsets d_e = A_e / 2 = k_e w_e of the tangent lines, linear in the loss
     k = np.where(rounded, np.tan(gamma) / (2 * np.where(rounded, tan_minus_angle(gamma), 1.0)), 0.0)
-    loss_of_edge = np.zeros((mesh.n_edges, n_h))
-    loss_of_edge[he_edge, np.arange(n_h)] = 1.0  # w_e = sum of its half-edge widths
+    # w_e = sum of its half-edge widths
+    loss_of_edge = sparse.csr_matrix(
+        (np.ones(n_h), (he_edge, np.arange(n_h))), shape=(mesh.n_edges, n_h)
+    )
+    edge_halves = [[] for _ in range(mesh.n_edges)]
+    for h, e in enumerate(he_edge):
+        edge_halves[e].append(h)
     h_out, h_in, alpha = _corner_rows(mesh)
     sin, cos = np.sin(alpha), np.cos(alpha)
     L = mesh.edge_length
-    ub_rows, ub_rhs, ub_names = [], [], []
+    ub_r, ub_c, ub_v, ub_rhs, ub_names = [], [], [], [], []
+
+    def add_row(coef: dict, rhs: float, name) -> None:
+        r = len(ub_rhs)
+        for col, val in coef.items():
+            ub_r.append(r)
+            ub_c.append(col)
+            ub_v.append(val)
+        ub_rhs.append(rhs)
+        ub_names.append(name)
+
+    def edge_terms(e, factor, coef) -> None:
+        for h in edge_halves[e]:
+            coef[h] = coef.get(h, 0.0) + factor
+
     for h in range(n_h):
         if sin[h] <= 0:
             continue  # reflex corner: the crossing lies behind the corner
@@ -186,47 +215,51 @@ def solve_material_loss(
         for own, other in ((e_o, e_i), (e_i, e_o)):
             if not rounded[own]:
                 continue
-            row = (k[other] * loss_of_edge[other] + k[own] * cos[h] * loss_of_edge[own]) / sin[h]
-            ub_rows.append(row)
-            ub_rhs.append(share * 0.5 * L[own])
-            ub_names.append(
+            coef: dict = {}
+            edge_terms(other, k[other] / sin[h], coef)
+            edge_terms(own, k[own] * cos[h] / sin[h], coef)
+            add_row(
+                coef,
+                share * 0.5 * L[own],
                 f"tangent-line crossing at vertex {mesh.halfedge_from[h]} on face "
-                f"{mesh.halfedge_face[h]} at {share:g} of edge {own}'s half length"
+                f"{mesh.halfedge_face[h]} at {share:g} of edge {own}'s half length",
             )
     if max_loss is not None:
         for e in np.nonzero(rounded)[0]:
-            ub_rows.append(loss_of_edge[e])
-            ub_rhs.append(max_loss)
-            ub_names.append(f"edge {e} at the maximal loss {max_loss:g}")
+            add_row(
+                {h: 1.0 for h in edge_halves[e]},
+                max_loss,
+                f"edge {e} at the maximal loss {max_loss:g}",
+            )
     if max_radius is not None:
         r_cap = np.broadcast_to(np.asarray(max_radius, dtype=float), (mesh.n_edges,))
         if not np.all(np.isfinite(r_cap[rounded]) & (r_cap[rounded] > 0)):
             raise ParameterError("max radius must be a positive length", name="max_radius")
         cap = 2 * r_cap * np.where(rounded, tan_minus_angle(np.where(rounded, gamma, 1.0)), 0)
         for e in np.nonzero(rounded)[0]:
-            ub_rows.append(loss_of_edge[e])
-            ub_rhs.append(cap[e])
-            ub_names.append(("maximal radius", f"edge {e}"))
+            add_row({h: 1.0 for h in edge_halves[e]}, cap[e], ("maximal radius", f"edge {e}"))
     # b <= u_h for free half-edges:  b - u_h <= 0
     n_x = n_h + 1
-    A_ub = [np.append(r, 0.0) for r in ub_rows]
-    b_ub = list(ub_rhs)
+    n_names = len(ub_rhs)
     for h in np.nonzero(var)[0]:
-        row = np.zeros(n_x)
-        row[h] = -1.0
-        row[-1] = 1.0
-        A_ub.append(row)
-        b_ub.append(0.0)
+        r = len(ub_rhs)
+        ub_r += [r, r]
+        ub_c += [int(h), n_h]
+        ub_v += [-1.0, 1.0]
+        ub_rhs.append(0.0)
     n_width_rows = int(var.sum())
-    A_eq_x = np.hstack([A_eq, np.zeros((len(A_eq), 1))])
+    A_ub = sparse.csr_matrix((ub_v, (ub_r, ub_c)), shape=(len(ub_rhs), n_x))
+    b_ub = np.array(ub_rhs, dtype=float)
+    A_eq_x = sparse.hstack([A_eq, sparse.csr_matrix((A_eq.shape[0], 1))]).tocsr()
     c = np.zeros(n_x)
     c[-1] = -1.0
     bounds = [(0.0, None) if v else (0.0, 0.0) for v in var] + [(None, None)]
+    has_eq = A_eq.shape[0] > 0
     lp = {
-        "A_ub": np.array(A_ub) if A_ub else None,
-        "b_ub": np.array(b_ub) if b_ub else None,
-        "A_eq": A_eq_x if len(A_eq_x) else None,
-        "b_eq": np.zeros(len(A_eq_x)) if len(A_eq_x) else None,
+        "A_ub": A_ub if len(b_ub) else None,
+        "b_ub": b_ub if len(b_ub) else None,
+        "A_eq": A_eq_x if has_eq else None,
+        "b_eq": np.zeros(A_eq.shape[0]) if has_eq else None,
         "method": "highs",
     }
     res = linprog(c, bounds=bounds, **lp)
@@ -254,23 +287,26 @@ def solve_material_loss(
         )
     u = res.x[:n_h].copy()
     b = float(res.x[-1])
-    # polish: remove the solver's equality residual (minimal-norm correction on free widths)
-    if len(A_eq):
-        sub = A_eq[:, var]
-        corr, *_ = np.linalg.lstsq(sub, A_eq @ u, rcond=None)
-        u[var] -= corr
+    # polish: remove the solver's equality residual (minimal-norm correction on free widths,
+    # sparse least squares, twice for the last digits)
+    if has_eq:
+        sub = A_eq[:, np.nonzero(var)[0]]
+        for _ in range(2):
+            resid = A_eq @ np.where(var, u, 0.0)
+            corr = lsqr(sub, resid, atol=1e-16, btol=1e-16, iter_lim=10 * sub.shape[1])[0]
+            u[var] -= corr
     u = np.where(var, u, 0.0)
     closure = np.zeros(mesh.n_vertices)
-    if len(A_eq):
+    if has_eq:
         resid = np.abs(A_eq @ u)
         for (vtx, _), r in zip(rows, resid, strict=True):
             closure[vtx] = max(closure[vtx], r)
     w = loss_of_edge @ u
     radius = np.where(rounded & (w > 0), radius_from_loss(w, np.where(rounded, gamma, 1.0)), 0.0)
-    slack = np.array(b_ub) - np.array(A_ub) @ res.x if A_ub else np.zeros(0)
+    slack = b_ub - A_ub @ res.x if len(b_ub) else np.zeros(0)
     scale = float(L.mean())
-    tight = [ub_names[i] for i in range(len(ub_names)) if slack[i] <= 1e-9 * scale]
-    n_b_tight = int(np.sum(slack[len(ub_names) : len(ub_names) + n_width_rows] <= 1e-9 * scale))
+    tight = [ub_names[i] for i in range(n_names) if slack[i] <= 1e-9 * scale]
+    n_b_tight = int(np.sum(slack[n_names : n_names + n_width_rows] <= 1e-9 * scale))
     if n_b_tight:
         tight.append(f"{n_b_tight} half-edge width(s) at the bound b")
     ok = b > 1e-12 * scale
