@@ -9,6 +9,8 @@ coincident points are then merged, so shared borders become ordinary facet edges
 
 from __future__ import annotations
 
+import collections
+
 import numpy as np
 
 from .module import Piece
@@ -35,12 +37,15 @@ def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, st
     """
     arrays = [p.arrays() for p in pieces]
     shared = shared_points(pieces, eps)
+    neighbours: dict[int, list] = {}  # per piece, its (other piece, matches) in order
+    for (ka, kb), matches in sorted(shared.items()):
+        neighbours.setdefault(ka, []).append((kb, matches))
     placed = {0: np.eye(3)}
-    queue = [0]
+    queue = collections.deque([0])
     while queue:
-        k = queue.pop(0)
-        for (ka, kb), matches in sorted(shared.items()):
-            if ka != k or kb in placed or len(matches) < 2:
+        ka = queue.popleft()
+        for kb, matches in neighbours.get(ka, []):
+            if kb in placed or len(matches) < 2:
                 continue
             src = arrays[kb][0][[j for _, j in matches]]
             dst = arrays[ka][0][[i for i, _ in matches]]
