@@ -356,33 +356,52 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
         If a face piece is not star-shaped (no point sees all of it).
     """
     half = 0.5 * rounding.strip_width
-    out = np.empty((mesh.n_faces, 3))
-    for fi, face in enumerate(mesh.faces):
-        n = mesh.face_normal[fi]
-        p = mesh.vertices[face]
-        q = np.roll(p, -1, axis=0)
-        u = q - p
-        u /= np.linalg.norm(u, axis=1)[:, None]
-        he = np.arange(mesh.face_start[fi], mesh.face_start[fi + 1])
-        d = half[mesh.halfedge_edge[he]]
-        base = p + d[:, None] * np.cross(n, u)  # a point of each edge's tangent line
-        T = np.empty_like(p)
-        for j in range(len(face)):  # corner j: lines of edge j-1 and edge j
-            a = np.stack([u[j - 1], -u[j]], axis=1)
-            z, *_ = np.linalg.lstsq(a, base[j] - base[j - 1], rcond=None)
-            T[j] = base[j - 1] + z[0] * u[j - 1]
-        e1 = u[0]
-        e2 = np.cross(n, e1)
-        xy = np.stack([(T - p[0]) @ e1, (T - p[0]) @ e2], axis=1)
-        centre = _kernel_centroid(xy)
-        if centre is None:
+    start = np.asarray(mesh.face_start)
+    face_of = np.repeat(np.arange(mesh.n_faces), np.diff(start))
+    nxt = np.arange(len(face_of)) + 1
+    nxt[start[1:] - 1] = start[:-1]  # the half-edge after the last one of a face is its first
+    p = mesh.vertices[mesh.halfedge_from]
+    u = p[nxt] - p
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    n = mesh.face_normal[face_of]
+    base = p + half[mesh.halfedge_edge][:, None] * np.cross(n, u)  # a point of each tangent line
+    # corner of half-edge h: the tangent lines of the previous half-edge and of h cross at T
+    prev = mesh.halfedge_prev
+    delta = base - base[prev]
+    cos = np.einsum("ij,ij->i", u[prev], u)
+    z = (np.einsum("ij,ij->i", u[prev], delta) - cos * np.einsum("ij,ij->i", u, delta)) / (
+        1 - cos**2
+    )
+    T = base[prev] + z[:, None] * u[prev]
+    # face coordinates: origin at the first corner, e1 along the first edge
+    origin = p[start[:-1]]
+    e1 = u[start[:-1]]
+    e2 = np.cross(mesh.face_normal, e1)
+    rel = T - origin[face_of]
+    xy = np.stack(
+        [np.einsum("ij,ij->i", rel, e1[face_of]), np.einsum("ij,ij->i", rel, e2[face_of])], axis=1
+    )
+    # convex pieces: the polygon centroid (shoelace); the others: the kernel's centroid
+    x, y = xy[:, 0], xy[:, 1]
+    xn, yn = x[nxt], y[nxt]
+    cross = x * yn - xn * y
+    area = np.add.reduceat(cross, start[:-1]) / 2
+    cx = np.add.reduceat((x + xn) * cross, start[:-1]) / (6 * np.where(area != 0, area, 1))
+    cy = np.add.reduceat((y + yn) * cross, start[:-1]) / (6 * np.where(area != 0, area, 1))
+    d = xy[nxt] - xy
+    turn = d[:, 0] * d[nxt][:, 1] - d[:, 1] * d[nxt][:, 0]
+    convex = (np.minimum.reduceat(turn, start[:-1]) >= 0) & (area > 0)
+    centre = np.stack([cx, cy], axis=1)
+    for fi in np.nonzero(~convex)[0]:
+        c = _kernel_centroid(xy[start[fi] : start[fi + 1]])
+        if c is None:
             raise MeshError(
                 f"face {fi} is not star-shaped after rounding: no point of it sees the whole "
                 "face piece; split it into convex polygons or use a smaller radius",
-                face=fi,
+                face=int(fi),
             )
-        out[fi] = p[0] + centre[0] * e1 + centre[1] * e2
-    return out
+        centre[fi] = c
+    return origin + centre[:, :1] * e1 + centre[:, 1:] * e2
 
 
 def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
