@@ -64,7 +64,6 @@ class Piece:
         """Store the points as two arrays and forget the point keys (a built piece); returns
         the piece. Adding points afterwards still works (the arrays become lists again)."""
         self.points_2d, self.points_3d = self.arrays()
-        self.faces = [np.asarray(f, dtype=np.int64) for f in self.faces]
         self._keys = {}
         return self
 

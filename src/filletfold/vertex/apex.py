@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..tolerances import tol
-from .frame import VertexFrame, apply, invert
+from .frame import VertexFrame
 
 KINDS = {
     "patch": "valid patch (developed height above spatial height)",
@@ -290,11 +290,12 @@ def crease_length(frame: VertexFrame, i: int, V: np.ndarray, v: np.ndarray, s: n
     dn : float
         The denominator ``(v - c) . r - (V - C) . R`` (constant along the arc; > 0 when valid).
     """
-    side = frame.sides[i]
-    vi = apply(invert(frame.cyl_map[i]), v)[0]
-    C = side.base(s)
+    sa = frame.arrays
+    s = np.asarray(s, dtype=float)
+    vi = sa.Q[i] @ v + sa.t[i]
+    C = sa.base(np.full(len(s), i), s)
     num = (vi[0] - s) ** 2 + vi[1] ** 2 - np.einsum("ij,ij->i", V - C, V - C)
-    dn = vi[1] - (V - side.M) @ side.R
+    dn = vi[1] - (V - sa.M[i]) @ sa.R[i]
     return 0.5 * num / dn, float(dn)
 
 
