@@ -321,10 +321,15 @@ def build_side(
 
 
 def _line_crossing(p1, d1, p2, d2):
-    """Parameters (z1, z2) with p1 + z1 d1 ~= p2 + z2 d2 (least squares)."""
-    a = np.stack([d1, -d2], axis=1)
-    z, *_ = np.linalg.lstsq(a, p2 - p1, rcond=None)
-    return float(z[0]), float(z[1])
+    """Parameters (z1, z2) with p1 + z1 d1 ~= p2 + z2 d2 (least squares; unit d1, d2)."""
+    delta = p2 - p1
+    c = float(d1 @ d2)
+    a, b = float(d1 @ delta), float(d2 @ delta)
+    det = 1.0 - c * c
+    if det < 1e-12:  # (nearly) parallel: the least-squares solution of smallest norm
+        z, *_ = np.linalg.lstsq(np.stack([d1, -d2], axis=1), delta, rcond=None)
+        return float(z[0]), float(z[1])
+    return (a - c * b) / det, (c * a - b) / det
 
 
 def vertex_frame(
