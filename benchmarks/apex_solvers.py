@@ -15,10 +15,9 @@ the same problems go to every method:
   ``g >= 0`` is not relaxed by 1e-8); the symbolic functions are built once per distinct
   (row count, variable count) and that setup is reported separately;
 * ``reference``: the library's SLSQP solver with a feasibility phase from several starts
-  (``filletfold.vertex.reference.solve_apex_slsqp`` when present, else
-  ``filletfold.vertex.apex.solve_apex``);
+  (``filletfold.vertex.reference.solve_apex_slsqp``);
 * ``batched``: ``filletfold.vertex.batch.solve_apex_batch``, one call for all problems of a
-  case (skipped with a note while it does not exist).
+  case.
 
 A vertex is *feasible* when at least one method returned a point with every row
 ``g >= -1e-9 L`` (``L`` = the constraints' scale, the mean incident edge length); a method
@@ -40,7 +39,6 @@ and two small random polyhedra.
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import statistics
 import sys
@@ -54,6 +52,8 @@ from scipy.spatial import ConvexHull
 from filletfold.design import parse_length
 from filletfold.mesh import load_mesh
 from filletfold.rounding import clamp_radii, round_edges
+from filletfold.vertex.batch import solve_apex_batch
+from filletfold.vertex.reference import solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems
 
 sys.path.insert(0, os.path.dirname(__file__))
@@ -239,24 +239,6 @@ class Ipopt:
         return out
 
 
-def reference_solver():
-    try:
-        mod = importlib.import_module("filletfold.vertex.reference")
-        return mod.solve_apex_slsqp, "filletfold.vertex.reference.solve_apex_slsqp"
-    except (ImportError, AttributeError):
-        from filletfold.vertex.apex import solve_apex
-
-        return solve_apex, "filletfold.vertex.apex.solve_apex"
-
-
-def batched_solver():
-    try:
-        mod = importlib.import_module("filletfold.vertex.batch")
-        return mod.solve_apex_batch
-    except (ImportError, AttributeError) as exc:
-        return exc
-
-
 # --------------------------------------------------------------------------- measuring
 def timed(fn, repeat: int):
     """(result of the last run, median seconds) of ``repeat`` runs of ``fn()``."""
@@ -368,9 +350,10 @@ def main(argv=None) -> int:
 
     print(f"# machine: {machine()}")
     print(f"# command: {' '.join([os.path.basename(sys.executable), *sys.argv])}")
-    ref_fn, ref_note = reference_solver()
-    batch = batched_solver()
-    print(f"# problems: filletfold.vertex.solve.apex_problems; reference: {ref_note}")
+    print(
+        "# problems: filletfold.vertex.solve.apex_problems; reference: "
+        "filletfold.vertex.reference.solve_apex_slsqp"
+    )
     print(
         f"# µs per vertex: median of {repeat} run(s) after one warm-up; feasible: some method "
         f"meets every row within {FEAS_TOL:g} L; gap = (f - f_best) / max(f_best, 1e-12)"
@@ -385,11 +368,8 @@ def main(argv=None) -> int:
         except ImportError:
             print("# ipopt: skipped (casadi is not installed: pip install casadi)")
             methods.remove("ipopt")
-    if "batched" in methods and not callable(batch):
-        print(f"# batched: skipped (filletfold.vertex.batch.solve_apex_batch: {batch})")
-        methods.remove("batched")
 
-    solvers = {"ipopt": ipopt, "reference": ref_fn, "batched": batch}
+    solvers = {"ipopt": ipopt, "reference": solve_apex_slsqp, "batched": solve_apex_batch}
     rng = np.random.default_rng(args.seed)
     cases = [
         (name, name, "10%", "30%", False)
