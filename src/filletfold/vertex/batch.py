@@ -14,13 +14,12 @@ them in lockstep (numpy, no Python loop over vertices):
 * **phase 1** (only for targets that violate a row and starts that do too): maximise ``t``
   subject to ``g_j(x) >= t`` and ``t <= t_cap``, from the best start, until ``t > 0``; the
   reverse-convex rows (``l <= l_max``) can stall it, so the remaining starts are tried next;
-* **phase 2**: from the strictly feasible point, the closest point to ``P``, to a duality
-  measure of ``1e-13`` (relative to the squared length scale).
+* **phase 2**: from the strictly feasible point, the closest point to ``P``, to a mean
+  complementarity of ``1e-12`` (relative to the squared length scale).
 
 The Newton matrix is ``diag(q - 2 (sum_j lambda_j alpha_j) e) + sum_j (lambda_j / g_j)
-grad g_j grad g_j^T`` with the diagonal part clamped to be positive (the only indefinite part
-of this problem's Hessian is diagonal). Steps keep ``g > 0`` and ``lambda > 0`` and decrease the
-barrier merit function.
+grad g_j grad g_j^T``, shifted to positive definite where the reverse-convex rows make it
+indefinite. Steps keep ``g > 0`` and ``lambda > 0`` and decrease the barrier merit function.
 """
 
 from __future__ import annotations
@@ -74,8 +73,11 @@ class RowBlock:
 
     def values(self, y: np.ndarray) -> np.ndarray:
         """(B, R) row values at ``y`` ((B, n) float)."""
-        quad = (y * self.e * y).sum(axis=1)
-        return self.a + _matvec(self.A, y) + self.alpha * quad[:, None]
+        return _row_values(self.a, self.A, self.alpha, self.e, y)
+
+    def min_slack(self, y: np.ndarray) -> np.ndarray:
+        """(B,) smallest value of the real rows at ``y``."""
+        return np.where(self.mask, self.values(y), np.inf).min(axis=1)
 
     def take(self, idx: np.ndarray) -> RowBlock:
         return RowBlock(self.a[idx], self.A[idx], self.alpha[idx], self.e, self.mask[idx])
@@ -168,7 +170,7 @@ def interior_point(
     outer = (A[:, :, :, None] * A[:, :, None, :]).reshape(B, -1, n * n)
     count = mf.sum(axis=1)
     yl = y
-    g = a + _matvec(A, yl) + al * (yl * e * yl).sum(axis=1)[:, None]
+    g = _row_values(a, A, al, e, yl)
     # phase 1: multipliers that balance the objective's gradient, spread over the rows;
     # phase 2: a barrier-like start, larger on the rows close to their boundary
     scale = np.maximum(1e-2, np.abs(yl * q + cl).max(axis=1))
@@ -212,7 +214,7 @@ def interior_point(
                 live[k], a[k], A[k], al[k], mf[k], cl[k], outer[k], count[k], yl[k], g[k],
                 lam[k], stuck[k],
             )  # fmt: skip
-            ey, lam_al, mu = ey[k], lam_al[k], mu[k]
+            ey, mu = ey[k], mu[k]
         # Newton matrix: sum_j w_j grad g_j grad g_j^T (grad g_j = A_j + 2 alpha_j e*y) + diag
         # curvature weights: lambda, or the primal mu / g where lambda lags behind (rows that
         # just became nearly active would otherwise be crossed by every step)
@@ -262,7 +264,7 @@ def interior_point(
             step[todo] *= 0.5
         step[todo] = 0.0
         y_new = yl + step[:, None] * dy
-        g_new = a + _matvec(A, y_new) + al * (y_new * e * y_new).sum(axis=1)[:, None]
+        g_new = _row_values(a, A, al, e, y_new)
         # rounding can put a row a hair from its boundary onto it: no step then
         step[np.any(g_new <= 0, axis=1)] = 0.0
         stuck = step == 0
@@ -282,6 +284,11 @@ def _solve_small(H: np.ndarray, r: np.ndarray) -> np.ndarray:
         return np.stack([np.linalg.lstsq(h, b, rcond=None)[0] for h, b in zip(H, r, strict=True)])
 
 
+def _row_values(a, A, alpha, e, y) -> np.ndarray:
+    """(B, R) values ``a + A . y + alpha (y . e y)`` of padded rows at ``y`` ((B, n) float)."""
+    return a + _matvec(A, y) + alpha * (y * e * y).sum(axis=1)[:, None]
+
+
 def _matvec(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     """(B, R) products of (B, R, n) matrices with (B, n) vectors."""
     return np.matmul(A, x[:, :, None])[:, :, 0]
@@ -298,7 +305,7 @@ def _phase1(
     """(B, n) points of larger smallest slack, maximised from ``y0`` (see :func:`interior_point`
     for ``groups``)."""
     B, R, n = rows.A.shape
-    g0 = np.where(rows.mask, rows.values(y0), np.inf).min(axis=1)
+    g0 = rows.min_slack(y0)
     t0 = g0 - np.maximum(0.1, 0.1 * np.abs(g0))
     # rows g - t >= 0, plus the cap T_CAP - t >= 0
     a = np.concatenate([rows.a, np.full((B, 1), T_CAP)], axis=1)
@@ -385,8 +392,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
     rows = pack([rows_of(p, t) for p, t in zip(problems, targets, strict=True)], n)
     L = np.array([p.scale for p in problems])
     T = np.stack(targets)
-    g_target = np.where(rows.mask, rows.a, np.inf).min(axis=1)
-    at_target = g_target >= 0
+    at_target = rows.min_slack(np.zeros((B, n))) >= 0
     # candidate starts in y coordinates, the target (y = 0) first
     n_s = 1 + max((len(s) for s in starts), default=0)
     cand = np.zeros((B, n_s, n))
@@ -396,21 +402,27 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
         for j, x in enumerate(s):
             cand[b, j + 1] = (np.asarray(x, dtype=float) - T[b]) / L[b]
             valid[b, j + 1] = True
-    gmin = np.full((B, n_s), -np.inf)
-    for j in range(n_s):
-        gj = np.where(rows.mask, rows.values(cand[:, j]), np.inf).min(axis=1)
-        gmin[:, j] = np.where(valid[:, j], gj, -np.inf)
+    gmin = np.stack([rows.min_slack(cand[:, j]) for j in range(n_s)], axis=1)
+    gmin = np.where(valid, gmin, -np.inf)
     order = np.argsort(-gmin, axis=1)
     ar = np.arange(B)
-    y0 = np.zeros((B, n))
+    # the best point per problem so far (a start that is already strictly feasible skips
+    # phase 1); phase 2 starts from it once its smallest slack is positive
     best = cand[ar, order[:, 0]]
     best_g = gmin[ar, order[:, 0]]
     need = ~at_target
-    # a start that is already strictly feasible skips phase 1
-    feasible = need & (best_g > 0)
-    y0[feasible] = best[feasible]
-    # phase 1 from the best starts first (several at once), then from the others
+
+    def keep_best(idx: np.ndarray, y: np.ndarray) -> None:
+        """Take the phase-1 points ``y`` of problems ``idx`` (repeats allowed) that beat
+        their problem's best point."""
+        g_y = rows.take(idx).min_slack(y)
+        for k in np.argsort(g_y):  # ascending: the best point per problem wins
+            if g_y[k] > best_g[idx[k]]:
+                best[idx[k]], best_g[idx[k]] = y[k], g_y[k]
+
+    # phase 1 from the PARALLEL_STARTS best starts first, then from the others
     for lo, hi in ((0, PARALLEL_STARTS), (PARALLEL_STARTS, n_s)):
+        feasible = need & (best_g > 0)
         todo_b, todo_j = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]
         for j in range(lo, min(hi, n_s)):
             b = np.nonzero(need & ~feasible & valid[ar, order[:, j]] & (thorough | (lo == 0)))[0]
@@ -419,29 +431,18 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
         todo_b, todo_j = np.concatenate(todo_b), np.concatenate(todo_j)
         if len(todo_b) == 0:
             continue
-        y = _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter)
-        g_y = np.where(rows.mask[todo_b], rows.take(todo_b).values(y), np.inf).min(axis=1)
-        for k in np.argsort(g_y):  # the best point per problem wins
-            b = todo_b[k]
-            if g_y[k] > best_g[b]:
-                best[b], best_g[b] = y[k], g_y[k]
-        feasible |= need & (best_g > 0)
-        y0[feasible] = best[feasible]
+        keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter))
     # the give-up rule is only a hint here: the rest continue from their best point, longer
-    rest = np.nonzero(need & ~feasible & thorough)[0]
+    rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
     if len(rest):
-        y = _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False)
-        g_y = np.where(rows.mask[rest], rows.take(rest).values(y), np.inf).min(axis=1)
-        better = g_y > best_g[rest]
-        best[rest[better]], best_g[rest[better]] = y[better], g_y[better]
-        feasible |= need & (best_g > 0)
-        y0[feasible] = best[feasible]
-    solve = np.nonzero(need & feasible)[0]
+        keep_best(rest, _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False))
+    feasible = need & (best_g > 0)
+    solve = np.nonzero(feasible)[0]
     y = np.zeros((B, n))
     converged = np.ones(B, dtype=bool)
     if len(solve):
         y[solve], converged[solve] = interior_point(
-            rows.take(solve), np.full(n, 2.0), np.zeros((len(solve), n)), y0[solve],
+            rows.take(solve), np.full(n, 2.0), np.zeros((len(solve), n)), best[solve],
             max_iter=max_iter,
         )  # fmt: skip
     result = []
@@ -457,7 +458,8 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
             result.append(ApexSolution(True, x, [], False, how))
         elif thorough[b]:
             # the feasibility phase can stall at a local maximum of the smallest slack (the
-            # l <= l_max rows are reverse-convex): SLSQP from every start decides
+            # l <= l_max rows are reverse-convex): SLSQP from the best point, the target and
+            # two starts decides
             result.append(solve_apex_slsqp(p, T[b], [T[b] + L[b] * best[b], *starts[b][:2]]))
         else:
             x = T[b] + L[b] * best[b]
