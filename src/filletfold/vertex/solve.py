@@ -312,7 +312,7 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
         res.status[u] = "infeasible"
         res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
         return None
-    problem = ApexProblem(
+    return ApexProblem(
         frame=frame,
         closed=closed,
         sigma=int(res.sigma[u]),
@@ -325,7 +325,6 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
         attempts=list(ATTEMPTS),
         failing=[],
     )
-    return problem
 
 
 def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) -> list[ApexProblem]:
@@ -340,12 +339,18 @@ def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) ->
     """
     res = VertexResult.empty(mesh.n_vertices)
     frames = classify_vertices(mesh, rounding, res)
-    problems = []
-    for u, frame in enumerate(frames):
-        if res.status[u] == "":
-            p = apex_problem(frame, float(depths[u]), res)
-            if p is not None:
-                problems.append(p)
+    vertices = [u for u in range(mesh.n_vertices) if res.status[u] == ""]
+    return list(_set_up(frames, depths, res, vertices).values())
+
+
+def _set_up(frames, depths, res: VertexResult, vertices) -> dict:
+    """The apex problems of ``vertices`` (vertex -> ApexProblem; those without one are
+    marked in ``res`` and left out)."""
+    problems = {}
+    for u in vertices:
+        p = apex_problem(frames[u], float(depths[u]), res)
+        if p is not None:
+            problems[u] = p
     return problems
 
 
@@ -389,12 +394,9 @@ def solve_apices(
     """
     if vertices is None:
         vertices = [u for u in range(len(res.status)) if res.status[u] == ""]
-    out, pending = {}, {}
-    for u in vertices:
-        out[u] = (None, None)
-        problem = apex_problem(frames[u], float(depths[u]), res)
-        if problem is not None:
-            pending[u] = problem
+    vertices = list(vertices)
+    out = dict.fromkeys(vertices, (None, None))
+    pending = _set_up(frames, depths, res, vertices)
     total = len(pending)
     while pending:
         order = list(pending)
@@ -448,11 +450,3 @@ def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
                 p.shrink[i, 1] *= 0.7
                 p.shrink[(i + 1) % n_sides, 0] *= 0.7
         p.attempts.insert(0, attempt)
-
-
-def solve_vertex_apex(
-    frame: VertexFrame, depth: float, res: VertexResult, centres: np.ndarray | None = None
-) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """One vertex through :func:`solve_apices` (the frame's vertex; same parameters)."""
-    u = frame.vertex
-    return solve_apices({u: frame}, {u: depth}, res, centres, vertices=[u])[u]
