@@ -505,14 +505,13 @@ def round_mesh(
 
     t = time.perf_counter()
     if st is not None:
-        frames = st.frames
-        res = copy.deepcopy(st.classified)
+        frames, classified = st.frames, st.classified  # read-only: res is a copy
     else:
-        res = VertexResult.empty(pm.n_vertices)
-        frames = classify_vertices(pm, rounding, res)
+        classified = VertexResult.empty(pm.n_vertices)
+        frames = classify_vertices(pm, rounding, classified)
         if conical:
-            use_cone_axes(pm, frames, res)
-    classified = copy.deepcopy(res)
+            use_cone_axes(pm, frames, classified)
+    res = copy.deepcopy(classified)
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()
