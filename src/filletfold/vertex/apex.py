@@ -150,14 +150,7 @@ def build_constraints(
     if lmax_scale is None:
         lmax_scale = np.ones((k, 2))
     lmax = np.stack([frame.lmax_start, frame.lmax_end], axis=1) * lmax_scale
-    ks = np.where(sa.arc > 0, n_samples, 1)
-    side = np.repeat(np.arange(k), ks)
-    first = np.concatenate([[0], np.cumsum(ks)[:-1]])
-    j = np.arange(len(side)) - first[side]
-    s = sa.arc[side] * j / np.maximum(ks[side] - 1, 1)
-    C = sa.base(side, s)
-    N = sa.normal(side, s)
-    last = first + ks - 1
+    side, first, last, s, C, N = sa.samples(n_samples)
     ends = np.arange(k)
     # quadratic rows: l >= m at every sample, l <= l_max - m at both ends, Dn >= m
     q_side = np.concatenate([side, ends, ends, ends])
@@ -323,13 +316,7 @@ def validate_apex(
     k = len(sa.arc)
     scale = float(sa.length.mean())
     eps = tol.validate * scale
-    ks = np.where(sa.arc > 0, n_samples, 1)
-    side = np.repeat(np.arange(k), ks)
-    first = np.concatenate([[0], np.cumsum(ks)[:-1]])
-    last = first + ks - 1
-    s = sa.arc[side] * (np.arange(len(side)) - first[side]) / np.maximum(ks[side] - 1, 1)
-    C = sa.base(side, s)
-    N = sa.normal(side, s)
+    side, first, last, s, C, N = sa.samples(n_samples)
     vi = np.einsum("kij,j->ki", sa.Q, v) + sa.t  # developed apex in each cylinder's chart
     d = V - C
     num = (vi[side, 0] - s) ** 2 + vi[side, 1] ** 2 - np.einsum("ij,ij->i", d, d)

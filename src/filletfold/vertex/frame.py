@@ -172,6 +172,26 @@ class SideArrays:
         """(m, 3) base-curve points ``C(s)`` of sides ``i``."""
         return self.O[i] + (self.kappa[i] * self.radius[i])[:, None] * self.normal(i, s)
 
+    def samples(self, n_samples: int):
+        """Evenly spaced samples along every arc, ends included (one on a flat side).
+
+        Returns
+        -------
+        side : (m,) int
+            Side of each sample, sides one after another.
+        first, last : (k,) int
+            Each side's first and last sample.
+        s : (m,) float
+            Arc parameters.
+        C, N : (m, 3) float
+            Base-curve points and normals.
+        """
+        ks = np.where(self.arc > 0, n_samples, 1)
+        side = np.repeat(np.arange(len(ks)), ks)
+        first = np.concatenate([[0], np.cumsum(ks)[:-1]])
+        s = self.arc[side] * (np.arange(len(side)) - first[side]) / np.maximum(ks[side] - 1, 1)
+        return side, first, first + ks - 1, s, self.base(side, s), self.normal(side, s)
+
 
 @dataclass
 class VertexFrame:
