@@ -404,11 +404,11 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
 
 
 def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
-    """Centroid of the kernel of a counter-clockwise polygon (k, 2), or None if it is empty."""
+    """Centroid of the kernel of a counter-clockwise polygon (k, 2), or None if it is empty.
+
+    (Convex pieces do not come here: :func:`face_piece_centres` takes their centroid.)
+    """
     poly = shapely.Polygon(xy)
-    if poly.is_valid and poly.exterior.is_ccw and _is_convex(xy):
-        c = poly.centroid
-        return np.array([c.x, c.y])
     size = float(np.ptp(xy, axis=0).max()) * 4 + 1.0
     kernel = poly if poly.is_valid else shapely.convex_hull(poly)
     for a, b in zip(xy, np.roll(xy, -1, axis=0), strict=True):
@@ -421,12 +421,6 @@ def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
         return None
     c = kernel.centroid
     return np.array([c.x, c.y])
-
-
-def _is_convex(xy: np.ndarray) -> bool:
-    d = np.roll(xy, -1, axis=0) - xy
-    cross = d[:, 0] * np.roll(d[:, 1], -1) - d[:, 1] * np.roll(d[:, 0], -1)
-    return bool(np.all(cross >= 0))
 
 
 def hole_heights(frame: VertexFrame) -> np.ndarray:
