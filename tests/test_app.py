@@ -48,6 +48,22 @@ def test_load_example_and_recompute():
     assert again.params.radius == "5%" and again.params.samples == 8
 
 
+def test_arc_step_reaches_the_design_and_its_download():
+    """The arc step is a session parameter; the download (rebuilt with tabs by reuse) keeps
+    the shown design's sampling."""
+    s = AppSession()
+    s.load("geodesic-sphere")  # arcs of about 20 degrees: the step decides their points
+    fine = len(s.design.pattern.faces)
+    s.set_params(arc_step=5.0)
+    coarse = s.recompute()
+    assert coarse.params.arc_step == 5.0 and len(coarse.pattern.faces) < fine
+    files = dict(s.export_files())
+    fold = json.loads(files["design.fold"])
+    assert json.loads(files["report.json"])["parameters"]["arc_step"] == 5.0
+    cp = [len(f) for f in fold["faces_vertices"]]
+    assert len(cp) >= len(coarse.pattern.faces) and len(cp) < fine
+
+
 def test_older_request_never_replaces_a_newer_result():
     s = AppSession()
     s.load("cube")

@@ -35,6 +35,19 @@ def test_relative_radius_and_depth(tmp_path):
     assert report["vertices"][0]["depth_requested"] == pytest.approx(0.6)
 
 
+def test_arc_step_sets_the_points_per_arc(tmp_path):
+    """--arc-step is recorded in the report; a finer step (or 0) gives more pattern faces."""
+    faces = {}
+    for step in ("0", "1.5", "6"):
+        out = tmp_path / f"blob-{step}"
+        args = ["round", "blob", "--arc-step", step, "--format", "fold,json", "-o", str(out)]
+        assert main(args) == 0
+        report = json.loads((out / "report.json").read_text())
+        assert report["parameters"]["arc_step"] == float(step)
+        faces[step] = len(json.loads((out / "design.fold").read_text())["faces_vertices"])
+    assert faces["0"] > faces["1.5"] > faces["6"]
+
+
 def test_dry_run_writes_nothing(tmp_path):
     assert main(["round", "cube", "--dry-run", "-o", str(tmp_path / "x")]) == 0
     assert not (tmp_path / "x").exists()
@@ -68,6 +81,7 @@ def test_file_input_and_clamp(tmp_path):
         (["round", "no-such-thing"], "no such file and no built-in example"),
         (["round", "cube", "--radius", "3"], "exceeds its limit"),
         (["round", "cube", "--depth", "abc"], "depth must be a number"),
+        (["round", "cube", "--arc-step", "-1"], "arc step must be in [0, 180] degrees"),
     ],
 )
 def test_errors_are_one_line_with_exit_code_2(args, match, capsys, tmp_path):

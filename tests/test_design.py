@@ -171,9 +171,11 @@ def test_invariants_on_every_example(example_design, check):
     share=st.floats(0.15, 0.7),
     depth=st.floats(0.1, 1.0),
     samples=st.integers(3, 30),
+    arc_step=st.sampled_from([0.0, 1.5, 10.0, 60.0]),
 )
-def test_invariants_on_generated_meshes(seed, share, depth, samples):
-    """Random convex polyhedra, radii, depths and samplings: every invariant holds."""
+def test_invariants_on_generated_meshes(seed, share, depth, samples, arc_step):
+    """Random convex polyhedra, radii, depths and samplings (down to 2 points on an arc):
+    every invariant holds."""
     v, f = random_convex(seed)
     m = filletfold.load_mesh((v, f))[0]
     d = filletfold.round_mesh(
@@ -181,6 +183,7 @@ def test_invariants_on_generated_meshes(seed, share, depth, samples):
         radius=share * round_edges(m, 1e-3).uniform_limit,
         depth=depth * m.mean_edge_length,
         samples=samples,
+        arc_step=arc_step,
     )
     for check in CHECKS:
         check(d)
@@ -224,15 +227,56 @@ def test_mismatch_converges_under_refinement(name):
     """Doubling the sampling divides the relative chord mismatch by 4 (absolute: by 8)."""
     rel, ab = [], []
     for n in (9, 17, 33):
-        p = design_of(name, samples=n).pattern
+        p = design_of(name, samples=n, arc_step=0).pattern
         rel.append(relative_mismatch(p).max())
         ab.append(edge_mismatch(p).max())
     assert 3.8 < rel[0] / rel[1] < 4.2 and 3.8 < rel[1] / rel[2] < 4.2
     assert 7.6 < ab[0] / ab[1] < 8.4 and 7.6 < ab[1] / ab[2] < 8.4
 
 
+@pytest.mark.parametrize("name", ["blob", "geodesic-sphere"])
+def test_mismatch_converges_as_the_arc_step_shrinks(name):
+    """Halving the arc step (arcs under (samples - 1) steps) divides the relative chord
+    mismatch by about 4: the adaptive sampling refines like the uniform one."""
+    rel = []
+    for step in (4.0, 2.0, 1.0):
+        p = design_of(name, samples=200, arc_step=step).pattern
+        rel.append(relative_mismatch(p).max())
+    assert 3.5 < rel[0] / rel[1] < 4.5 and 3.5 < rel[1] / rel[2] < 4.5
+
+
+@pytest.mark.parametrize("step", [0.0, 0.7, 1.5, 5.0, 45.0])
+def test_arc_points_bound_the_turn_between_samples(step):
+    """Every arc gets at most ``samples`` points, at least 2, and fewer only when the turn
+    between two samples stays within the arc step; the built modules use those counts."""
+    d = design_of("blob", arc_step=step)
+    rd = d.rounding
+    n = rd.arc_points(24, step)
+    arcs = rd.arc_length > 0
+    assert (n[~arcs] == 1).all() and (n[arcs] >= 2).all() and (n <= 24).all()
+    turn = np.degrees(2 * rd.half_angle[arcs]) / (n[arcs] - 1)
+    fewer = n[arcs] < 24
+    if step == 0:
+        assert not fewer.any()
+    else:
+        assert (turn[fewer] <= step * (1 + 1e-9)).all()
+        # one point less would exceed the step (unless already at the minimum of 2)
+        more = fewer & (n[arcs] > 2)
+        assert (np.degrees(2 * rd.half_angle[arcs][more]) / (n[arcs][more] - 2) > step).all()
+    assert_allclose(np.asarray(d.stages.samples), n)
+    # a cylinder patch of edge e has n[e] - 1 quads on each of its two modules' halves
+    quads = {}
+    for patch, face in zip(d.pattern.face_patch, d.pattern.faces, strict=True):
+        if patch.startswith("cylinder ") and len(face) == 4:
+            e = int(patch.split()[1])
+            quads[e] = quads.get(e, 0) + 1
+    for e, count in quads.items():
+        assert count <= 2 * (n[e] - 1)
+    assert sum(quads.values()) > 0.9 * (2 * (n[arcs] - 1)).sum()
+
+
 def test_icosahedron_fold_angles_match_reference():
-    d = filletfold.round_mesh("icosahedron", radius=0.15, depth=0.3, samples=64)
+    d = filletfold.round_mesh("icosahedron", radius=0.15, depth=0.3, samples=64, arc_step=0)
     a = d.pattern.edge_fold_angle[d.pattern.edge_assignment == "M"]
     assert a.min() == pytest.approx(-73.18, abs=0.01)
     assert a.max() == pytest.approx(-64.14, abs=0.01)
@@ -303,6 +347,9 @@ def test_export_writes_the_four_files(tmp_path):
         ({"depth": np.ones(3)}, ParameterError, r"per-element depth must have shape \(8,\)"),
         ({"depth": {"default": 0.3, 99: 0.2}}, ParameterError, "vertex 99, which does not exist"),
         ({"coplanar_deg": -1}, ParameterError, "coplanar tolerance"),
+        ({"arc_step": -1}, ParameterError, r"arc step must be in \[0, 180\] degrees"),
+        ({"arc_step": float("nan")}, ParameterError, "arc step must be in"),
+        ({"arc_step": "2"}, ParameterError, "arc step must be a number of degrees"),
     ],
 )
 def test_bad_parameters(kwargs, error, match):

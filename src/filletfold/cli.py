@@ -4,7 +4,8 @@ Commands
 --------
 ``filletfold examples``
     List the built-in meshes.
-``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--coplanar-tol DEG]``
+``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
+``[--coplanar-tol DEG]``
 ``[--format LIST] [--units U] [--scale S] [--sheet PAGE]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
@@ -28,7 +29,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from . import __version__
-from .design import DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES, round_mesh
+from .design import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES, round_mesh
 from .errors import FilletfoldError
 from .tolerances import tol
 
@@ -153,8 +154,23 @@ def round_cmd(
         ),
     ] = DEFAULT_DEPTH,
     samples: Annotated[
-        int, typer.Option("--samples", "-n", min=3, help="Points per cylinder arc.")
+        int,
+        typer.Option(
+            "--samples",
+            "-n",
+            min=3,
+            help="Points per cylinder arc (arcs that turn little get fewer: see --arc-step).",
+        ),
     ] = DEFAULT_SAMPLES,
+    arc_step: Annotated[
+        float,
+        typer.Option(
+            "--arc-step",
+            help="Largest turn between two samples of an arc (degrees): an arc that turns "
+            "less than (samples - 1) steps gets one point per step, at least 2. 0: every arc "
+            "gets --samples points.",
+        ),
+    ] = DEFAULT_ARC_STEP,
     clamp: Annotated[
         bool,
         typer.Option(
@@ -245,6 +261,7 @@ def round_cmd(
                 radius=radius,
                 depth=depth,
                 samples=samples,
+                arc_step=arc_step,
                 clamp=clamp,
                 material_loss=material_loss,
                 max_loss=max_loss,

@@ -32,6 +32,7 @@ from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apice
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
+DEFAULT_ARC_STEP = 1.5  # degrees: see round_mesh(arc_step=...)
 #: Height of a glue tab, as a share of the mean edge length.
 TAB_HEIGHT = 0.04
 
@@ -89,7 +90,9 @@ class Parameters:
     radius, depth : float, str or array
         As given (absolute, ``"N%"`` of the mean edge length, or per edge / per vertex).
     samples : int
-        Points per cylinder arc.
+        Most points per cylinder arc.
+    arc_step : float
+        Largest turn between two samples of an arc (degrees; 0: every arc gets ``samples``).
     clamp : bool
         Whether radii over their limit were reduced to fit.
     material_loss : bool
@@ -105,6 +108,7 @@ class Parameters:
     radius: object = DEFAULT_RADIUS
     depth: object = DEFAULT_DEPTH
     samples: int = DEFAULT_SAMPLES
+    arc_step: float = DEFAULT_ARC_STEP
     clamp: bool = False
     material_loss: bool = False
     max_loss: object = None
@@ -119,6 +123,7 @@ class Parameters:
             "radius": plain(self.radius),
             "depth": plain(self.depth),
             "samples": self.samples,
+            "arc_step": self.arc_step,
             "clamp": self.clamp,
             "material_loss": self.material_loss,
             "max_loss": plain(self.max_loss) if self.max_loss is not None else None,
@@ -133,8 +138,8 @@ class Stages:
 
     A later call on the same mesh with the same rounding parameters takes over the rounding,
     frames and vertex normals; vertices whose depth did not change keep their apex, and their
-    modules are kept when ``samples`` did not change either. Only the changed vertices are
-    re-solved and rebuilt; the layout stage always runs.
+    modules are kept when their arcs' sample counts did not change either. Only the changed
+    vertices are re-solved and rebuilt; the layout stage always runs.
 
     Attributes
     ----------
@@ -153,7 +158,8 @@ class Stages:
     vertices : VertexResult
         The final per-vertex results.
     solved : list of (VertexFrame, apex or None, developed apex or None)
-    samples : int
+    samples : (n_edges,) int
+        Points on each edge's arc (:meth:`~filletfold.rounding.EdgeRounding.arc_points`).
     modules : list of list of Piece
         Each vertex's module pieces, before the layout.
     """
@@ -168,7 +174,7 @@ class Stages:
     depths: np.ndarray
     vertices: VertexResult
     solved: list
-    samples: int
+    samples: np.ndarray
     modules: list
 
 
@@ -385,6 +391,7 @@ def round_mesh(
     depth=DEFAULT_DEPTH,
     *,
     samples: int = DEFAULT_SAMPLES,
+    arc_step: float = DEFAULT_ARC_STEP,
     clamp: bool = False,
     material_loss: bool = False,
     max_loss=None,
@@ -410,7 +417,14 @@ def round_mesh(
         Apex depth ``d`` along the vertex normal (``P = U + d D``): absolute, a percentage of the
         mean edge length, per vertex, or ``{"default": ..., vertex: value}``.
     samples : int
-        Points per cylinder arc (>= 3).
+        Points per cylinder arc, both ends included (>= 3): every arc gets this many, except
+        arcs that turn by less than ``(samples - 1) * arc_step``.
+    arc_step : float
+        Largest turn between two samples of an arc, in degrees (default 1.5): an arc that turns
+        less gets fewer points, one per ``arc_step`` and at least 2, so a fine mesh, whose arcs
+        turn by a few degrees, is not sampled as densely as a cube's quarter turns. The chord
+        then deviates from the cylinder by at most ``r (1 - cos(arc_step / 2))`` (8.6e-5 r at
+        1.5 degrees). 0 gives every arc ``samples`` points.
     clamp : bool
         Reduce radii over their edge's limit to 90% of it (see
         :func:`filletfold.rounding.clamp_radii`) instead of raising.
@@ -455,7 +469,7 @@ def round_mesh(
     MeshError
         Unreadable or invalid mesh.
     ParameterError
-        Invalid radius, depth or samples (a radius over an edge's limit names the edge).
+        Invalid radius, depth, samples or arc step (a radius over an edge's limit names the edge).
     SolverError
         With ``material_loss``: the programme has no solution with positive losses (the
         message names the binding vertices and edges); with ``layout="sheet"``: the modules do
@@ -465,6 +479,14 @@ def round_mesh(
     t0 = time.perf_counter()
     if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
         raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
+    if isinstance(arc_step, bool) or not isinstance(arc_step, int | float | np.number):
+        raise ParameterError(
+            f"arc step must be a number of degrees, got {arc_step!r}", name="arc_step"
+        )
+    if not (np.isfinite(arc_step) and 0 <= arc_step <= 180):
+        raise ParameterError(
+            f"arc step must be in [0, 180] degrees (0: no limit), got {arc_step!r}", name="arc_step"
+        )
     if layout not in ("auto", "modules", "net", "sheet"):
         raise ParameterError(
             f"layout must be 'auto', 'modules', 'net' or 'sheet', got {layout!r}", name="layout"
@@ -481,6 +503,7 @@ def round_mesh(
         radius=radius,
         depth=depth,
         samples=int(samples),
+        arc_step=float(arc_step),
         clamp=bool(clamp),
         material_loss=bool(material_loss),
         max_loss=max_loss,
@@ -529,13 +552,14 @@ def round_mesh(
     timings["apices"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    same_samples = st is not None and st.samples == int(samples)
+    points = rounding.arc_points(int(samples), float(arc_step))
+    same_samples = st is not None and np.array_equal(st.samples, points)
     modules = []
     for u, (frame, apex, v) in enumerate(solved):
         if same_samples and u in kept:
             modules.append(st.modules[u])
         else:
-            modules.append(build_module(pm, frame, centres, int(samples), apex, v))
+            modules.append(build_module(pm, frame, centres, points, apex, v))
         if progress is not None:
             progress("surface", u + 1, pm.n_vertices)
     stages = Stages(
@@ -549,7 +573,7 @@ def round_mesh(
         depths=depths,
         vertices=res,
         solved=solved,
-        samples=int(samples),
+        samples=points,
         modules=modules,
     )
     pieces = [piece for module in modules for piece in module]
@@ -593,7 +617,7 @@ def round_mesh(
             pieces,
             solved,
             centres,
-            int(samples),
+            points,
             eps,
             sheet=room,
         )

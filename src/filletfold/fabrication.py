@@ -70,7 +70,8 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
     solved : list of (frame, apex or None, developed apex or None)
         The frames the apices were solved in, and the apices.
     centres : (n_faces, 3) float
-    samples : int
+    samples : int or (n_edges,) int
+        Points per arc (see :func:`~filletfold.module.build_module`).
     eps : float
     sheet : (float, float), optional
         Every net must fit this (pattern units).

@@ -433,7 +433,7 @@ def build_module(
     mesh: PolyMesh,
     frame: VertexFrame,
     centres: np.ndarray,
-    n_samples: int,
+    n_samples,
     apex: np.ndarray | None = None,
     dev_apex: np.ndarray | None = None,
     runs=None,
@@ -446,8 +446,9 @@ def build_module(
     frame : VertexFrame
     centres : (n_faces, 3) float
         Face piece centres (:func:`face_piece_centres`).
-    n_samples : int
-        Points per cylinder arc (both ends included).
+    n_samples : int or (n_edges,) int
+        Points per cylinder arc (both ends included), for all arcs or per edge
+        (:meth:`~filletfold.rounding.EdgeRounding.arc_points`).
     apex : (3,) float, optional
         Spatial apex; when given the module has a cone, otherwise a hole border.
     dev_apex : (2,) float, optional
@@ -479,14 +480,15 @@ def build_module(
     return pieces
 
 
-def _side_curves(frame: VertexFrame, i: int, n_samples: int, apex, dev_apex, heights):
+def _side_curves(frame: VertexFrame, i: int, n_samples, apex, dev_apex, heights):
     """Base points and crease (or hole) points of rounded side ``i``.
 
     Returns (s, base_3d (k, 3), top_3d (k, 3), top_z (k,)) with ``top`` the crease or the
     hole border.
     """
     side = frame.sides[i]
-    s = np.linspace(0.0, side.arc, n_samples if side.arc > 0 else 1)
+    n = n_samples if np.ndim(n_samples) == 0 else n_samples[side.edge]
+    s = np.linspace(0.0, side.arc, int(n) if side.arc > 0 else 1)
     C = side.base(s)
     if apex is not None:
         z, _ = crease_length(frame, i, apex, dev_apex, s)

@@ -236,6 +236,31 @@ class EdgeRounding:
     limit: np.ndarray
     uniform_limit: float
 
+    def arc_points(self, samples: int, step_deg: float = 0.0) -> np.ndarray:
+        """Points to sample on each edge's arc (both ends included).
+
+        An arc gets ``samples`` points, or fewer when it turns little: one point per
+        ``step_deg`` degrees it turns (``2 gamma``), and at least 2. Flat and boundary edges
+        (no arc) get 1. ``step_deg = 0`` gives every arc ``samples`` points.
+
+        Parameters
+        ----------
+        samples : int
+            Most points per arc (>= 2).
+        step_deg : float
+            Largest turn between two samples (degrees); 0 for no limit.
+
+        Returns
+        -------
+        (n_edges,) int
+        """
+        n = np.full(len(self.arc_length), int(samples))
+        if step_deg > 0:
+            turn = np.degrees(2 * self.half_angle)
+            steps = np.ceil(turn / step_deg - 1e-9)  # an exact multiple of the step gains none
+            n = np.minimum(n, np.maximum(2, steps + 1).astype(int))
+        return np.where(self.arc_length > 0, n, 1)
+
 
 def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -> EdgeRounding:
     """Round every interior edge with a cylinder tangent to both faces.

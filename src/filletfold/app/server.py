@@ -20,7 +20,7 @@ import threading
 import time
 import webbrowser
 
-from ..design import DEFAULT_SAMPLES
+from ..design import DEFAULT_ARC_STEP, DEFAULT_SAMPLES
 from ..errors import FilletfoldError
 from ..mesh import example_names
 from .session import AppSession, nearest_vertex_to_ray
@@ -248,6 +248,9 @@ class AppServer:
             self._radius = gui.add_slider("Radius (% edge)", 1.0, 50.0, 0.5, DEFAULT_RADIUS_PERCENT)
             self._depth = gui.add_slider("Depth (% edge)", 1.0, 150.0, 1.0, DEFAULT_DEPTH_PERCENT)
             self._samples = gui.add_slider("Samples", 3, 64, 1, DEFAULT_SAMPLES)
+            self._arc_step = gui.add_slider(
+                "Arc step (°, 0 = off)", 0.0, 10.0, 0.25, DEFAULT_ARC_STEP
+            )
             self._loss = gui.add_checkbox("Material loss", False)
             self._tabs = gui.add_checkbox("Glue tabs (always in the download)", False)
             self._show_pattern = gui.add_checkbox("Show crease pattern", True)
@@ -269,7 +272,14 @@ class AppServer:
             f = event.target.value
             self.request_load(f.name, f.content)
 
-        for handle in (self._radius, self._depth, self._samples, self._loss, self._tabs):
+        for handle in (
+            self._radius,
+            self._depth,
+            self._samples,
+            self._arc_step,
+            self._loss,
+            self._tabs,
+        ):
             handle.on_update(lambda _event: self._params_changed())
 
         @self._show_pattern.on_update
@@ -310,6 +320,7 @@ class AppServer:
             radius=f"{float(self._radius.value)}%",
             depth=f"{float(self._depth.value)}%",
             samples=int(self._samples.value),
+            arc_step=float(self._arc_step.value),
             material_loss=bool(self._loss.value),
             tabs=bool(self._tabs.value),
         )
@@ -428,7 +439,7 @@ def params_text(params) -> str:
     Returns
     -------
     str
-        E.g. ``radius 10.0%, depth 30.0% (own depth at 2 vertices), samples 24``.
+        E.g. ``radius 10.0%, depth 30.0% (own depth at 2 vertices), samples 24, arc step 1.5°``.
     """
 
     def length(x) -> str:
@@ -447,6 +458,7 @@ def params_text(params) -> str:
         depth, own = depth.get("default"), f" (own depth at {where})" if n else ""
     radius = ("max " if params.material_loss else "") + length(params.radius)
     text = f"radius {radius}, depth {length(depth)}{own}, samples {params.samples}"
+    text += f", arc step {params.arc_step:g}°" if params.arc_step > 0 else ", no arc step"
     return text + (", material loss" if params.material_loss else "")
 
 

@@ -21,7 +21,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..design import DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES, Design, round_mesh
+from ..design import (
+    DEFAULT_ARC_STEP,
+    DEFAULT_DEPTH,
+    DEFAULT_RADIUS,
+    DEFAULT_SAMPLES,
+    Design,
+    round_mesh,
+)
 from ..errors import MeshReadError, ParameterError
 from ..export.cutfiles import cut_files
 from ..export.report import report_json
@@ -36,7 +43,7 @@ UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
 #: Files in the zip from :meth:`AppSession.export_zip`, besides ``report.json``.
 ZIP_FORMATS = ("fold", "obj", "svg", "dxf")
 #: Parameters :meth:`AppSession.set_params` accepts.
-PARAM_NAMES = ("radius", "depth", "samples", "material_loss", "clamp", "tabs")
+PARAM_NAMES = ("radius", "depth", "samples", "arc_step", "material_loss", "clamp", "tabs")
 
 
 @dataclass(frozen=True)
@@ -127,6 +134,9 @@ class AppSession:
     radius, depth : float or str
         As for :func:`~filletfold.design.round_mesh` (``"10%"`` of the mean edge length...).
     samples : int
+    arc_step : float
+        Largest turn between two samples of an arc (degrees; see
+        :func:`~filletfold.design.round_mesh`).
     material_loss : bool
 
     Attributes
@@ -135,7 +145,8 @@ class AppSession:
     name : str
         What the mesh came from.
     params : dict
-        ``radius``, ``depth``, ``samples``, ``material_loss``, ``clamp``.
+        ``radius``, ``depth``, ``samples``, ``arc_step``, ``material_loss``, ``clamp``,
+        ``tabs``.
     vertex_depth : dict of int to float or str
         Per-vertex depth overrides.
     design : Design or None
@@ -150,6 +161,7 @@ class AppSession:
         radius=DEFAULT_RADIUS,
         depth=DEFAULT_DEPTH,
         samples: int = DEFAULT_SAMPLES,
+        arc_step: float = DEFAULT_ARC_STEP,
         material_loss: bool = False,
     ):
         self.mesh: PolyMesh | None = None
@@ -158,6 +170,7 @@ class AppSession:
             "radius": radius,
             "depth": depth,
             "samples": samples,
+            "arc_step": arc_step,
             "material_loss": material_loss,
             "clamp": True,
             "tabs": False,  # the download always has them (see export_files)
@@ -280,8 +293,8 @@ class AppSession:
         return self.design
 
     def set_params(self, **kw) -> None:
-        """Change parameters (``radius``, ``depth``, ``samples``, ``material_loss``, ``clamp``,
-        ``tabs``: glue tabs in the shown pattern, off by default for speed).
+        """Change parameters (``radius``, ``depth``, ``samples``, ``arc_step``, ``material_loss``,
+        ``clamp``, ``tabs``: glue tabs in the shown pattern, off by default for speed).
 
         Raises
         ------
@@ -385,6 +398,7 @@ class AppSession:
                 radius=p.radius,
                 depth=p.depth,
                 samples=p.samples,
+                arc_step=p.arc_step,
                 clamp=p.clamp,
                 material_loss=p.material_loss,
                 max_loss=p.max_loss,
