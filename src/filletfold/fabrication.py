@@ -14,7 +14,7 @@ import shapely
 from .errors import ParameterError
 from .module import Piece, build_module, face_polygons
 from .net import build_nets, cut_edges_for_nets
-from .vertex.frame import apply, invert, vertex_frame
+from .vertex.frame import apply, invert, vertex_frames
 
 #: Sheet sizes in millimetres (width, height), portrait.
 SHEETS_MM = {
@@ -95,10 +95,15 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
     best = None
     for cut in choices[:tries]:
         pieces = [] if cut is not None else modules
+        recut = {}  # the frames cut along the tree's edges, built at once
+        if cut is not None:
+            cut_at = [u for u, (f, _, _) in enumerate(solved) if f.ring.closed and cut[u] >= 0]
+            new_frames = vertex_frames(mesh, rounding, cut_at, [int(cut[u]) for u in cut_at])
+            recut = dict(zip(cut_at, new_frames, strict=True))
         for u, (frame, apex, v) in enumerate(solved if cut is not None else []):
-            if cut is not None and frame.ring.closed and cut[u] >= 0:
+            if u in recut:
                 k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
-                new = vertex_frame(mesh, rounding, u, int(cut[u]))
+                new = recut[u]
                 if v is not None and k:
                     v = apply(invert(frame.face_map[k - 1]), v)[0]
                 frame = new

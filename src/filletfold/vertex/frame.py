@@ -11,15 +11,19 @@ All pieces are developed into one common 2D frame: the chart of ``tau = f_{n-1}`
 cylinder and face gets a rigid 2D map (3x3 homogeneous) by chaining the tangent-plane gluings
 ``tau -> cylinder 0 -> f_0 -> ... -> cylinder n-1 -> tau'``. The last map ``rho`` turns by minus the
 angle defect; the developed apex is its fixed point (METHOD-NOTES, "one common 2D frame").
+
+:func:`vertex_frames` builds the frames of many vertices at once, on flat arrays over all their
+(vertex, ring position) pairs; :func:`vertex_frame` is one vertex through it.
 """
 
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
 from ..rounding import EdgeRounding
 
@@ -95,14 +99,33 @@ class Side:
         return self.base([self.arc])[0] if self.rounded else self.M
 
 
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products (...,) of vectors (..., 3); the same bits as ``a[k] @ b[k]``."""
+    return (a[..., None, :] @ b[..., :, None])[..., 0, 0]
+
+
+def _norm(a: np.ndarray) -> np.ndarray:
+    """Row-wise lengths (...,) of vectors (..., 3); the same bits as ``np.linalg.norm(a[k])``."""
+    return np.sqrt(_dot(a, a))
+
+
+def _face_axes(mesh: PolyMesh, faces: np.ndarray) -> np.ndarray:
+    """In-plane axes of the charts of ``faces`` (k,): (k, 2, 3) rows e1, e2.
+
+    ``e1`` runs from a face's first vertex to its second, ``e2 = n x e1`` (``n`` the front
+    normal), so the chart is orientation-preserving.
+    """
+    first = mesh.face_start[faces]
+    a = mesh.vertices[mesh.halfedge_from[first]]
+    d = mesh.vertices[mesh.halfedge_from[first + 1]] - a
+    e1 = d / _norm(d)[:, None]
+    return np.stack([e1, np.cross(mesh.face_normal[faces], e1)], axis=1)
+
+
 def face_frame(mesh: PolyMesh, f: int, origin: np.ndarray) -> np.ndarray:
     """(3, 3) rows: origin, e1, e2 of an orientation-preserving chart of face ``f``."""
-    n = mesh.face_normal[f]
-    face = mesh.faces[f]
-    d = mesh.vertices[face[1]] - mesh.vertices[face[0]]
-    e1 = d / np.linalg.norm(d)
-    e2 = np.cross(n, e1)
-    return np.stack([origin, e1, e2])
+    axes = _face_axes(mesh, np.array([f], dtype=np.int64))[0]
+    return np.concatenate([np.asarray(origin, dtype=float)[None], axes])
 
 
 def to_chart(frame: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -112,10 +135,15 @@ def to_chart(frame: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 def rigid(linear: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """3x3 homogeneous matrix of the 2D map ``x -> linear @ x + t``."""
-    m = np.eye(3)
-    m[:2, :2] = linear
-    m[:2, 2] = t
+    """3x3 homogeneous matrix of the 2D map ``x -> linear @ x + t``.
+
+    Stacked: ``linear`` (..., 2, 2) and ``t`` (..., 2) give (..., 3, 3).
+    """
+    linear = np.asarray(linear, dtype=float)
+    m = np.zeros((*linear.shape[:-2], 3, 3))
+    m[..., :2, :2] = linear
+    m[..., :2, 2] = t
+    m[..., 2, 2] = 1.0
     return m
 
 
@@ -126,9 +154,9 @@ def apply(m: np.ndarray, p) -> np.ndarray:
 
 
 def invert(m: np.ndarray) -> np.ndarray:
-    """Inverse of a rigid 3x3 homogeneous 2D map."""
-    q = m[:2, :2].T
-    return rigid(q, -q @ m[:2, 2])
+    """Inverse of a rigid 3x3 homogeneous 2D map (or of a stack (..., 3, 3) of them)."""
+    q = np.swapaxes(m[..., :2, :2], -1, -2)
+    return rigid(q, -(q @ m[..., :2, 2:])[..., 0])
 
 
 @dataclass
@@ -162,11 +190,21 @@ class SideArrays:
     t: np.ndarray
     face_normal: np.ndarray
 
+    def _angle(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """(m, 1) turning angles ``s / r`` of sides ``i`` (0 on a side of radius 0)."""
+        r = self.radius[i]
+        return np.where(r > 0, s / np.where(r > 0, r, 1.0), 0.0)[:, None]
+
     def normal(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
         """(m, 3) front normals at arc parameters ``s`` (m,) of sides ``i`` (m,)."""
-        r = self.radius[i]
-        ang = np.where(r > 0, s / np.where(r > 0, r, 1.0), 0.0)[:, None]
+        ang = self._angle(i, s)
         return np.cos(ang) * self.N0[i] + np.sin(ang) * self.B[i]
+
+    def tangent(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """(m, 3) unit tangents ``C'(s)`` of sides ``i`` (``B = R x N0`` on a flat side)."""
+        ang = self._angle(i, s)
+        k = np.where(self.radius[i] > 0, self.kappa[i], 1.0)[:, None]
+        return k * (-np.sin(ang) * self.N0[i] + np.cos(ang) * self.B[i])
 
     def base(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
         """(m, 3) base-curve points ``C(s)`` of sides ``i``."""
@@ -294,68 +332,344 @@ class VertexFrame:
 
     @staticmethod
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
-        tan = side.tangent([s])[0]
-        lin = np.array([[tan @ frame[1], side.R @ frame[1]], [tan @ frame[2], side.R @ frame[2]]])
-        p = to_chart(frame, side.base([s])[0])[0]
-        return rigid(lin, p - lin @ np.array([s, 0.0]))
+        s = np.array([s], dtype=float)
+        return _gluing_maps(side.tangent(s), side.R[None], frame[None], side.base(s), s)[0]
 
 
-def build_side(
-    mesh: PolyMesh,
-    rounding: EdgeRounding,
-    u: int,
-    e: int,
-    n_prev: np.ndarray | None,
-    n_next: np.ndarray | None,
-) -> Side:
-    """The side of edge ``e`` seen from vertex ``u``.
+def _gluing_maps(
+    tangent: np.ndarray, R: np.ndarray, frames: np.ndarray, C: np.ndarray, s: np.ndarray
+) -> np.ndarray:
+    """Maps from cylinder charts ``(s, z)`` into face charts, where cylinder and face touch.
 
-    ``n_prev`` and ``n_next`` are the front normals of the ring faces before and after the edge
-    (``f_{i-1}`` and ``f_i``).
+    Parameters
+    ----------
+    tangent : (k, 3) float
+        Unit tangent ``C'(s)`` of the base curve at the contact line.
+    R : (k, 3) float
+        Unit edge direction (the charts' ``z`` axis).
+    frames : (k, 3, 3) float
+        The faces' charts (rows origin, e1, e2).
+    C : (k, 3) float
+        Base-curve point ``C(s)`` on the contact line.
+    s : (k,) float
+        Arc parameter of the contact line.
+
+    Returns
+    -------
+    (k, 3, 3) float
+        Rigid maps: ``(s, 0) -> C`` and the chart axes ``(C'(s), R)`` onto the face's.
     """
-    a, b = mesh.edges[e]
-    other = b if a == u else a
-    d = mesh.vertices[u] - mesh.vertices[other]
-    length = float(np.linalg.norm(d))
-    R = d / length
-    M = 0.5 * (mesh.vertices[u] + mesh.vertices[other])
-    common = {"edge": int(e), "R": R, "M": M, "length": length}
-    if n_prev is None or n_next is None:
-        return Side(rounded=False, **common)
-    r = float(rounding.radius[e])
-    if r <= 0:  # flat edge between coplanar faces: a cylinder of radius 0
-        return Side(rounded=True, O=M, N0=n_prev, B=np.cross(R, n_prev), **common)
-    B = n_next - (n_next @ n_prev) * n_prev
-    B /= np.linalg.norm(B)
-    return Side(
-        rounded=True,
-        radius=r,
-        gamma=float(rounding.half_angle[e]),
-        arc=float(rounding.arc_length[e]),
-        kappa=int(rounding.kappa[e]),
-        O=rounding.axis_point[e],
-        N0=n_prev,
-        B=B,
-        **common,
-    )
+    axes = frames[:, 1:]
+    lin = np.stack([_dot(axes, tangent[:, None]), _dot(axes, R[:, None])], axis=-1)
+    p = _dot(axes, (C - frames[:, 0])[:, None])
+    return rigid(lin, p - lin[..., 0] * s[:, None])
 
 
-def _line_crossing(p1, d1, p2, d2):
-    """Parameters (z1, z2) with p1 + z1 d1 ~= p2 + z2 d2 (least squares; unit d1, d2)."""
+def _line_crossings(p1, d1, p2, d2):
+    """Parameters ``z1, z2`` (k,) with ``p1 + z1 d1 ~= p2 + z2 d2``, row by row.
+
+    Least squares; ``p1, p2`` (k, 3) points, ``d1, d2`` (k, 3) unit directions. Where two lines
+    are (nearly) parallel, the least-squares solution of smallest norm (that of
+    :func:`numpy.linalg.lstsq`).
+    """
     delta = p2 - p1
-    c = float(d1 @ d2)
-    a, b = float(d1 @ delta), float(d2 @ delta)
+    c, a, b = _dot(d1, d2), _dot(d1, delta), _dot(d2, delta)
     det = 1.0 - c * c
-    if det < 1e-12:  # (nearly) parallel: the least-squares solution of smallest norm
-        z, *_ = np.linalg.lstsq(np.stack([d1, -d2], axis=1), delta, rcond=None)
-        return float(z[0]), float(z[1])
-    return (a - c * b) / det, (c * a - b) / det
+    parallel = det < 1e-12
+    det = np.where(parallel, 1.0, det)
+    z1, z2 = (a - c * b) / det, (c * a - b) / det
+    if parallel.any():  # minimum-norm least squares, singular values cut as lstsq does
+        A = np.stack([d1[parallel], -d2[parallel]], axis=-1)  # (m, 3, 2)
+        u, sv, vt = np.linalg.svd(A, full_matrices=False)
+        keep = sv > 3 * np.finfo(float).eps * sv[:, :1]
+        w = np.einsum("mij,mi->mj", u, delta[parallel])
+        w = np.where(keep, w / np.where(keep, sv, 1.0), 0.0)
+        z = np.einsum("mji,mj->mi", vt, w)
+        z1[parallel], z2[parallel] = z[:, 0], z[:, 1]
+    return z1, z2
+
+
+def _halfedge_ids(mesh: PolyMesh, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k,) int: the half-edges ``a -> b`` (k,), -1 where there is none.
+
+    :meth:`PolyMesh.halfedge` for arrays.
+    """
+    keys = mesh._he_key_sorted
+    k = np.asarray(a, dtype=np.int64) * mesh.n_vertices + b
+    if not len(keys):
+        return np.full(k.shape, -1, dtype=np.int64)
+    i = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+    return np.where(keys[i] == k, mesh._he_order[i], -1)
+
+
+def _ring_walks(mesh: PolyMesh, verts: np.ndarray):
+    """Walk the rings of many vertices at once, as :meth:`PolyMesh.vertex_ring` does one by one.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    verts : (n,) int
+
+    Returns
+    -------
+    he : (n, w) int
+        ``he[j, i]`` is the half-edge ``u -> q`` of ring face ``f_i`` (``i < n_faces[j]``; the
+        ring's edge ``e_i`` and face ``f_i``), -1 beyond.
+    n_faces : (n,) int
+    last : (n,) int
+        The half-edge ``p -> u`` whose edge closes an open ring (-1 for a closed ring).
+    closed : (n,) bool
+
+    Raises
+    ------
+    MeshError
+        As :meth:`PolyMesh.vertex_ring`, for the first vertex whose ring is not a single fan.
+    """
+    frm = mesh.halfedge_from
+    out = np.nonzero(np.isin(frm, verts))[0]
+    out = out[np.argsort(frm[out], kind="stable")]  # outgoing half-edges by vertex, then index
+    gv, gstart, gcount = np.unique(frm[out], return_index=True, return_counts=True)
+    g = np.minimum(np.searchsorted(gv, verts), max(len(gv) - 1, 0))
+    used = gv[g] == verts if len(gv) else np.zeros(len(verts), dtype=bool)
+    # start: the first outgoing u -> q without a reverse (an open ring), else the first one
+    pos = np.arange(len(out))
+    key = np.where(_halfedge_ids(mesh, mesh.halfedge_to[out], frm[out]) < 0, pos, pos + len(out))
+    first = np.minimum.reduceat(key, gstart) if len(out) else key
+    closed_g = first >= len(out)
+    start = out[np.where(closed_g, gstart, first)][g] if len(out) else np.zeros(len(verts), int)
+    closed = closed_g[g] if len(out) else np.ones(len(verts), dtype=bool)
+    n_out = np.where(used, gcount[g] if len(out) else 0, 0)
+    n = len(verts)
+    width = int(n_out.max(initial=0))
+    he = np.full((n, width + 1), -1, dtype=np.int64)
+    last = np.full(n, -1, dtype=np.int64)
+    n_faces = np.zeros(n, dtype=np.int64)
+    bad = ~used
+    active = used.copy()
+    cur = start.copy()
+    for k in range(width + 1):
+        over = active & (k >= n_out)  # more faces than outgoing half-edges: not a fan
+        bad |= over
+        active &= ~over
+        idx = np.nonzero(active)[0]
+        if not len(idx):
+            break
+        h = cur[idx]
+        he[idx, k] = h
+        ph = mesh.halfedge_prev[h]  # p -> u in the same face; the next face holds u -> p
+        nh = _halfedge_ids(mesh, verts[idx], frm[ph])
+        end = nh < 0  # reached the boundary: the last edge is (u, p)
+        last[idx[end]] = ph[end]
+        stop = end | (nh == start[idx])
+        n_faces[idx[stop]] = k + 1
+        active[idx[stop]] = False
+        cur[idx[~stop]] = nh[~stop]
+    bad |= n_faces != n_out
+    for u in verts[bad]:
+        mesh.vertex_ring(int(u))  # raises the MeshError that names the problem
+        raise MeshError(f"non-manifold vertex {u}: its faces do not form a fan", vertex=int(u))
+    return he[:, :width], n_faces, last, closed
+
+
+def vertex_frames(
+    mesh: PolyMesh, rounding: EdgeRounding, vertices, start_edges=None
+) -> list[VertexFrame]:
+    """Build the sides, T points and development of many vertices at once.
+
+    Every formula runs on flat arrays over all the vertices' (vertex, ring position) pairs;
+    the development's chained maps run ring position by ring position, over all vertices.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+    vertices : sequence of int
+        The vertices, (n,).
+    start_edges : sequence of (int or None), optional
+        Per vertex, for a closed ring: the incident edge to list first. The development is cut
+        along the start of its cylinder, so this chooses where the module's angle-defect cut
+        runs. None (or an edge not in the ring) keeps the ring's own order.
+
+    Returns
+    -------
+    list of VertexFrame
+        In the order of ``vertices``; the frames of closed rings come with their
+        :attr:`VertexFrame.arrays` filled in.
+
+    Raises
+    ------
+    MeshError
+        If a vertex is not used by any face or its faces do not form a single fan.
+    """
+    verts = np.asarray(vertices, dtype=np.int64).reshape(-1)
+    n = len(verts)
+    if start_edges is not None and len(start_edges) != n:
+        raise ValueError(f"{len(start_edges)} start edges for {n} vertices")
+    if n == 0:
+        return []
+    he, nf, last, closed = _ring_walks(mesh, verts)
+    ne = nf + ~closed
+    he_edge = mesh.halfedge_edge
+    shift = np.zeros(n, dtype=np.int64)  # closed rings: position of the start edge
+    if start_edges is not None:
+        want = np.array([-1 if e is None else int(e) for e in start_edges], dtype=np.int64)
+        hit = (he_edge[he] == want[:, None]) & (he >= 0) & closed[:, None]
+        shift = np.where(hit.any(axis=1), hit.argmax(axis=1), 0)
+
+    # ---- flat (vertex, ring position) pairs: sides (one per edge) and faces
+    so = np.concatenate([[0], np.cumsum(ne)])
+    fo = np.concatenate([[0], np.cumsum(nf)])
+    sv = np.repeat(np.arange(n), ne)  # (P,) vertex of each side
+    sp = np.arange(so[-1]) - so[sv]  # (P,) its ring position
+    fv = np.repeat(np.arange(n), nf)  # (F,) vertex of each face
+    fp = np.arange(fo[-1]) - fo[fv]
+    nfs = nf[sv]
+    fh = he[fv, (fp + shift[fv]) % nf[fv]]  # (F,) half-edge u -> q in face f_i
+    sh = he[sv, (sp + shift[sv]) % nfs]  # (P,) half-edge u -> q of edge e_i (i < n_faces)
+    tail = sp >= nfs  # the last edge of an open ring
+    lh = last[sv[tail]]
+    edge = he_edge[sh]
+    edge[tail] = he_edge[lh]
+    nbr = mesh.halfedge_to[sh]
+    nbr[tail] = mesh.halfedge_from[lh]
+    face = mesh.halfedge_face[fh]
+    corner = mesh.corner_angles()[fh]
+
+    # ---- sides (see Side): rounded ones run from f_{i-1} to f_i
+    U = mesh.vertices[verts]
+    other = mesh.vertices[nbr]
+    d = U[sv] - other
+    length = _norm(d)
+    R = d / length[:, None]
+    M = 0.5 * (U[sv] + other)
+    rounded = closed[sv] | ((sp > 0) & ~tail)
+    f_prev = fo[sv] + (sp - 1) % nfs  # (P,) flat face f_{i-1}, f_i (valid on rounded sides)
+    f_next = fo[sv] + sp % nfs
+    normals = mesh.face_normal[face]
+    n_prev = normals[f_prev]
+    curved = rounded & (rounding.radius[edge] > 0)  # else a flat edge: a cylinder of radius 0
+    N0 = np.where(rounded[:, None], n_prev, 0.0)
+    B = np.where(rounded[:, None], np.cross(R, n_prev), 0.0)
+    c = np.nonzero(curved)[0]
+    n_next = normals[f_next[c]]
+    b = n_next - _dot(n_next, n_prev[c])[:, None] * n_prev[c]
+    B[c] = b / _norm(b)[:, None]
+    O = M.copy()
+    O[c] = rounding.axis_point[edge[c]]
+    radius = np.where(curved, rounding.radius[edge], 0.0)
+    gamma = np.where(curved, rounding.half_angle[edge], 0.0)
+    arc = np.where(curved, rounding.arc_length[edge], 0.0)
+    kappa = np.where(curved, rounding.kappa[edge], 0).astype(np.int64)
+    # boundary sides get O = M and zero N0, B here, so that their base curve is the point M
+    sa = SideArrays(
+        edge=edge.astype(np.int64),
+        R=R,
+        M=M,
+        O=O,
+        N0=N0,
+        B=B,
+        radius=radius,
+        kappa=kappa.astype(float),
+        arc=arc,
+        length=length,
+        Q=None,
+        t=None,
+        face_normal=None,
+    )
+    frames = np.concatenate([U[fv][:, None], _face_axes(mesh, face)], axis=1)  # (F, 3, 3)
+
+    # ---- T points: the tangent lines on face f_i of sides i (its end) and i + 1 (its start)
+    si = so[fv] + fp
+    sj = so[fv] + (fp + 1) % ne[fv]
+    p1 = sa.base(si, arc[si])
+    p2 = sa.base(sj, np.zeros(len(sj)))
+    z1, z2 = _line_crossings(p1, R[si], p2, R[sj])
+    lmax_start, lmax_end = np.full(len(sv), np.nan), np.full(len(sv), np.nan)
+    T_start, T_end = np.full((len(sv), 3), np.nan), np.full((len(sv), 3), np.nan)
+    lmax_end[si], lmax_start[sj] = z1, z2
+    T_end[si] = p1 + z1[:, None] * R[si]
+    T_start[sj] = p2 + z2[:, None] * R[sj]
+
+    # ---- development: chain tau -> cylinder 0 -> f_0 -> ... (closed) or f_0 -> ... (open)
+    rs = np.nonzero(rounded)[0]
+    s0 = np.zeros(len(rs))
+    g_start = np.full((len(sv), 3, 3), np.nan)
+    g_end_inv = np.full((len(sv), 3, 3), np.nan)
+    g_start[rs] = _gluing_maps(sa.tangent(rs, s0), R[rs], frames[f_prev[rs]], sa.base(rs, s0), s0)
+    g_end_inv[rs] = invert(
+        _gluing_maps(
+            sa.tangent(rs, arc[rs]), R[rs], frames[f_next[rs]], sa.base(rs, arc[rs]), arc[rs]
+        )
+    )
+    current = np.repeat(np.eye(3)[None], n, axis=0)  # tau = f_{n-1}; f_0 for an open ring
+    cyl_map = np.full((len(sv), 3, 3), np.nan)
+    face_map = np.empty((len(fv), 3, 3))
+    for k in range(int(ne.max())):
+        j = np.nonzero(k < ne)[0]
+        j = j[rounded[so[j] + k]]
+        p = so[j] + k
+        cyl_map[p] = current[j] @ g_start[p]
+        current[j] = cyl_map[p] @ g_end_inv[p]
+        j = np.nonzero(k < nf)[0]
+        face_map[fo[j] + k] = current[j]
+    sa.Q = cyl_map[:, :2, :2].transpose(0, 2, 1)  # maps are rigid: the inverse is [Q^T, -Q^T t]
+    sa.t = -np.einsum("kij,kj->ki", sa.Q, cyl_map[:, :2, 2])
+    sa.face_normal = np.cross(frames[:, 1], frames[:, 2])
+
+    # ---- objects
+    sides = []
+    columns = (edge, rounded, R, M, length, radius, gamma, arc, kappa, O, N0, B)
+    for e, rnd, r3, m3, ln, rad, gam, a, kap, o3, n3, b3 in zip(
+        *[c.tolist() if c.ndim == 1 else c for c in columns], strict=True
+    ):
+        if rnd:
+            sides.append(Side(e, True, r3, m3, ln, rad, gam, a, kap, o3, n3, b3))
+        else:
+            sides.append(Side(e, False, r3, m3, ln))
+    cyl_list = [m if r else None for m, r in zip(cyl_map, rounded.tolist(), strict=True)]
+    frame_list, face_map_list = list(frames), list(face_map)
+    per_side = [(fd.name, getattr(sa, fd.name)) for fd in fields(SideArrays)]
+    per_side = [(name, a) for name, a in per_side if name != "face_normal"]
+    result = []
+    for j, u in enumerate(verts.tolist()):
+        s, s2, f, f2 = so[j], so[j + 1], fo[j], fo[j + 1]
+        ring = VertexRing(
+            vertex=u,
+            edges=sa.edge[s:s2],
+            faces=face[f:f2],
+            neighbors=nbr[s:s2],
+            closed=bool(closed[j]),
+        )
+        frame = VertexFrame(
+            vertex=u,
+            ring=ring,
+            U=mesh.vertices[u],
+            sides=sides[s:s2],
+            face_frames=frame_list[f:f2],
+            cyl_map=cyl_list[s:s2],
+            face_map=face_map_list[f:f2],
+            rho=current[j] if ring.closed else None,
+            lmax_start=lmax_start[s:s2],
+            lmax_end=lmax_end[s:s2],
+            T_start=T_start[s:s2],
+            T_end=T_end[s:s2],
+            corner_angle=corner[f:f2],
+        )
+        if ring.closed:
+            frame.__dict__["arrays"] = SideArrays(
+                **{name: a[s:s2] for name, a in per_side},
+                face_normal=sa.face_normal[f:f2],
+            )
+        result.append(frame)
+    return result
 
 
 def vertex_frame(
     mesh: PolyMesh, rounding: EdgeRounding, u: int, start_edge: int | None = None
 ) -> VertexFrame:
     """Build the sides, T points and development of vertex ``u``.
+
+    One vertex through :func:`vertex_frames`.
 
     Parameters
     ----------
@@ -370,67 +684,4 @@ def vertex_frame(
     -------
     VertexFrame
     """
-    ring = mesh.vertex_ring(u)
-    if ring.closed and start_edge is not None:
-        hit = np.nonzero(ring.edges == start_edge)[0]
-        if len(hit):
-            k = int(hit[0])
-            ring = VertexRing(
-                vertex=ring.vertex,
-                edges=np.roll(ring.edges, -k),
-                faces=np.roll(ring.faces, -k),
-                neighbors=np.roll(ring.neighbors, -k),
-                closed=True,
-            )
-    U = mesh.vertices[u]
-    nf = len(ring.faces)
-    ne = len(ring.edges)
-    normals = mesh.face_normal[ring.faces]
-    sides = []
-    for i, e in enumerate(ring.edges):
-        prev = normals[i - 1] if (ring.closed or i > 0) else None
-        nxt = normals[i] if (ring.closed or i < nf) else None
-        sides.append(build_side(mesh, rounding, u, int(e), prev, nxt))
-    frames = [face_frame(mesh, int(f), U) for f in ring.faces]
-    angles = mesh.corner_angles()
-    corner_angle = np.array([angles[mesh.halfedge(u, int(q))] for q in ring.neighbors[:nf]])
-    lmax_start = np.full(ne, np.nan)
-    lmax_end = np.full(ne, np.nan)
-    T_start = np.full((ne, 3), np.nan)
-    T_end = np.full((ne, 3), np.nan)
-    for i in range(nf):
-        j = (i + 1) % ne
-        s1, s2 = sides[i], sides[j]
-        p1, p2 = s1.end_point(), s2.start_point()
-        z1, z2 = _line_crossing(p1, s1.R, p2, s2.R)
-        lmax_end[i], lmax_start[j] = z1, z2
-        T_end[i] = p1 + z1 * s1.R
-        T_start[j] = p2 + z2 * s2.R
-    frame = VertexFrame(
-        vertex=u,
-        ring=ring,
-        U=U,
-        sides=sides,
-        face_frames=frames,
-        cyl_map=[None] * ne,
-        face_map=[None] * nf,
-        rho=None,
-        lmax_start=lmax_start,
-        lmax_end=lmax_end,
-        T_start=T_start,
-        T_end=T_end,
-        corner_angle=corner_angle,
-    )
-    if ring.closed:
-        current = np.eye(3)  # tau = f_{n-1}
-        for i in range(ne):
-            frame.cyl_map[i] = current @ frame.gluing_start(i)
-            current = frame.cyl_map[i] @ invert(frame.gluing_end(i))
-            frame.face_map[i] = current
-        frame.rho = current
-    else:
-        frame.face_map[0] = np.eye(3)
-        for i in range(1, ne - 1):
-            frame.cyl_map[i] = frame.face_map[i - 1] @ frame.gluing_start(i)
-            frame.face_map[i] = frame.cyl_map[i] @ invert(frame.gluing_end(i))
-    return frame
+    return vertex_frames(mesh, rounding, [u], [start_edge])[0]
