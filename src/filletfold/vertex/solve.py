@@ -15,7 +15,7 @@ from ..rounding import EdgeRounding
 from ..tolerances import tol
 from .apex import build_constraints, validate_apex
 from .batch import solve_apex_batch
-from .frame import VertexFrame, vertex_frame
+from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angle_front, vertex_normals
 
 STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
@@ -118,7 +118,7 @@ def classify_vertices(
         Default: every vertex.
     start_edge : sequence of (int or None), optional
         Per listed vertex, the incident edge along which its module is cut (see
-        :func:`~filletfold.vertex.frame.vertex_frame`).
+        :func:`~filletfold.vertex.frame.vertex_frames`).
 
     Returns
     -------
@@ -130,7 +130,7 @@ def classify_vertices(
     vertices = [int(u) for u in vertices]
     if start_edge is None:
         start_edge = [None] * len(vertices)
-    frames = [vertex_frame(mesh, rounding, u, e) for u, e in zip(vertices, start_edge, strict=True)]
+    frames = vertex_frames(mesh, rounding, vertices, start_edge)
     closed = [k for k, f in enumerate(frames) if f.ring.closed]
     for k, frame in enumerate(frames):
         u = vertices[k]
