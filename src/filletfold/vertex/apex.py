@@ -15,17 +15,19 @@ The quadratic range constraints are sampled at a few points per arc during the s
 constraint ``l <= l_max`` is reverse-convex, so the solve starts with a feasibility phase
 (maximise the smallest slack) before the projection of ``P`` (METHOD-NOTES); the solver is
 :func:`filletfold.vertex.batch.solve_apex_batch`, which solves many vertices at once. Every
-result is then validated densely, without margin, by :func:`validate_apex`.
+result is then validated densely, without margin, by :func:`validate_apices` (all the
+vertices of a round at once).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from ..tolerances import tol
-from .frame import VertexFrame
+from .frame import SideArrays, VertexFrame
 
 KINDS = {
     "patch": "valid patch (developed height above spatial height)",
@@ -300,86 +302,157 @@ def validate_apex(
     n_samples: int = 65,
     centres: np.ndarray | None = None,
 ) -> ApexCheck:
-    """Check every condition along every arc, without margin.
+    """One vertex through :func:`validate_apices`.
+
+    Parameters
+    ----------
+    frame : VertexFrame
+    V : (3,) float
+        Spatial apex.
+    v : (2,) float
+        Developed apex in the common frame.
+    sigma : int
+    n_samples : int
+    centres : (n_faces, 3) float, optional
+    """
+    return validate_apices([frame], [V], [v], [sigma], n_samples, centres)[0]
+
+
+def validate_apices(
+    frames: Sequence[VertexFrame],
+    apices,
+    developed,
+    sigmas,
+    n_samples: int = 65,
+    centres: np.ndarray | None = None,
+) -> list[ApexCheck]:
+    """Check every condition along every arc of many vertices at once, without margin.
 
     Conditions: ``Dn > 0``; ``l(s) >= 0``; ``l <= l_max`` at both ends; ``sigma (V - C) . N > 0``
     along the arc; ``sigma (V - T) . N_f > 0`` for every face; and, given the face pieces'
-    ``centres`` ((n_faces, 3) float), the straight crease on every face runs between the
-    corner T and the centre, so the vertex's share of the face stays a simple polygon.
+    ``centres``, the straight crease on every face runs between the corner T and the centre,
+    so the vertex's share of the face stays a simple polygon.
 
     The two conditions along an arc are checked at ``n_samples`` points and then at the
     minimum between them, found by Newton steps on their closed forms (a convex quadratic
     plus a sinusoid over at most half its period: at most two local minima, which the samples
-    separate).
+    separate). The sides of all vertices are stacked into one :class:`SideArrays` (sides of a
+    vertex one after another), so every step runs once for the whole batch; each vertex's
+    result is the same as when it is checked alone.
+
+    Parameters
+    ----------
+    frames : sequence of VertexFrame
+        Closed-ring vertices, ``n`` of them.
+    apices : (n, 3) float
+        Spatial apex ``V`` of each vertex.
+    developed : (n, 2) float
+        Developed apex ``v`` of each vertex, in its common frame.
+    sigmas : (n,) int
+        Side of each apex (+1 front, -1 back).
+    n_samples : int
+        Samples per arc (both ends included).
+    centres : (n_faces, 3) float, optional
+        Face pieces' centres, indexed by mesh face: adds the face-centre condition.
+
+    Returns
+    -------
+    list of ApexCheck
+        One per vertex, in the order of ``frames``; ``failing`` lists, per vertex, the
+        conditions of its sides in order (patch, l_min, l_max, nonint per side), then those of
+        its faces (face, centre per face).
     """
-    sa = frame.arrays
-    k = len(sa.arc)
-    scale = float(sa.length.mean())
-    eps = tol.validate * scale
+    n = len(frames)
+    if n == 0:
+        return []
+    arrs = [f.arrays for f in frames]
+    sa = _stack(arrs)  # the sides of every vertex, vertex after vertex
+    n_sides = np.array([len(a.arc) for a in arrs])
+    n_faces = np.array([len(f.ring.faces) for f in frames])
+    vert = np.repeat(np.arange(n), n_sides)  # (K,) vertex of each side
+    fvert = np.repeat(np.arange(n), n_faces)  # (F,) vertex of each face
+    offset = np.concatenate([[0], np.cumsum(n_sides)[:-1]])  # first side of each vertex
+    scale = np.array([a.length.mean() for a in arrs])  # (add.reduceat sums in another order)
+    eps = tol.validate * scale  # (n,)
+    sigma = np.asarray(sigmas).reshape(n)
+    V = np.asarray(apices, dtype=float).reshape(n, 3)[vert]  # (K, 3) per side
+    v = np.asarray(developed, dtype=float).reshape(n, 2)[vert]  # (K, 2)
+    lmax_start = np.concatenate([f.lmax_start for f in frames])
+    lmax_end = np.concatenate([f.lmax_end for f in frames])
+    faces = np.concatenate([f.ring.faces for f in frames])  # (F,) mesh faces
+    T_face = np.concatenate([f.T_end[:nf] for f, nf in zip(frames, n_faces, strict=True)])
     side, first, last, s, C, N = sa.samples(n_samples)
-    vi = np.einsum("kij,j->ki", sa.Q, v) + sa.t  # developed apex in each cylinder's chart
-    d = V - C
+    vi = np.einsum("kij,kj->ki", sa.Q, v) + sa.t  # developed apex in each cylinder's chart
+    d = V[side] - C
     num = (vi[side, 0] - s) ** 2 + vi[side, 1] ** 2 - np.einsum("ij,ij->i", d, d)
     dn = vi[:, 1] - np.einsum("ij,ij->i", V - sa.M, sa.R)
     valid = dn > 0
     l = 0.5 * num / np.where(valid, dn, 1.0)[side]
-    nonint = sigma * np.einsum("ij,ij->i", d, N)
+    nonint = sigma[vert][side] * np.einsum("ij,ij->i", d, N)
     # the minima between samples: Newton from the smallest sample on the closed forms
     l_min = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
-    nonint_min = _refined_min(sa, V, nonint, s, first, sigma=sigma)
+    nonint_min = _refined_min(sa, V, nonint, s, first, sigma=sigma[vert])
     checks = np.stack(
         [
             dn,
             np.where(valid, l_min, -np.inf),
-            np.where(
-                valid,
-                np.minimum(frame.lmax_start - l[first], frame.lmax_end - l[last]),
-                -np.inf,
-            ),
+            np.where(valid, np.minimum(lmax_start - l[first], lmax_end - l[last]), -np.inf),
             nonint_min,
         ],
         axis=1,
-    )  # (k, 4): patch, l_min, l_max, nonint
-    slack = [checks.ravel()]
-    failing = []
+    )  # (K, 4): patch, l_min, l_max, nonint
     strict = np.array([True, False, False, True])
-    bad = np.where(strict, checks < eps, checks < -eps)
-    names = ("patch", "l_min", "l_max", "nonint")
-    for i, c in zip(*np.nonzero(bad), strict=True):
-        failing.append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
-    nf = len(frame.ring.faces)
-    n = sa.face_normal
-    face_val = sigma * np.einsum("ij,ij->i", V - frame.T_end[:nf], n)
-    slack.append(face_val)
-    centre_val = np.full(nf, np.inf)
+    e_side = eps[vert][:, None]
+    bad = np.where(strict, checks < e_side, checks < -e_side)
+    # faces: side i of a vertex ends on its face i, side i + 1 starts on it
+    local = np.arange(len(faces)) - np.repeat(np.cumsum(n_faces) - n_faces, n_faces)
+    fside = offset[fvert] + local  # (F,) side ending on each face
+    nxt = offset[fvert] + (local + 1) % n_sides[fvert]  # (F,) side starting on it
+    nrm = sa.face_normal
+    face_val = sigma[fvert] * np.einsum("ij,ij->i", V[fside] - T_face, nrm)
+    centre_val = np.full(len(faces), np.inf)
+    e_face = eps[fvert]
     if centres is not None:
-        # the straight crease on face i runs from side i's end to side i+1's start
-        nxt = (np.arange(nf) + 1) % k
-        p0 = C[last[:nf]] + l[last[:nf], None] * sa.R[:nf]
+        p0 = C[last[fside]] + l[last[fside], None] * sa.R[fside]
         p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
         dvec = p1 - p0
         length = np.linalg.norm(dvec, axis=1)
-        dvec = dvec / np.where(length > eps, length, 1.0)[:, None]
-        side_t = np.einsum("ij,ij->i", np.cross(dvec, frame.T_end[:nf] - p0), n)
-        side_c = np.einsum("ij,ij->i", np.cross(dvec, centres[frame.ring.faces] - p0), n)
+        dvec = dvec / np.where(length > e_face, length, 1.0)[:, None]
+        side_t = np.einsum("ij,ij->i", np.cross(dvec, T_face - p0), nrm)
+        side_c = np.einsum("ij,ij->i", np.cross(dvec, centres[faces] - p0), nrm)
         centre_val = np.where(side_t != 0, -side_c * np.sign(side_t), np.abs(side_c))
-        centre_val = np.where(length > eps, centre_val, np.inf)
-        slack.append(centre_val[length > eps])
-    for i, f in enumerate(frame.ring.faces):
-        if face_val[i] < eps:
-            failing.append(f"{KINDS['face']} at face {int(f)}")
-        if centre_val[i] < eps:
-            failing.append(f"{KINDS['centre']} on face {int(f)}")
-    return ApexCheck(not failing, float(np.min(np.concatenate(slack))), failing)
+        centre_val = np.where(length > e_face, centre_val, np.inf)  # no crease: no condition
+    # the smallest slack per vertex (a NaN anywhere propagates, as in np.min)
+    margin = np.full(n, np.inf)
+    np.minimum.at(margin, vert, checks.min(axis=1))
+    np.minimum.at(margin, fvert, np.minimum(face_val, centre_val))
+    failing = [[] for _ in range(n)]
+    names = ("patch", "l_min", "l_max", "nonint")
+    for i, c in zip(*np.nonzero(bad), strict=True):
+        failing[vert[i]].append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
+    face_bad = np.stack([face_val < e_face, centre_val < e_face], axis=1)
+    for j, c in zip(*np.nonzero(face_bad), strict=True):
+        text = f"{KINDS['face']} at face" if c == 0 else f"{KINDS['centre']} on face"
+        failing[fvert[j]].append(f"{text} {int(faces[j])}")
+    return [ApexCheck(not fail, float(m), fail) for fail, m in zip(failing, margin, strict=True)]
+
+
+def _stack(arrays: Sequence[SideArrays]) -> SideArrays:
+    """The sides (and faces) of many vertices in one :class:`SideArrays`, one after another."""
+    return SideArrays(
+        **{x.name: np.concatenate([getattr(a, x.name) for a in arrays]) for x in fields(SideArrays)}
+    )
 
 
 def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.ndarray:
     """(k,) smallest value per side along its arc: the smallest sample, refined by Newton steps
     on the closed form between the samples.
 
-    With ``vi`` and ``dn`` the values are the crease lengths ``l(s) = num(s) / (2 dn)`` of eq. (1)
-    (``num(s) = (v_x - s)^2 + v_y^2 - |V - C(s)|^2``); without, ``sigma (V - C(s)) . N(s)``. With
-    ``C(s) = O + kappa r N(s)`` both are trigonometric in ``s / r``.
+    With ``vi`` ((k, 2) float) and ``dn`` ((k,) float) the values are the crease lengths
+    ``l(s) = num(s) / (2 dn)`` of eq. (1) (``num(s) = (v_x - s)^2 + v_y^2 - |V - C(s)|^2``);
+    without, ``sigma (V - C(s)) . N(s)``. With ``C(s) = O + kappa r N(s)`` both are
+    trigonometric in ``s / r``. ``V`` ((3,) or (k, 3) float) and ``sigma`` (int or (k,)) may be
+    given per side, so that the sides of many vertices are refined at once.
     """
     ends = np.append(first[1:], len(values))
     best = np.minimum.reduceat(values, first)
@@ -387,10 +460,14 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.nd
     ok = r > 0
     if not ok.any():
         return best
-    # the first sample of each side that attains its smallest value
+    # the first sample of each side that attains its smallest value (the side's first sample
+    # where none does: a NaN)
     side = np.repeat(np.arange(len(first)), ends - first)
     hit = np.flatnonzero(values == best[side])
-    arg = hit[np.unique(side[hit], return_index=True)[1]]
+    lead = np.ones(len(hit), dtype=bool)
+    lead[1:] = side[hit[1:]] != side[hit[:-1]]
+    arg = first.copy()
+    arg[side[hit[lead]]] = hit[lead]
     t = s[arg].copy()
     rr = np.where(ok, r, 1.0)
     P = np.einsum("ij,ij->i", V - sa.O, sa.N0)

@@ -13,7 +13,7 @@ import numpy as np
 from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
-from .apex import build_constraints, validate_apex
+from .apex import build_constraints, validate_apices
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angle_front, vertex_normals
@@ -365,10 +365,11 @@ def solve_apices(
     """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
 
     All vertices still without a status are solved together, one attempt per round, by
-    :func:`~filletfold.vertex.batch.solve_apex_batch`; a vertex whose attempt fails the
-    dense validation :func:`validate_apex` goes to its next attempt in the next round (more
-    samples and margin, shorter creases when a straight crease passes a face piece's centre,
-    a tenth of the margin when the sampled problem is infeasible: see :data:`ATTEMPTS`).
+    :func:`~filletfold.vertex.batch.solve_apex_batch`, and validated together by
+    :func:`~filletfold.vertex.apex.validate_apices`; a vertex whose attempt fails the dense
+    validation goes to its next attempt in the next round (more samples and margin, shorter
+    creases when a straight crease passes a face piece's centre, a tenth of the margin when
+    the sampled problem is infeasible: see :data:`ATTEMPTS`).
     Sets ``res.status`` to ``ok`` (with apex, depth used and margin) or ``infeasible`` (with
     the constraints that fail).
 
@@ -408,14 +409,27 @@ def solve_apices(
             [pending[u].starts for u in order],
             thorough=[t[1] < 1.0 for t in tries],  # only the thin attempts end a vertex
         )
+        # the dense validation of every solved vertex of the round at once
+        solved = [
+            (u, sol, sol.developed if pending[u].closed else pending[u].v)
+            for u, sol in zip(order, sols, strict=True)
+            if sol.ok
+        ]
+        checks = validate_apices(
+            [pending[u].frame for u, _, _ in solved],
+            [sol.apex for _, sol, _ in solved],
+            [v for _, _, v in solved],
+            [pending[u].sigma for u, _, _ in solved],
+            centres=centres,
+        )
+        checked = {u: (v, c) for (u, _, v), c in zip(solved, checks, strict=True)}
         for u, attempt, sol in zip(order, tries, sols, strict=True):
             p = pending[u]
             if not sol.ok:
                 p.failing = sol.failing
                 p.attempts = [] if attempt[1] < 1.0 else list(THIN_ATTEMPTS)
             else:
-                v_sol = sol.developed if p.closed else p.v
-                check = validate_apex(p.frame, sol.apex, v_sol, p.sigma, centres=centres)
+                v_sol, check = checked[u]
                 if check.ok:
                     res.status[u] = "ok"
                     res.apex[u] = sol.apex

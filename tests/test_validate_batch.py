@@ -1,0 +1,211 @@
+"""Batched dense validation of apices (:func:`~filletfold.vertex.apex.validate_apices`).
+
+Every vertex's check must be the same as a straightforward one-vertex validation: the
+reference below is the per-vertex implementation the batched one replaced, kept here only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from filletfold.tolerances import tol
+from filletfold.vertex.apex import KINDS, ApexCheck, validate_apex, validate_apices
+
+from .conftest import design_of
+
+EXAMPLES = ["icosahedron", "cube", "dimpled-cube", "l-prism", "torus", "blob", "conical-dome"]
+
+
+def _reference_validate(frame, V, v, sigma, n_samples=65, centres=None) -> ApexCheck:
+    """One vertex on its own (the former ``validate_apex``)."""
+    sa = frame.arrays
+    k = len(sa.arc)
+    scale = float(sa.length.mean())
+    eps = tol.validate * scale
+    side, first, last, s, C, N = sa.samples(n_samples)
+    vi = np.einsum("kij,j->ki", sa.Q, v) + sa.t
+    d = V - C
+    num = (vi[side, 0] - s) ** 2 + vi[side, 1] ** 2 - np.einsum("ij,ij->i", d, d)
+    dn = vi[:, 1] - np.einsum("ij,ij->i", V - sa.M, sa.R)
+    valid = dn > 0
+    l = 0.5 * num / np.where(valid, dn, 1.0)[side]
+    nonint = sigma * np.einsum("ij,ij->i", d, N)
+    l_min = _reference_refined_min(sa, V, l, s, first, vi=vi, dn=dn)
+    nonint_min = _reference_refined_min(sa, V, nonint, s, first, sigma=sigma)
+    checks = np.stack(
+        [
+            dn,
+            np.where(valid, l_min, -np.inf),
+            np.where(
+                valid,
+                np.minimum(frame.lmax_start - l[first], frame.lmax_end - l[last]),
+                -np.inf,
+            ),
+            nonint_min,
+        ],
+        axis=1,
+    )
+    slack = [checks.ravel()]
+    failing = []
+    strict = np.array([True, False, False, True])
+    bad = np.where(strict, checks < eps, checks < -eps)
+    names = ("patch", "l_min", "l_max", "nonint")
+    for i, c in zip(*np.nonzero(bad), strict=True):
+        failing.append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
+    nf = len(frame.ring.faces)
+    n = sa.face_normal
+    face_val = sigma * np.einsum("ij,ij->i", V - frame.T_end[:nf], n)
+    slack.append(face_val)
+    centre_val = np.full(nf, np.inf)
+    if centres is not None:
+        nxt = (np.arange(nf) + 1) % k
+        p0 = C[last[:nf]] + l[last[:nf], None] * sa.R[:nf]
+        p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
+        dvec = p1 - p0
+        length = np.linalg.norm(dvec, axis=1)
+        dvec = dvec / np.where(length > eps, length, 1.0)[:, None]
+        side_t = np.einsum("ij,ij->i", np.cross(dvec, frame.T_end[:nf] - p0), n)
+        side_c = np.einsum("ij,ij->i", np.cross(dvec, centres[frame.ring.faces] - p0), n)
+        centre_val = np.where(side_t != 0, -side_c * np.sign(side_t), np.abs(side_c))
+        centre_val = np.where(length > eps, centre_val, np.inf)
+        slack.append(centre_val[length > eps])
+    for i, f in enumerate(frame.ring.faces):
+        if face_val[i] < eps:
+            failing.append(f"{KINDS['face']} at face {int(f)}")
+        if centre_val[i] < eps:
+            failing.append(f"{KINDS['centre']} on face {int(f)}")
+    return ApexCheck(not failing, float(np.min(np.concatenate(slack))), failing)
+
+
+def _reference_refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
+    """Smallest value per side of one vertex: its smallest sample, refined by Newton steps."""
+    ends = np.append(first[1:], len(values))
+    best = np.minimum.reduceat(values, first)
+    r, arc = sa.radius, sa.arc
+    ok = r > 0
+    if not ok.any():
+        return best
+    side = np.repeat(np.arange(len(first)), ends - first)
+    hit = np.flatnonzero(values == best[side])
+    arg = hit[np.unique(side[hit], return_index=True)[1]]
+    t = s[arg].copy()
+    rr = np.where(ok, r, 1.0)
+    P = np.einsum("ij,ij->i", V - sa.O, sa.N0)
+    Q = np.einsum("ij,ij->i", V - sa.O, sa.B)
+    for _ in range(4):
+        c, sn = np.cos(t / rr), np.sin(t / rr)
+        if vi is not None:
+            d1 = -2 * (vi[:, 0] - t) + 2 * sa.kappa * (-P * sn + Q * c)
+            d2 = 2 + 2 * sa.kappa / rr * (-P * c - Q * sn)
+        else:
+            d1 = sigma / rr * (-P * sn + Q * c)
+            d2 = sigma / rr**2 * (-P * c - Q * sn)
+        step = np.where(d2 > 0, d1 / np.where(d2 > 0, d2, 1.0), 0.0)
+        t = np.clip(t - step, 0.0, arc)
+    i = np.arange(len(first))
+    C = sa.base(i, t)
+    if vi is not None:
+        dv = V - C
+        num = (vi[:, 0] - t) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", dv, dv)
+        val = 0.5 * num / np.where(dn > 0, dn, 1.0)
+    else:
+        val = sigma * np.einsum("ij,ij->i", V - C, sa.normal(i, t))
+    return np.where(ok, np.minimum(best, val), best)
+
+
+def _cases(name):
+    """Frames, centres and the solved (V, v, sigma) of every vertex with a cone."""
+    d = design_of(name)
+    res = d.vertices
+    us = [u for u in range(d.mesh.n_vertices) if res.status[u] == "ok"]
+    frames = [d.stages.frames[u] for u in us]
+    V = np.array([res.apex[u] for u in us])
+    v = np.array([res.apex_developed[u] for u in us])
+    sigma = np.array([int(res.sigma[u]) for u in us])
+    return frames, d.stages.centres, V, v, sigma
+
+
+def _perturbed(frames, V, v, sigma, how, seed):
+    """Apices moved so that various conditions fail."""
+    rng = np.random.default_rng(seed)
+    scale = np.array([f.arrays.length.mean() for f in frames])[:, None]
+    U = np.array([f.U for f in frames])
+    if how == "jitter":  # small moves: some conditions just fail, most hold
+        return V + 0.02 * scale * rng.normal(size=V.shape), v + 0.01 * scale * rng.normal(
+            size=v.shape
+        )
+    if how == "far":  # large moves of both apices
+        return V + 0.5 * scale * rng.normal(size=V.shape), v + 0.3 * scale * rng.normal(
+            size=v.shape
+        )
+    if how == "mirror":  # the apex through the vertex, to the wrong side of the faces
+        return 2 * U - V, v
+    if how == "deep":  # far along the axis: crease lengths beyond l_max
+        return U + 3 * (V - U), v
+    raise ValueError(how)
+
+
+def _assert_same(got, want):
+    assert len(got) == len(want)
+    for g, w in zip(got, want, strict=True):
+        assert g.ok == w.ok
+        assert g.failing == w.failing
+        # bit for bit here; a hair of rounding allowed (margins are in units of edges ~1)
+        np.testing.assert_allclose(g.margin, w.margin, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+@pytest.mark.parametrize("with_centres", [False, True])
+def test_solved_apices_match_reference(name, with_centres):
+    frames, centres, V, v, sigma = _cases(name)
+    centres = centres if with_centres else None
+    got = validate_apices(frames, V, v, sigma, centres=centres)
+    want = [
+        _reference_validate(f, V[j], v[j], sigma[j], centres=centres) for j, f in enumerate(frames)
+    ]
+    _assert_same(got, want)
+    assert all(c.ok for c in want)  # solved apices pass the dense validation
+    # the one-vertex wrapper and a reversed batch give the same checks
+    assert validate_apex(frames[0], V[0], v[0], sigma[0], centres=centres) == want[0]
+    _assert_same(validate_apices(frames[::-1], V[::-1], v[::-1], sigma[::-1], centres=centres),
+                 want[::-1])  # fmt: skip
+
+
+def test_perturbed_apices_match_reference():
+    """Apices that fail every kind of condition; the failing lists, in order, and margins."""
+    seen = set()
+    for name in EXAMPLES:
+        frames, centres, V, v, sigma = _cases(name)
+        for seed, how in enumerate(["jitter", "far", "mirror", "deep"]):
+            Vp, vp = _perturbed(frames, V, v, sigma, how, seed)
+            for c in (None, centres):
+                for n_samples in (65, 9):
+                    got = validate_apices(frames, Vp, vp, sigma, n_samples, centres=c)
+                    want = [
+                        _reference_validate(f, Vp[j], vp[j], sigma[j], n_samples, centres=c)
+                        for j, f in enumerate(frames)
+                    ]
+                    _assert_same(got, want)
+                    for w in want:
+                        seen.update(k for k, text in KINDS.items() for f in w.failing
+                                    if f.startswith(text))  # fmt: skip
+    assert seen == set(KINDS) - {"chord"}  # the chord plane is only sampled in the solve
+
+
+def test_mixed_batch_of_meshes():
+    """Vertices of different meshes in one batch (no centres: they are per mesh)."""
+    frames, V, v, sigma = [], [], [], []
+    for seed, name in enumerate(EXAMPLES):
+        f, _, V_, v_, s_ = _cases(name)
+        V_, v_ = _perturbed(f, V_, v_, s_, "jitter", 10 + seed)
+        frames += f
+        V.append(V_), v.append(v_), sigma.append(s_)
+    V, v, sigma = np.concatenate(V), np.concatenate(v), np.concatenate(sigma)
+    got = validate_apices(frames, V, v, sigma)
+    _assert_same(got, [_reference_validate(f, V[j], v[j], sigma[j]) for j, f in enumerate(frames)])
+    assert any(not c.ok for c in got) and any(c.ok for c in got)
+
+
+def test_empty_batch():
+    assert validate_apices([], np.zeros((0, 3)), np.zeros((0, 2)), []) == []
