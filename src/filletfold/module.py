@@ -32,7 +32,7 @@ from .pattern import CreasePattern
 from .rounding import EdgeRounding
 from .tolerances import tol
 from .vertex.apex import crease_length
-from .vertex.frame import VertexFrame, apply, to_chart
+from .vertex.frame import SideArrays, VertexFrame, apply, to_chart
 
 
 @dataclass
@@ -480,21 +480,75 @@ def build_module(
     return pieces
 
 
-def _side_curves(frame: VertexFrame, i: int, n_samples, apex, dev_apex, heights):
-    """Base points and crease (or hole) points of rounded side ``i``.
+def _side_curves(frame: VertexFrame, sides: list, n_samples, apex, dev_apex, heights) -> dict:
+    """Base points and crease (or hole) points of the rounded sides ``sides``, all at once.
 
-    Returns (s, base_3d (k, 3), top_3d (k, 3), top_z (k,)) with ``top`` the crease or the
-    hole border.
+    Parameters
+    ----------
+    frame : VertexFrame
+    sides : list of int
+        Rounded side indices.
+    n_samples : int or (n_edges,) int
+        Points per arc (one on a side without arc).
+    apex, dev_apex : (3,) float and (2,) float, or None
+        The cone's apices; without, the top is the hole border at ``heights``.
+    heights : (n_sides,) float
+
+    Returns
+    -------
+    dict
+        Side -> (s (k,), base_3d (k, 3), top_3d (k, 3), top_z (k,)), with ``top`` the crease
+        or the hole border and ``s = linspace(0, arc, k)``.
     """
-    side = frame.sides[i]
-    n = n_samples if np.ndim(n_samples) == 0 else n_samples[side.edge]
-    s = np.linspace(0.0, side.arc, int(n) if side.arc > 0 else 1)
-    C = side.base(s)
+    if not sides:
+        return {}
+    which = np.asarray(sides, dtype=np.int64)
+    if frame.ring.closed:
+        sa, idx = frame.arrays, which
+    else:  # an open ring has no SideArrays: stack the sides asked for
+        sa, idx = _stacked_sides([frame.sides[i] for i in sides]), np.arange(len(sides))
+    arc = sa.arc[idx]
+    n = np.full(len(idx), n_samples) if np.ndim(n_samples) == 0 else n_samples[sa.edge[idx]]
+    n = np.where(arc > 0, n, 1).astype(np.int64)
+    rep = np.repeat(np.arange(len(idx)), n)
+    first = np.concatenate([[0], np.cumsum(n)[:-1]])
+    # np.linspace(0, arc, n) for every side: k * (arc / (n - 1)), the last point exactly arc
+    k = np.arange(len(rep)) - first[rep]
+    step = np.where(n > 1, arc / np.maximum(n - 1, 1), 0.0)
+    s = k * step[rep]
+    last = first + n - 1
+    s[last[n > 1]] = arc[n > 1]
+    side = idx[rep]
+    C = sa.base(side, s)
     if apex is not None:
-        z, _ = crease_length(frame, i, apex, dev_apex, s)
+        z, _ = crease_length(frame, side, apex, dev_apex, s, C=C)
     else:
-        z = np.full(len(s), heights[i])
-    return s, C, C + z[:, None] * side.R, z
+        z = np.asarray(heights, dtype=float)[which][rep]
+    F = C + z[:, None] * sa.R[side]
+    bounds = np.append(first, len(rep)).tolist()
+    return {
+        i: (s[a:b], C[a:b], F[a:b], z[a:b])
+        for i, a, b in zip(sides, bounds[:-1], bounds[1:], strict=True)
+    }
+
+
+def _stacked_sides(sides: list) -> SideArrays:
+    """The geometry of rounded :class:`Side` objects as :class:`SideArrays` (no charts)."""
+    return SideArrays(
+        edge=np.array([x.edge for x in sides], dtype=np.int64),
+        R=np.array([x.R for x in sides]),
+        M=np.array([x.M for x in sides]),
+        O=np.array([x.O for x in sides]),
+        N0=np.array([x.N0 for x in sides]),
+        B=np.array([x.B for x in sides]),
+        radius=np.array([x.radius for x in sides]),
+        kappa=np.array([x.kappa for x in sides], dtype=float),
+        arc=np.array([x.arc for x in sides]),
+        length=np.array([x.length for x in sides]),
+        Q=None,
+        t=None,
+        face_normal=None,
+    )
 
 
 def apply_rows(m: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -653,12 +707,12 @@ def _build_run(
     if apex is not None:
         piece.apex_index = piece.point(("apex",), dev_apex, apex)
     rounded = [i for i in range(j0, j1 + 1) if frame.sides[i].rounded]
-    curves = {i: _side_curves(frame, i, n_samples, apex, dev_apex, heights) for i in rounded}
+    curves = _side_curves(frame, rounded, n_samples, apex, dev_apex, heights)
     strips = _strips(frame, rounded, curves, dev_apex if apex is not None else None)
 
     def curves_of(i):
         if i not in curves:
-            curves[i] = _side_curves(frame, i, n_samples, apex, dev_apex, heights)
+            curves.update(_side_curves(frame, [i], n_samples, apex, dev_apex, heights))
         return curves[i]
 
     def line_points(i, face_i, start: bool, end_copy: bool = False):

@@ -264,34 +264,48 @@ class ApexCheck:
     failing: list
 
 
-def crease_length(frame: VertexFrame, i: int, V: np.ndarray, v: np.ndarray, s: np.ndarray):
-    """Eq. (1): ruling length ``l(s)`` of the crease on cylinder ``i``.
+def crease_length(
+    frame: VertexFrame, i, V: np.ndarray, v: np.ndarray, s: np.ndarray, C: np.ndarray | None = None
+):
+    """Eq. (1): ruling length ``l(s)`` of the crease on cylinder ``i``, or on several.
 
     Parameters
     ----------
     frame : VertexFrame
-    i : int
-        Side index.
+    i : int or (k,) int
+        Side index, or the side of each arc parameter.
     V : (3,) float
         Spatial apex.
     v : (2,) float
         Developed apex in the common frame.
     s : (k,) float
         Arc parameters in ``[0, a_i]``.
+    C : (k, 3) float, optional
+        The base-curve points ``C(s)``, when known.
 
     Returns
     -------
     l : (k,) float
-    dn : float
-        The denominator ``(v - c) . r - (V - C) . R`` (constant along the arc; > 0 when valid).
+    dn : float or (k,) float
+        The denominator ``(v - c) . r - (V - C) . R`` (constant along an arc; > 0 when valid),
+        per side given: a float for one side, else one per arc parameter.
     """
     sa = frame.arrays
     s = np.asarray(s, dtype=float)
-    vi = sa.Q[i] @ v + sa.t[i]
-    C = sa.base(np.full(len(s), i), s)
-    num = (vi[0] - s) ** 2 + vi[1] ** 2 - np.einsum("ij,ij->i", V - C, V - C)
-    dn = vi[1] - (V - sa.M[i]) @ sa.R[i]
-    return 0.5 * num / dn, float(dn)
+    if np.ndim(i) == 0:
+        vi = sa.Q[i] @ v + sa.t[i]
+        side = np.full(len(s), i)
+        dn = vi[1] - (V - sa.M[i]) @ sa.R[i]
+        vx, vy, dn_out = vi[0], vi[1], float(dn)
+    else:
+        side = np.asarray(i)
+        vi = np.einsum("kij,j->ki", sa.Q, v) + sa.t  # per side of the ring
+        dn = vi[:, 1] - np.einsum("ij,ij->i", V - sa.M, sa.R)
+        vx, vy, dn, dn_out = vi[side, 0], vi[side, 1], dn[side], None
+    if C is None:
+        C = sa.base(side, s)
+    num = (vx - s) ** 2 + vy**2 - np.einsum("ij,ij->i", V - C, V - C)
+    return 0.5 * num / dn, dn if dn_out is None else dn_out
 
 
 def validate_apex(
