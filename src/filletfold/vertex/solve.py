@@ -263,6 +263,10 @@ class ApexProblem:
 ATTEMPTS = [(9, 1.0), (33, 2.0), (65, 4.0)]
 THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
 
+#: Vertices solved and validated together: bounds the memory of a round's sampled
+#: constraints and dense validation (about 100 kB per vertex at 65 validation samples).
+ROUND_SLICE = 2048
+
 
 def _margin_length(frame: VertexFrame) -> float:
     """The length the safety margin is a fraction of: the shortest incident edge, or four times
@@ -366,7 +370,8 @@ def solve_apices(
 
     All vertices still without a status are solved together, one attempt per round, by
     :func:`~filletfold.vertex.batch.solve_apex_batch`, and validated together by
-    :func:`~filletfold.vertex.apex.validate_apices`; a vertex whose attempt fails the dense
+    :func:`~filletfold.vertex.apex.validate_apices`, :data:`ROUND_SLICE` vertices at a time
+    (``progress`` is called after each); a vertex whose attempt fails the dense
     validation goes to its next attempt in the next round (more samples and margin, shorter
     creases when a straight crease passes a face piece's centre, a tenth of the margin when
     the sampled problem is infeasible: see :data:`ATTEMPTS`).
@@ -383,7 +388,7 @@ def solve_apices(
     centres : (n_faces, 3) float, optional
         Face pieces' centres: adds the check that every straight crease stays short of them.
     progress : callable, optional
-        ``progress("apices", done, total)`` after every round.
+        ``progress("apices", done, total)`` after every slice of a round.
     vertices : iterable of int, optional
         The vertices to solve (default: every vertex whose status is still empty).
 
@@ -399,56 +404,12 @@ def solve_apices(
     out = dict.fromkeys(vertices, (None, None))
     pending = _set_up(frames, depths, res, vertices)
     total = len(pending)
-    while pending:
+    while pending:  # one attempt per vertex and round, ROUND_SLICE vertices at a time
         order = list(pending)
-        tries = [pending[u].attempts.pop(0) for u in order]
-        cons = [pending[u].constraints(*t) for u, t in zip(order, tries, strict=True)]
-        sols = solve_apex_batch(
-            cons,
-            [pending[u].target for u in order],
-            [pending[u].starts for u in order],
-            thorough=[t[1] < 1.0 for t in tries],  # only the thin attempts end a vertex
-        )
-        # the dense validation of every solved vertex of the round at once
-        solved = [
-            (u, sol, sol.developed if pending[u].closed else pending[u].v)
-            for u, sol in zip(order, sols, strict=True)
-            if sol.ok
-        ]
-        checks = validate_apices(
-            [pending[u].frame for u, _, _ in solved],
-            [sol.apex for _, sol, _ in solved],
-            [v for _, _, v in solved],
-            [pending[u].sigma for u, _, _ in solved],
-            centres=centres,
-        )
-        checked = {u: (v, c) for (u, _, v), c in zip(solved, checks, strict=True)}
-        for u, attempt, sol in zip(order, tries, sols, strict=True):
-            p = pending[u]
-            if not sol.ok:
-                p.failing = sol.failing
-                p.attempts = [] if attempt[1] < 1.0 else list(THIN_ATTEMPTS)
-            else:
-                v_sol, check = checked[u]
-                if check.ok:
-                    res.status[u] = "ok"
-                    res.apex[u] = sol.apex
-                    res.apex_developed[u] = v_sol
-                    res.depth[u] = float((sol.apex - p.frame.U) @ res.normal[u])
-                    res.margin[u] = check.margin
-                    out[u] = (sol.apex, v_sol)
-                    del pending[u]
-                    continue
-                p.failing = check.failing
-                _shorten_creases(p, attempt)
-            if not p.attempts:
-                res.status[u] = "infeasible"
-                res.reason[u] = "no apex meets every constraint: " + "; ".join(p.failing[:6])
-                if len(p.failing) > 6:
-                    res.reason[u] += f"; and {len(p.failing) - 6} more"
-                del pending[u]
-        if progress is not None:
-            progress("apices", total - len(pending), total)
+        for lo in range(0, len(order), ROUND_SLICE):
+            _solve_round(order[lo : lo + ROUND_SLICE], pending, res, out, centres)
+            if progress is not None:
+                progress("apices", total - len(pending), total)
     return out
 
 
@@ -464,3 +425,54 @@ def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
                 p.shrink[i, 1] *= 0.7
                 p.shrink[(i + 1) % n_sides, 0] *= 0.7
         p.attempts.insert(0, attempt)
+
+
+def _solve_round(order: list, pending: dict, res: VertexResult, out: dict, centres) -> None:
+    """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
+    solved ones at once, and settle every vertex that is done (ok, or out of attempts)."""
+    tries = [pending[u].attempts.pop(0) for u in order]
+    cons = [pending[u].constraints(*t) for u, t in zip(order, tries, strict=True)]
+    sols = solve_apex_batch(
+        cons,
+        [pending[u].target for u in order],
+        [pending[u].starts for u in order],
+        thorough=[t[1] < 1.0 for t in tries],  # only the thin attempts end a vertex
+    )
+    # the dense validation of every solved vertex at once
+    solved = [
+        (u, sol, sol.developed if pending[u].closed else pending[u].v)
+        for u, sol in zip(order, sols, strict=True)
+        if sol.ok
+    ]
+    checks = validate_apices(
+        [pending[u].frame for u, _, _ in solved],
+        [sol.apex for _, sol, _ in solved],
+        [v for _, _, v in solved],
+        [pending[u].sigma for u, _, _ in solved],
+        centres=centres,
+    )
+    checked = {u: (v, c) for (u, _, v), c in zip(solved, checks, strict=True)}
+    for u, attempt, sol in zip(order, tries, sols, strict=True):
+        p = pending[u]
+        if not sol.ok:
+            p.failing = sol.failing
+            p.attempts = [] if attempt[1] < 1.0 else list(THIN_ATTEMPTS)
+        else:
+            v_sol, check = checked[u]
+            if check.ok:
+                res.status[u] = "ok"
+                res.apex[u] = sol.apex
+                res.apex_developed[u] = v_sol
+                res.depth[u] = float((sol.apex - p.frame.U) @ res.normal[u])
+                res.margin[u] = check.margin
+                out[u] = (sol.apex, v_sol)
+                del pending[u]
+                continue
+            p.failing = check.failing
+            _shorten_creases(p, attempt)
+        if not p.attempts:
+            res.status[u] = "infeasible"
+            res.reason[u] = "no apex meets every constraint: " + "; ".join(p.failing[:6])
+            if len(p.failing) > 6:
+                res.reason[u] += f"; and {len(p.failing) - 6} more"
+            del pending[u]
