@@ -61,6 +61,9 @@ def to_json_data(obj, where: str = ""):
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         obj = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
     if isinstance(obj, Mapping):
+        fast = _plain_dict(obj)
+        if fast is not None:
+            return fast
         out = {}
         for k, v in obj.items():
             key = _key(k, where)
@@ -103,6 +106,29 @@ def _plain_list(items) -> list | None:
                 [x if type(x) is not float or math.isfinite(x) else None for x in v] for v in items
             ]
     return None
+
+
+def _plain_dict(obj: Mapping) -> dict | None:
+    """:func:`to_json_data` of a dict with string keys whose values are numbers, strings,
+    booleans, None, or lists that :func:`_plain_list` takes, all at once; None for anything
+    else (the records of a report: one dict per vertex or edge)."""
+    if type(obj) is not dict or not set(map(type, obj)) <= {str}:
+        return None
+    out = {}
+    for k, v in obj.items():
+        kind = type(v)
+        if kind in _AS_IS:
+            out[k] = v
+        elif kind is float:
+            out[k] = v if math.isfinite(v) else None
+        elif kind is list:
+            v = _plain_list(v)
+            if v is None:
+                return None
+            out[k] = v
+        else:
+            return None
+    return out
 
 
 def _key(k, where: str) -> str:
