@@ -1,6 +1,7 @@
 """Stage timings and peak memory of the pipeline on meshes of growing size (issue 6's table).
 
     .venv/bin/python benchmarks/pipeline.py [--repeat N] [--max-faces F] [--timeout S]
+                                            [--arc-step DEG] [cases...]
     .venv/bin/python benchmarks/pipeline.py --max-faces 100000 --repeat 1   # the big run
 
 Cases, each skipped when it has more than ``--max-faces`` faces (default 1280, quick):
@@ -14,7 +15,9 @@ Cases, each skipped when it has more than ``--max-faces`` faces (default 1280, q
 * large tessellations with material loss: ``miura:20x20`` and ``miura:40x40`` (400 and 1600
   parallelograms) with ``material_loss=True`` and layout ``auto`` (one uncut sheet).
 
-Radius 10 %, depth 30 %, no tabs; layout ``modules`` except for the tessellations. Every case
+Radius 10 %, depth 30 %, no tabs, 24 samples per arc at most and the library's arc step
+(``--arc-step 0``: every arc gets 24 points, as before adaptive sampling); layout ``modules``
+except for the tessellations. Every case
 runs in its own child process (so peak memory, ``ru_maxrss``, is the case's alone and includes
 the interpreter and imports, ``base MB``), killed after ``--timeout`` seconds (then skipped
 with a note). Per case: the median over ``--repeat`` runs of every stage of ``round_mesh``
@@ -84,7 +87,7 @@ def rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # KB on Linux
 
 
-def child(name: str, repeat: int) -> dict:
+def child(name: str, repeat: int, arc_step: float | None = None) -> dict:
     """Run one case ``repeat`` times in this process; medians, sizes and peak memory."""
     import filletfold
 
@@ -92,6 +95,8 @@ def child(name: str, repeat: int) -> dict:
     mesh = case_mesh(spec)
     base = rss_mb()
     kwargs = {"layout": "modules", "tabs": False, **kwargs}
+    if arc_step is not None:
+        kwargs["arc_step"] = arc_step
     runs = []
     d = None
     for _ in range(repeat):
@@ -116,6 +121,7 @@ def child(name: str, repeat: int) -> dict:
         "F": int(d.mesh.n_faces),
         "status": d.status_counts(),
         "layout": d.layout,
+        "pattern_faces": len(d.pattern.faces),
         "median": med,
         "base_mb": base,
         "peak_mb": rss_mb(),
@@ -132,11 +138,17 @@ def main(argv=None) -> int:
         help="skip cases with more faces (100000 for the big run)",
     )
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per case")
+    ap.add_argument(
+        "--arc-step",
+        type=float,
+        default=None,
+        help="round_mesh's arc_step in degrees (default: the library's; 0: uniform samples)",
+    )
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("cases", nargs="*", help=f"case names (default all: {', '.join(CASES)})")
     args = ap.parse_args(argv)
     if args.child:
-        print(json.dumps(child(args.child, args.repeat)))
+        print(json.dumps(child(args.child, args.repeat, args.arc_step)))
         return 0
     for c in args.cases:
         if c not in CASES:
@@ -148,7 +160,8 @@ def main(argv=None) -> int:
     print(f"# machine: {machine()}")
     print(f"# command: {' '.join([os.path.basename(sys.executable), *sys.argv])}")
     print(
-        f"# medians of {args.repeat} runs (s); radius 10%, depth 30%, no tabs; one child "
+        f"# medians of {args.repeat} runs (s); radius 10%, depth 30%, no tabs, arc step "
+        f"{'default' if args.arc_step is None else f'{args.arc_step:g}'}; one child "
         f"process per case (timeout {args.timeout:g} s); peak = child's max RSS"
     )
     names = args.cases or list(CASES)
@@ -157,7 +170,7 @@ def main(argv=None) -> int:
         f"{'case':17s} {'V':>6s} {'F':>6s} "
         + " ".join(f"{s:>8s}" for s in cols)
         + f" {'total':>8s} {'ms/vert':>8s} {'µs/face':>8s} {'peak MB':>8s} {'base MB':>8s}"
-        + "  statuses"
+        + f" {'faces out':>9s}  statuses"
     )
     print(head)
     done = {}
@@ -174,6 +187,7 @@ def main(argv=None) -> int:
             name,
             "--repeat",
             str(args.repeat),
+            *([] if args.arc_step is None else ["--arc-step", str(args.arc_step)]),
         ]
         try:
             out = subprocess.run(
@@ -196,6 +210,7 @@ def main(argv=None) -> int:
             + " ".join(f"{med[s]:8.3f}" if s in med else f"{'-':>8s}" for s in cols)
             + f" {med['total']:8.2f} {1e3 * med['total'] / r['V']:8.2f}"
             + f" {1e6 * med['total'] / r['F']:8.0f} {r['peak_mb']:8.0f} {r['base_mb']:8.0f}"
+            + f" {r['pattern_faces']:9d}"
             + f"  {counts}"
             + (f"; {r['layout']}" if r["layout"] != "modules" else "")
             + (f"; other stages: {', '.join(f'{k} {med[k]:.3f}' for k in extra)}" if extra else "")
