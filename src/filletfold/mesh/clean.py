@@ -536,9 +536,12 @@ def _group_boundary(fs, he, group, twin_face, g) -> np.ndarray | None:
 
 
 def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
-    faces = [f.tolist() for f in face_list]
     fl = _Flat.of(face_list)
-    straight = fl.split(np.abs(_corner_angles(fl, v) - np.pi) <= tol.angle)
+    is_straight = np.abs(_corner_angles(fl, v) - np.pi) <= tol.angle
+    if not is_straight.any():  # nothing to remove (the usual case)
+        return [np.asarray(f, dtype=np.int64) for f in face_list]
+    faces = [f.tolist() for f in face_list]
+    straight = fl.split(is_straight)
     incident: dict[int, list[int]] = {}
     edges: set[tuple[int, int]] = set()
     for i, f in enumerate(faces):

@@ -78,9 +78,11 @@ class PolyMesh:
         he_from = np.concatenate(self.faces) if self.faces else np.zeros(0, np.int64)
         if len(he_from) and (he_from.min() < 0 or he_from.max() >= n):
             raise MeshError("a face refers to a vertex index outside the vertex list")
-        he_to = np.concatenate([np.roll(f, -1) for f in self.faces]) if self.faces else he_from
-        he_face = np.repeat(np.arange(len(self.faces)), face_size)
         self.face_start = np.concatenate([[0], np.cumsum(face_size)])
+        nxt = np.arange(1, len(he_from) + 1)  # the next corner of each face, cyclically
+        nxt[self.face_start[1:] - 1] = self.face_start[:-1]
+        he_to = he_from[nxt]
+        he_face = np.repeat(np.arange(len(self.faces)), face_size)
         self.halfedge_from = he_from
         self.halfedge_to = he_to
         self.halfedge_face = he_face
@@ -213,17 +215,13 @@ class PolyMesh:
         edge to the face's previous vertex, measured inside the face (atan2, so small angles
         keep their precision; reflex corners give angles above pi).
         """
-        out = np.empty(len(self.halfedge_from))
-        for fi, f in enumerate(self.faces):
-            p = self.vertices[f]
-            nxt = np.roll(p, -1, axis=0) - p
-            prv = np.roll(p, 1, axis=0) - p
-            n = self.face_normal[fi]
-            s = np.einsum("ij,j->i", np.cross(nxt, prv), n)
-            c = np.einsum("ij,ij->i", nxt, prv)
-            ang = np.arctan2(s, c)
-            out[self.face_start[fi] : self.face_start[fi + 1]] = np.mod(ang, 2 * np.pi)
-        return out
+        p = self.vertices[self.halfedge_from]
+        nxt = self.vertices[self.halfedge_to] - p
+        prv = self.vertices[self.halfedge_from[self.halfedge_prev]] - p
+        n = self.face_normal[self.halfedge_face]
+        s = np.einsum("ij,ij->i", np.cross(nxt, prv), n)
+        c = np.einsum("ij,ij->i", nxt, prv)
+        return np.mod(np.arctan2(s, c), 2 * np.pi)
 
     @cached_property
     def vertex_angle_sum(self) -> np.ndarray:
