@@ -180,7 +180,7 @@ def test_invariants_on_generated_meshes(seed, share, depth, samples, arc_step):
     m = filletfold.load_mesh((v, f))[0]
     d = filletfold.round_mesh(
         m,
-        radius=share * round_edges(m, 1e-3).uniform_limit,
+        radius=share * round_edges(m, 1e-6 * m.mean_edge_length).uniform_limit,
         depth=depth * m.mean_edge_length,
         samples=samples,
         arc_step=arc_step,

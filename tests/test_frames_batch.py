@@ -404,6 +404,6 @@ def test_bad_vertices_raise_like_vertex_ring():
 def test_random_convex_polyhedra(seed, share):
     v, f = random_convex(seed)
     m = load_mesh((v, f))[0]
-    limit = round_edges(m, 1e-3 * m.mean_edge_length).uniform_limit
+    limit = round_edges(m, 1e-6 * m.mean_edge_length).uniform_limit
     rd = round_edges(m, share * limit)
     check_mesh(m, rd)

@@ -209,3 +209,48 @@ def test_mixed_batch_of_meshes():
 
 def test_empty_batch():
     assert validate_apices([], np.zeros((0, 3)), np.zeros((0, 2)), []) == []
+
+
+def test_cuts_are_the_worst_points_and_a_retry_with_them_holds_there():
+    """The first attempt on blob leaves ``l < 0`` between the samples at many vertices: each
+    cut is a point of its side where the failing condition is at its worst (no sample of 257
+    is lower), and solving again with the cuts as samples meets ``l >= m`` there."""
+    from filletfold.vertex.apex import crease_length
+    from filletfold.vertex.batch import solve_apex_batch
+    from filletfold.vertex.solve import ATTEMPTS, apex_problems
+
+    d = design_of("blob")
+    probs = apex_problems(d.mesh, d.rounding, d.stages.depths)
+    cons = [p.constraints(*ATTEMPTS[0]) for p in probs]
+    sols = solve_apex_batch(cons, [p.target for p in probs], [p.starts for p in probs])
+    solved = [(p, s) for p, s in zip(probs, sols, strict=True) if s.ok and not p.closed]
+    checks = validate_apices(
+        [p.frame for p, _ in solved], [s.apex for _, s in solved], [p.v for p, _ in solved],
+        [p.sigma for p, _ in solved],
+    )  # fmt: skip
+    cut = [(p, s, c) for (p, s), c in zip(solved, checks, strict=True) if len(c.cuts)]
+    assert len(cut) > 10  # the case this is for
+    retried = []
+    for p, sol, check in cut:
+        assert not check.ok
+        for side, s_cut in check.cuts:
+            side = int(side)
+            arc = p.frame.arrays.arc[side]
+            l_cut, _ = crease_length(p.frame, side, sol.apex, p.v, np.array([s_cut]))
+            l_all, _ = crease_length(p.frame, side, sol.apex, p.v, np.linspace(0, arc, 257))
+            if l_cut[0] < 0:  # an l >= 0 cut: its worst point
+                assert l_cut[0] <= l_all.min() + 1e-12
+        p.extra = check.cuts
+        retried.append((p, p.constraints(*ATTEMPTS[0])))
+    again = solve_apex_batch(
+        [c for _, c in retried], [p.target for p, _ in retried], [p.starts for p, _ in retried]
+    )
+    held = 0
+    for (p, c), sol in zip(retried, again, strict=True):
+        if sol.ok:
+            n_cut = len(p.extra)
+            n_samples = len(c.quad_s) - 3 * len(p.frame.sides)  # l >= m rows, cuts last
+            rows = c.values(sol.x)[n_samples - n_cut : n_samples]
+            assert (rows >= -1e-9).all()
+            held += 1
+    assert held > 0.9 * len(retried)

@@ -151,7 +151,7 @@ def test_random_convex_polyhedra_every_solved_apex_is_valid(seed, share, depth):
     """Whatever the instance, an ok vertex passes the dense check, and no vertex is a saddle."""
     v, f = random_convex(seed)
     m = load_mesh((v, f))[0]
-    limit = round_edges(m, 1e-3 * m.mean_edge_length).uniform_limit
+    limit = round_edges(m, 1e-6 * m.mean_edge_length).uniform_limit
     d = filletfold.round_mesh(m, radius=share * limit, depth=depth * m.mean_edge_length)
     assert d.status_counts()["saddle"] == 0
     rd = d.rounding

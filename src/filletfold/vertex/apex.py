@@ -128,6 +128,7 @@ def build_constraints(
     n_samples: int,
     margin: float,
     lmax_scale: np.ndarray | None = None,
+    extra: np.ndarray | None = None,
 ) -> ApexConstraints:
     """Sample the sec. 3.2 constraints of a closed-ring vertex.
 
@@ -145,6 +146,9 @@ def build_constraints(
     lmax_scale : (n_sides, 2) float, optional
         Factors on ``l_max`` at the start and end of each side (default 1): shorter creases
         keep the straight crease on a face away from the face piece's centre.
+    extra : (m, 2) float, optional
+        ``(side, s)``: further arc parameters at which ``l >= m`` and the non-intersection
+        condition are sampled (where an earlier solution failed between the samples).
     """
     sa = frame.arrays
     k = len(sa.arc)
@@ -153,6 +157,10 @@ def build_constraints(
         lmax_scale = np.ones((k, 2))
     lmax = np.stack([frame.lmax_start, frame.lmax_end], axis=1) * lmax_scale
     side, first, last, s, C, N = sa.samples(n_samples)
+    if extra is not None and len(extra):
+        x_side, x_s = extra[:, 0].astype(np.int64), extra[:, 1]
+        side, s = np.concatenate([side, x_side]), np.concatenate([s, x_s])
+        C, N = np.vstack([C, sa.base(x_side, x_s)]), np.vstack([N, sa.normal(x_side, x_s)])
     ends = np.arange(k)
     # quadratic rows: l >= m at every sample, l <= l_max - m at both ends, Dn >= m
     q_side = np.concatenate([side, ends, ends, ends])
@@ -257,11 +265,15 @@ class ApexCheck:
     margin : float
         Smallest slack over all conditions, in length units (negative when violated).
     failing : list of str
+    cuts : (m, 2) float
+        ``(side, s)``: where ``l < 0`` or the non-intersection condition fails on a side, the
+        arc parameter of its worst point (a sample to add to the next solve).
     """
 
     ok: bool
     margin: float
     failing: list
+    cuts: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)), compare=False)
 
 
 def crease_length(
@@ -404,8 +416,8 @@ def validate_apices(
     l = 0.5 * num / np.where(valid, dn, 1.0)[side]
     nonint = sigma[vert][side] * np.einsum("ij,ij->i", d, N)
     # the minima between samples: Newton from the smallest sample on the closed forms
-    l_min = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
-    nonint_min = _refined_min(sa, V, nonint, s, first, sigma=sigma[vert])
+    l_min, l_at = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
+    nonint_min, nonint_at = _refined_min(sa, V, nonint, s, first, sigma=sigma[vert])
     checks = np.stack(
         [
             dn,
@@ -448,7 +460,17 @@ def validate_apices(
     for j, c in zip(*np.nonzero(face_bad), strict=True):
         text = f"{KINDS['face']} at face" if c == 0 else f"{KINDS['centre']} on face"
         failing[fvert[j]].append(f"{text} {int(faces[j])}")
-    return [ApexCheck(not fail, float(m), fail) for fail, m in zip(failing, margin, strict=True)]
+    # where l or the non-intersection condition fails: the worst point, a sample to add
+    cut_side, cut_kind = np.nonzero(bad[:, [1, 3]])
+    cut_s = np.where(cut_kind == 0, l_at[cut_side], nonint_at[cut_side])
+    local_side = cut_side - offset[vert[cut_side]]
+    cuts = [[] for _ in range(n)]
+    for i, j, t in zip(vert[cut_side].tolist(), local_side.tolist(), cut_s.tolist(), strict=True):
+        cuts[i].append((j, t))
+    return [
+        ApexCheck(not fail, float(m), fail, np.array(c, dtype=float).reshape(-1, 2))
+        for fail, m, c in zip(failing, margin, cuts, strict=True)
+    ]
 
 
 def _stack(arrays: Sequence[SideArrays]) -> SideArrays:
@@ -458,9 +480,9 @@ def _stack(arrays: Sequence[SideArrays]) -> SideArrays:
     )
 
 
-def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.ndarray:
+def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
     """(k,) smallest value per side along its arc: the smallest sample, refined by Newton steps
-    on the closed form between the samples.
+    on the closed form between the samples; and (k,) the arc parameter where it is reached.
 
     With ``vi`` ((k, 2) float) and ``dn`` ((k,) float) the values are the crease lengths
     ``l(s) = num(s) / (2 dn)`` of eq. (1) (``num(s) = (v_x - s)^2 + v_y^2 - |V - C(s)|^2``);
@@ -472,8 +494,6 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.nd
     best = np.minimum.reduceat(values, first)
     r, arc = sa.radius, sa.arc
     ok = r > 0
-    if not ok.any():
-        return best
     # the first sample of each side that attains its smallest value (the side's first sample
     # where none does: a NaN)
     side = np.repeat(np.arange(len(first)), ends - first)
@@ -483,6 +503,8 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.nd
     arg = first.copy()
     arg[side[hit[lead]]] = hit[lead]
     t = s[arg].copy()
+    if not ok.any():
+        return best, t
     rr = np.where(ok, r, 1.0)
     P = np.einsum("ij,ij->i", V - sa.O, sa.N0)
     Q = np.einsum("ij,ij->i", V - sa.O, sa.B)
@@ -504,4 +526,4 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1) -> np.nd
         val = 0.5 * num / np.where(dn > 0, dn, 1.0)
     else:
         val = sigma * np.einsum("ij,ij->i", V - C, sa.normal(i, t))
-    return np.where(ok, np.minimum(best, val), best)
+    return np.where(ok, np.minimum(best, val), best), np.where(ok & (val < best), t, s[arg])

@@ -13,7 +13,7 @@ import numpy as np
 from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
-from .apex import build_constraints, validate_apices
+from .apex import KINDS, build_constraints, validate_apices
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angle_front, vertex_normals
@@ -235,6 +235,10 @@ class ApexProblem:
         Remaining (samples per arc, margin scale) to try, in order.
     failing : list of str
         What failed at the last attempt.
+    extra : (m, 2) float
+        ``(side, s)``: samples added where earlier solutions failed between the samples.
+    cut_rounds : int
+        Attempts repeated with such samples added (at most :data:`CUT_ROUNDS` per attempt).
     """
 
     frame: VertexFrame
@@ -248,12 +252,14 @@ class ApexProblem:
     shrink: np.ndarray
     attempts: list
     failing: list
+    extra: np.ndarray
+    cut_rounds: int
 
     def constraints(self, n_samples: int, scale: float):
         """The sampled constraints of the next attempt (:func:`build_constraints`)."""
         m = min(self.margin * scale, 0.25 * self.low)
         v = None if self.closed else self.v
-        return build_constraints(self.frame, v, self.sigma, n_samples, m, self.shrink)
+        return build_constraints(self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra)
 
 
 #: Attempts per vertex: (samples per arc, margin scale), the next one after a failed dense
@@ -262,6 +268,11 @@ class ApexProblem:
 #: only add constraints).
 ATTEMPTS = [(9, 1.0), (33, 2.0), (65, 4.0)]
 THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
+
+#: After a failed dense validation where only ``l >= 0`` or the non-intersection condition
+#: fails between the samples, the same attempt is repeated with the worst points added as
+#: samples (a cutting plane), this many times per attempt, before the next attempt.
+CUT_ROUNDS = 2
 
 #: Vertices solved and validated together: bounds the memory of a round's sampled
 #: constraints and dense validation (about 100 kB per vertex at 65 validation samples).
@@ -328,6 +339,8 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
         shrink=np.ones((len(frame.sides), 2)),
         attempts=list(ATTEMPTS),
         failing=[],
+        extra=np.zeros((0, 2)),
+        cut_rounds=0,
     )
 
 
@@ -413,6 +426,21 @@ def solve_apices(
     return out
 
 
+def _add_cuts(p: ApexProblem, attempt: tuple[int, float], check) -> bool:
+    """After a failed validation: when only ``l >= 0`` and non-intersection fail (between the
+    samples), retry ``attempt`` with their worst points as samples; whether it does."""
+    between = (KINDS["l_min"], KINDS["nonint"])
+    if not len(check.cuts) or not all(f.startswith(between) for f in check.failing):
+        return False
+    if p.cut_rounds >= CUT_ROUNDS:
+        p.cut_rounds = 0  # the next attempt may cut again
+        return False
+    p.cut_rounds += 1
+    p.extra = np.vstack([p.extra, check.cuts])
+    p.attempts.insert(0, attempt)
+    return True
+
+
 def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
     """After a failed validation: when only face-centre crossings fail, retry ``attempt``
     with shorter creases on those faces."""
@@ -469,7 +497,8 @@ def _solve_round(order: list, pending: dict, res: VertexResult, out: dict, centr
                 del pending[u]
                 continue
             p.failing = check.failing
-            _shorten_creases(p, attempt)
+            if not _add_cuts(p, attempt, check):
+                _shorten_creases(p, attempt)
         if not p.attempts:
             res.status[u] = "infeasible"
             res.reason[u] = "no apex meets every constraint: " + "; ".join(p.failing[:6])
