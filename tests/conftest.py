@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import itertools
 
 import numpy as np
 import pytest
@@ -52,3 +53,14 @@ def signed_volume(mesh) -> float:
         q = p[f]
         total += sum(np.dot(q[0], np.cross(q[i], q[i + 1])) for i in range(1, len(f) - 1))
     return total / 6.0
+
+
+def jittered_grid(rng, n: int, jitter: float):
+    """An n x n grid of points moved by up to ``jitter`` and its (n-1)^2 quads as index lists."""
+    xy = np.stack(np.meshgrid(np.arange(n), np.arange(n), indexing="ij"), -1).reshape(-1, 2)
+    pts = xy + rng.uniform(-jitter, jitter, size=xy.shape)
+    quads = [
+        [i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1, i * n + j + 1]
+        for i, j in itertools.product(range(n - 1), range(n - 1))
+    ]
+    return pts, quads

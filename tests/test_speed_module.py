@@ -4,7 +4,6 @@ and an overlap check that still fires."""
 from __future__ import annotations
 
 import collections
-import itertools
 
 import numpy as np
 import pytest
@@ -26,7 +25,7 @@ from filletfold.pattern import CreasePattern
 from filletfold.rounding import round_edges
 from filletfold.vertex.frame import apply, vertex_frame
 
-from .conftest import design_of
+from .conftest import design_of, jittered_grid
 
 
 def reference_overlap(points_2d, faces, rel=1e-9) -> bool:
@@ -130,12 +129,9 @@ def test_overlap_proof_on_non_convex_faces():
 def test_overlap_proof_is_sound_on_jittered_grids(seed, jitter):
     """Whenever the fast proof says disjoint, the polygons' union has their total area."""
     rng = np.random.default_rng(seed)
-    n = 5
-    xy = np.stack(np.meshgrid(np.arange(n), np.arange(n), indexing="ij"), -1).reshape(-1, 2)
-    pts = xy + rng.uniform(-jitter, jitter, size=xy.shape)
+    pts, quads = jittered_grid(rng, 5, jitter)
     faces = []
-    for i, j in itertools.product(range(n - 1), range(n - 1)):
-        a, b, c, d = i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1, i * n + j + 1
+    for a, b, c, d in quads:
         faces.extend([[a, b, c], [a, c, d]] if rng.random() < 0.5 else [[a, b, c, d]])
     faces = [f if _signed_area(pts[f]) > 0 else f[::-1] for f in faces]
     assert faces_overlap(pts, faces) == reference_overlap(pts, faces)

@@ -21,7 +21,9 @@ from .layout import shelf_layout
 from .material_loss import MaterialLoss, solve_material_loss
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
-from .module import Piece, assemble_pattern, build_module, face_piece_centres, piece_area
+from .module import Piece, assemble_pattern, face_piece_centres, piece_area
+from .module_batch import CHUNK as MODULE_CHUNK
+from .module_batch import build_modules
 from .pattern import CreasePattern
 from .rounding import EdgeRounding, clamp_radii, round_edges
 from .sheet import glue_pieces
@@ -554,14 +556,16 @@ def round_mesh(
     t = time.perf_counter()
     points = rounding.arc_points(int(samples), float(arc_step))
     same_samples = st is not None and np.array_equal(st.samples, points)
-    modules = []
-    for u, (frame, apex, v) in enumerate(solved):
-        if same_samples and u in kept:
-            modules.append(st.modules[u])
-        else:
-            modules.append(build_module(pm, frame, centres, points, apex, v))
+    modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
+    todo = [u for u, module in enumerate(modules) if module is None]
+    for lo in range(0, len(todo), MODULE_CHUNK):  # in chunks, for the progress reports
+        part = todo[lo : lo + MODULE_CHUNK]
+        frames_, apices_, developed_ = zip(*[solved[u] for u in part], strict=True)
+        built = build_modules(pm, frames_, centres, points, apices_, developed_)
+        for u, module in zip(part, built, strict=True):
+            modules[u] = module
         if progress is not None:
-            progress("surface", u + 1, pm.n_vertices)
+            progress("surface", lo + len(part), len(todo))
     stages = Stages(
         key=key,
         loss=loss,

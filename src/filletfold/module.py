@@ -275,16 +275,56 @@ def faces_interior_disjoint(points_2d: np.ndarray, faces) -> bool:
     n_faces = len(faces)
     if n_faces == 0:
         return True
-    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=n_faces)
-    if sizes.min() < 3:
-        return False
-    a = np.fromiter(itertools.chain.from_iterable(faces), dtype=np.int64, count=int(sizes.sum()))
-    start = np.zeros(n_faces + 1, dtype=np.int64)
-    np.cumsum(sizes, out=start[1:])
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=n_faces)
+    flat = np.fromiter(itertools.chain.from_iterable(faces), np.int64, int(size.sum()))
+    piece = np.zeros(n_faces, dtype=np.int64)
+    return bool(faces_interior_disjoint_many(points_2d, flat, size, piece, 1)[0])
+
+
+def faces_interior_disjoint_many(
+    points_2d: np.ndarray, flat: np.ndarray, size: np.ndarray, face_piece: np.ndarray, n_pieces
+) -> np.ndarray:
+    """:func:`faces_interior_disjoint` of many pieces at once.
+
+    The same proof with the same arithmetic per face, edge and border, so the same answers:
+    every face strictly convex (or valid with a positive area), every directed edge once, the
+    edges without their reverse one simple counter-clockwise loop.
+
+    Parameters
+    ----------
+    points_2d : (k, 2) float
+        The points of all pieces; each piece's points are its own.
+    flat : (h,) int
+        The faces' point indices (into ``points_2d``), face after face.
+    size : (n_faces,) int
+        Corners per face.
+    face_piece : (n_faces,) int
+        Piece of each face (non-decreasing).
+    n_pieces : int
+
+    Returns
+    -------
+    (n_pieces,) bool
+        True where the piece is proved free of overlap.
+    """
+    ok = np.bincount(face_piece, minlength=n_pieces) > 0  # a piece without faces: proved below
+    if len(size) == 0:
+        return ~ok
+    empty = ~ok
+    ok[face_piece[size < 3]] = False
+    keep = ok[face_piece]
+    if not keep.all():
+        sel = np.repeat(keep, size)
+        flat, size, face_piece = flat[sel], size[keep], face_piece[keep]
+        if len(size) == 0:
+            return ok | empty
+    a = np.asarray(flat, dtype=np.int64)
+    start = np.zeros(len(size) + 1, dtype=np.int64)
+    np.cumsum(size, out=start[1:])
     nxt = np.arange(1, len(a) + 1)
     nxt[start[1:] - 1] = start[:-1]
     b = a[nxt]
-    # faces: strictly convex, turning once (robust margin tol.area of the corner's edges)
+    # faces: strictly convex, turning once
     d = points_2d[b] - points_2d[a]
     dn = d[nxt]
     cross = d[:, 0] * dn[:, 1] - d[:, 1] * dn[:, 0]
@@ -300,40 +340,90 @@ def faces_interior_disjoint(points_2d: np.ndarray, faces) -> bool:
         term = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]
         area2 = np.add.reduceat(term, start[:-1])[rest]
         scale = np.add.reduceat(np.abs(term), start[:-1])[rest]
-        if not (area2 > tol.area * scale).all():
-            return False
-        if not shapely.is_valid(face_polygons(points_2d, [faces[i] for i in rest])).all():
-            return False
+        ok[face_piece[rest[~(area2 > tol.area * scale)]]] = False
+        rest = rest[ok[face_piece[rest]]]
+        if len(rest):
+            polys = face_polygons(points_2d, [a[start[i] : start[i + 1]] for i in rest.tolist()])
+            ok[face_piece[rest[~shapely.is_valid(polys)]]] = False
     # edges: each directed edge once; border = edges without their reverse
     n = len(points_2d)
+    edge_piece = np.repeat(face_piece, size)
+    point_piece = np.full(n, -1, dtype=np.int64)
+    point_piece[a] = edge_piece
     key = a * n + b
     ks = np.sort(key)
-    if (ks[1:] == ks[:-1]).any():
-        return False
+    ok[point_piece[ks[1:][ks[1:] == ks[:-1]] // n]] = False
     rev = b * n + a
     pos = np.minimum(np.searchsorted(ks, rev), len(ks) - 1)
-    border = ks[pos] != rev
-    ba, bb = a[border], b[border]
-    m = len(ba)
-    if m < 3 or len(np.unique(ba)) != m or len(np.unique(bb)) != m:
-        return False
-    # the border is one loop
+    border = (ks[pos] != rev) & ok[edge_piece]
+    ba, bb, bp = a[border], b[border], edge_piece[border]
+    m = np.bincount(bp, minlength=n_pieces)
+    ok &= m >= 3
+    for ends in (ba, bb):
+        e = np.sort(ends)
+        ok[point_piece[e[1:][e[1:] == e[:-1]]]] = False
+    # the border is one loop: cut each piece's successor cycle before its first edge and rank
+    # the edges by their distance to the cut (pointer jumping, all pieces at once)
     where = np.full(n, -1, dtype=np.int64)
-    where[ba] = np.arange(m)
-    succ = where[bb].tolist()
-    loop = [0]
-    h = succ[0]
-    while h > 0:
-        loop.append(h)
-        h = succ[h]
-    if h < 0 or len(loop) != m:
-        return False
-    ring = points_2d[ba[loop]]
-    q = np.roll(ring, -1, axis=0)
-    term = ring[:, 0] * q[:, 1] - q[:, 0] * ring[:, 1]
-    if not term.sum() > tol.area * np.abs(term).sum():
-        return False
-    return bool(shapely.is_valid(shapely.Polygon(ring)))
+    where[ba] = np.arange(len(ba))
+    succ = where[bb]
+    ok[bp[succ < 0]] = False
+    live = ok[bp]  # these pieces' successors are permutations of their border edges
+    renum = np.cumsum(live) - 1
+    ba, bp, succ = ba[live], bp[live], renum[succ[live]]
+    pieces = np.flatnonzero(ok)
+    head = np.searchsorted(bp, pieces)  # first border edge of each piece
+    pred = np.empty(len(succ), dtype=np.int64)
+    pred[succ] = np.arange(len(succ))
+    jump = np.append(succ, len(succ))  # len(succ): the cut, where every path ends
+    jump[pred[head]] = len(succ)
+    togo = np.ones(len(jump), dtype=np.int64)  # edges from here to the cut
+    togo[-1] = 0
+    for _ in range(int(m.max(initial=1)).bit_length()):
+        togo, jump = togo + togo[jump], jump[jump]
+    loop_len = np.zeros(n_pieces, dtype=np.int64)
+    loop_len[pieces] = togo[head]
+    ok &= loop_len == m
+    rank = m[bp] - togo[:-1]  # position along the loop from the first edge
+    live = ok[bp]
+    ba, bp, rank = ba[live], bp[live], rank[live]
+    if not len(ba):
+        return ok | empty
+    # each loop's points in order, from its first edge
+    r_start = np.flatnonzero(np.concatenate([[True], bp[1:] != bp[:-1]]))
+    r_size = np.diff(np.append(r_start, len(bp)))
+    ring = np.empty((len(ba), 2))
+    ring[np.repeat(r_start, r_size) + rank] = points_2d[ba]
+    r_next = np.arange(1, len(ring) + 1)
+    r_next[r_start + r_size - 1] = r_start
+    nr = ring[r_next]
+    term = ring[:, 0] * nr[:, 1] - nr[:, 0] * ring[:, 1]
+    pieces = bp[r_start]
+    oriented = np.add.reduceat(term, r_start) > tol.area * np.add.reduceat(np.abs(term), r_start)
+    rings = shapely.linearrings(ring, indices=np.repeat(np.arange(len(r_start)), r_size))
+    ok[pieces[~(oriented & shapely.is_valid(shapely.polygons(rings)))]] = False
+    return ok | empty
+
+
+def _arc_parameters(arc: np.ndarray, n: np.ndarray):
+    """``np.linspace(0, arc, n)`` of every side, one side after another, as
+    :func:`_side_curves` samples them.
+
+    Returns
+    -------
+    side : (m,) int
+    k : (m,) int
+        Sample number along its side.
+    s : (m,) float
+    """
+    side = np.repeat(np.arange(len(n)), n)
+    first = np.cumsum(n) - n
+    k = np.arange(len(side)) - first[side]
+    step = np.where(n > 1, arc / np.maximum(n - 1, 1), 0.0)
+    s = k * step[side]
+    long = n > 1
+    s[(first + n - 1)[long]] = arc[long]
+    return side, k, s
 
 
 def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
@@ -510,14 +600,8 @@ def _side_curves(frame: VertexFrame, sides: list, n_samples, apex, dev_apex, hei
     arc = sa.arc[idx]
     n = np.full(len(idx), n_samples) if np.ndim(n_samples) == 0 else n_samples[sa.edge[idx]]
     n = np.where(arc > 0, n, 1).astype(np.int64)
-    rep = np.repeat(np.arange(len(idx)), n)
-    first = np.concatenate([[0], np.cumsum(n)[:-1]])
-    # np.linspace(0, arc, n) for every side: k * (arc / (n - 1)), the last point exactly arc
-    k = np.arange(len(rep)) - first[rep]
-    step = np.where(n > 1, arc / np.maximum(n - 1, 1), 0.0)
-    s = k * step[rep]
-    last = first + n - 1
-    s[last[n > 1]] = arc[n > 1]
+    rep, _, s = _arc_parameters(arc, n)
+    first = np.cumsum(n) - n
     side = idx[rep]
     C = sa.base(side, s)
     if apex is not None:
