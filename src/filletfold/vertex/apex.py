@@ -129,6 +129,7 @@ def build_constraints(
     margin: float,
     lmax_scale: np.ndarray | None = None,
     extra: np.ndarray | None = None,
+    samples: tuple | None = None,
 ) -> ApexConstraints:
     """Sample the sec. 3.2 constraints of a closed-ring vertex.
 
@@ -149,6 +150,8 @@ def build_constraints(
     extra : (m, 2) float, optional
         ``(side, s)``: further arc parameters at which ``l >= m`` and the non-intersection
         condition are sampled (where an earlier solution failed between the samples).
+    samples : tuple, optional
+        ``frame.arrays.samples(n_samples)`` when already computed (:func:`arc_samples`).
     """
     sa = frame.arrays
     k = len(sa.arc)
@@ -156,7 +159,7 @@ def build_constraints(
     if lmax_scale is None:
         lmax_scale = np.ones((k, 2))
     lmax = np.stack([frame.lmax_start, frame.lmax_end], axis=1) * lmax_scale
-    side, first, last, s, C, N = sa.samples(n_samples)
+    side, first, last, s, C, N = sa.samples(n_samples) if samples is None else samples
     if extra is not None and len(extra):
         x_side, x_s = extra[:, 0].astype(np.int64), extra[:, 1]
         side, s = np.concatenate([side, x_side]), np.concatenate([s, x_s])
@@ -217,6 +220,34 @@ def build_constraints(
         kind=kind,
         element=element,
     )
+
+
+def arc_samples(frames: Sequence[VertexFrame], n_samples: Sequence[int]) -> list[tuple]:
+    """``frame.arrays.samples(n)`` of many closed-ring vertices, computed together.
+
+    Parameters
+    ----------
+    frames : sequence of VertexFrame
+    n_samples : sequence of int
+        Samples per arc, per vertex.
+
+    Returns
+    -------
+    list of tuple
+        Per vertex ``(side, first, last, s, C, N)`` as :meth:`SideArrays.samples` returns them.
+    """
+    out: list = [None] * len(frames)
+    n_samples = np.asarray(n_samples, dtype=np.int64).reshape(-1)
+    for n in np.unique(n_samples).tolist():
+        which = np.flatnonzero(n_samples == n).tolist()
+        arrays = [frames[j].arrays for j in which]
+        side, first, last, s, C, N = _stack(arrays).samples(n)
+        k = np.array([len(a.arc) for a in arrays])
+        lo = np.concatenate([[0], np.cumsum(k)])  # sides of each vertex
+        for j, a, b in zip(which, lo[:-1].tolist(), lo[1:].tolist(), strict=True):
+            p, q = int(first[a]), int(last[b - 1]) + 1  # its samples
+            out[j] = (side[p:q] - a, first[a:b] - p, last[a:b] - p, s[p:q], C[p:q], N[p:q])
+    return out
 
 
 @dataclass

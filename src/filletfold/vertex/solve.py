@@ -13,7 +13,7 @@ import numpy as np
 from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
-from .apex import KINDS, build_constraints, validate_apices
+from .apex import KINDS, arc_samples, build_constraints, validate_apices
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angle_front, vertex_normals
@@ -255,11 +255,14 @@ class ApexProblem:
     extra: np.ndarray
     cut_rounds: int
 
-    def constraints(self, n_samples: int, scale: float):
-        """The sampled constraints of the next attempt (:func:`build_constraints`)."""
+    def constraints(self, n_samples: int, scale: float, samples: tuple | None = None):
+        """The sampled constraints of the next attempt (:func:`build_constraints`; ``samples``
+        from :func:`~filletfold.vertex.apex.arc_samples` when known)."""
         m = min(self.margin * scale, 0.25 * self.low)
         v = None if self.closed else self.v
-        return build_constraints(self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra)
+        return build_constraints(
+            self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra, samples
+        )
 
 
 #: Attempts per vertex: (samples per arc, margin scale), the next one after a failed dense
@@ -316,9 +319,9 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
         )
         return None
     U = frame.U
-    lengths = np.array([s.length for s in frame.sides])
+    mean_length = np.array([s.length for s in frame.sides]).mean()
     target = U + depth * D
-    starts = [U + t * lengths.mean() * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
+    starts = [U + t * mean_length * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
     if closed:
         target = np.concatenate([target, v])
         starts = [np.concatenate([x, v]) for x in starts]
@@ -459,7 +462,10 @@ def _solve_round(order: list, pending: dict, res: VertexResult, out: dict, centr
     """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
     solved ones at once, and settle every vertex that is done (ok, or out of attempts)."""
     tries = [pending[u].attempts.pop(0) for u in order]
-    cons = [pending[u].constraints(*t) for u, t in zip(order, tries, strict=True)]
+    samples = arc_samples([pending[u].frame for u in order], [t[0] for t in tries])
+    cons = [
+        pending[u].constraints(*t, samples=x) for u, t, x in zip(order, tries, samples, strict=True)
+    ]
     sols = solve_apex_batch(
         cons,
         [pending[u].target for u in order],
