@@ -9,7 +9,8 @@ development), the objective ``|x - P|^2`` and constraint rows that are all of th
 (linear rows have ``alpha_j = 0``; the crease-length rows of eq. (1) are quadratic with an
 identity Hessian up to sign because the charts are rigid). The solver stacks the problems of
 many vertices into padded arrays and runs one primal-dual interior-point iteration for all of
-them in lockstep (numpy, no Python loop over vertices):
+them in lockstep (numpy, no Python loop over vertices; or compiled by numba when installed,
+see :data:`USE_KERNEL`):
 
 * **phase 1** (only for targets that violate a row and starts that do too): maximise ``t``
   subject to ``g_j(x) >= t`` and ``t <= t_cap``, from the best start, until ``t > 0``; the
@@ -24,13 +25,20 @@ indefinite. Steps keep ``g > 0`` and ``lambda > 0`` and decrease the barrier mer
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from . import batch_kernel
 from .apex import ApexConstraints, ApexSolution
 from .reference import project_slsqp, solve_apex_slsqp
+
+#: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, about 6x
+#: faster) when numba is installed (the ``fast`` extra); ``FILLETFOLD_NUMBA=0`` turns it off.
+#: Its first use compiles it (about 15 s, once: the result is cached on disk).
+USE_KERNEL = batch_kernel.AVAILABLE and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
 
 #: Most vertices per chunk, and most padded rows per chunk (keeps the arrays in cache).
 CHUNK = 2048
@@ -115,7 +123,15 @@ def pack(rows: Sequence[tuple], n: int) -> RowBlock:
     return RowBlock(a, A, alpha, e, mask)
 
 
-def interior_point(
+def interior_point(rows: RowBlock, q, c, y, **kwargs) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`interior_point_numpy`, or its compiled twin
+    :func:`~filletfold.vertex.batch_kernel.interior_point_numba` when :data:`USE_KERNEL`."""
+    if USE_KERNEL:
+        return batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
+    return interior_point_numpy(rows, q, c, y, **kwargs)
+
+
+def interior_point_numpy(
     rows: RowBlock,
     q: np.ndarray,
     c: np.ndarray,
