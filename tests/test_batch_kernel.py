@@ -226,6 +226,7 @@ def test_designs_with_and_without_the_kernel(name, kwargs, monkeypatch):
     """The pipeline through either implementation: the same statuses, apices within 1e-5 of
     the mean edge (both land within rounding of the same optimum)."""
     designs = []
+    monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", 0)
     for use in (False, True):
         monkeypatch.setattr(batch, "USE_KERNEL", use)
         designs.append(filletfold.round_mesh(name, tabs=False, layout="modules", **kwargs))
@@ -235,3 +236,20 @@ def test_designs_with_and_without_the_kernel(name, kwargs, monkeypatch):
     assert ok.any()
     gap = np.abs(a.vertices.apex[ok] - b.vertices.apex[ok]).max()
     assert gap <= 1e-5 * a.mesh.mean_edge_length
+
+
+def test_small_batches_stay_with_numpy(monkeypatch):
+    """Below KERNEL_MIN_PROBLEMS problems the numpy version runs (no compile wait)."""
+    called = []
+    monkeypatch.setattr(batch, "USE_KERNEL", True)
+    monkeypatch.setattr(batch, "interior_point_numpy", lambda *a, **k: called.append("numpy"))
+    monkeypatch.setattr(
+        batch.batch_kernel, "interior_point_numba", lambda *a, **k: called.append("numba")
+    )
+    calls = recorded_calls(problems_of(CASES[0]))
+    rows, q, c, y, kw = calls[0]
+    assert len(rows.a) < batch.KERNEL_MIN_PROBLEMS
+    batch.interior_point(rows, q, c, y, **kw)
+    monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", len(rows.a))
+    batch.interior_point(rows, q, c, y, **kw)
+    assert called == ["numpy", "numba"]

@@ -37,8 +37,11 @@ from .reference import project_slsqp, solve_apex_slsqp
 
 #: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, about 6x
 #: faster) when numba is installed (the ``fast`` extra); ``FILLETFOLD_NUMBA=0`` turns it off.
-#: Its first use compiles it (about 15 s, once: the result is cached on disk).
+#: Its first use compiles it (about 15 s, once: the result is cached on disk), so it is used
+#: for batches of at least :data:`KERNEL_MIN_PROBLEMS` problems only: a small design (the
+#: demo, the app's examples) never waits for the compiler, a large one does once.
 USE_KERNEL = batch_kernel.AVAILABLE and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
+KERNEL_MIN_PROBLEMS = 256
 
 #: Most vertices per chunk, and most padded rows per chunk (keeps the arrays in cache).
 CHUNK = 2048
@@ -125,8 +128,9 @@ def pack(rows: Sequence[tuple], n: int) -> RowBlock:
 
 def interior_point(rows: RowBlock, q, c, y, **kwargs) -> tuple[np.ndarray, np.ndarray]:
     """:func:`interior_point_numpy`, or its compiled twin
-    :func:`~filletfold.vertex.batch_kernel.interior_point_numba` when :data:`USE_KERNEL`."""
-    if USE_KERNEL:
+    :func:`~filletfold.vertex.batch_kernel.interior_point_numba` when :data:`USE_KERNEL` and
+    the batch has at least :data:`KERNEL_MIN_PROBLEMS` problems."""
+    if USE_KERNEL and len(rows.a) >= KERNEL_MIN_PROBLEMS:
         return batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
     return interior_point_numpy(rows, q, c, y, **kwargs)
 
