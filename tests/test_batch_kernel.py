@@ -27,7 +27,7 @@ import pytest
 pytest.importorskip("numba")
 
 import filletfold
-from filletfold.vertex import batch
+from filletfold.vertex import batch, batch_kernel
 from filletfold.vertex.batch_kernel import AVAILABLE, interior_point_numba
 
 from .conftest import random_convex
@@ -244,7 +244,7 @@ def test_small_batches_stay_with_numpy(monkeypatch):
     monkeypatch.setattr(batch, "USE_KERNEL", True)
     monkeypatch.setattr(batch, "interior_point_numpy", lambda *a, **k: called.append("numpy"))
     monkeypatch.setattr(
-        batch.batch_kernel, "interior_point_numba", lambda *a, **k: called.append("numba")
+        batch_kernel, "interior_point_numba", lambda *a, **k: called.append("numba")
     )
     calls = recorded_calls(problems_of(CASES[0]))
     rows, q, c, y, kw = calls[0]
@@ -253,3 +253,9 @@ def test_small_batches_stay_with_numpy(monkeypatch):
     monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", len(rows.a))
     batch.interior_point(rows, q, c, y, **kw)
     assert called == ["numpy", "numba"]
+
+
+def test_importing_filletfold_does_not_import_numba():
+    """numba (0.2 s, 50 MB) is imported on the kernel's first use only."""
+    code = "import sys, filletfold, filletfold.vertex.batch; assert 'numba' not in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)

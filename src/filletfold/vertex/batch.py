@@ -25,13 +25,13 @@ indefinite. Steps keep ``g > 0`` and ``lambda > 0`` and decrease the barrier mer
 
 from __future__ import annotations
 
+import importlib.util
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import batch_kernel
 from .apex import ApexConstraints, ApexSolution
 from .reference import project_slsqp, solve_apex_slsqp
 
@@ -40,7 +40,10 @@ from .reference import project_slsqp, solve_apex_slsqp
 #: Its first use compiles it (about 15 s, once: the result is cached on disk), so it is used
 #: for batches of at least :data:`KERNEL_MIN_PROBLEMS` problems only: a small design (the
 #: demo, the app's examples) never waits for the compiler, a large one does once.
-USE_KERNEL = batch_kernel.AVAILABLE and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
+#: (numba itself is imported on that first use, not with filletfold.)
+USE_KERNEL = (
+    importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
+)
 KERNEL_MIN_PROBLEMS = 256
 
 #: Most vertices per chunk, and most padded rows per chunk (keeps the arrays in cache).
@@ -131,7 +134,9 @@ def interior_point(rows: RowBlock, q, c, y, **kwargs) -> tuple[np.ndarray, np.nd
     :func:`~filletfold.vertex.batch_kernel.interior_point_numba` when :data:`USE_KERNEL` and
     the batch has at least :data:`KERNEL_MIN_PROBLEMS` problems."""
     if USE_KERNEL and len(rows.a) >= KERNEL_MIN_PROBLEMS:
-        return batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
+        from .batch_kernel import interior_point_numba
+
+        return interior_point_numba(rows, q, c, y, **kwargs)
     return interior_point_numpy(rows, q, c, y, **kwargs)
 
 
