@@ -17,7 +17,9 @@ the same problems go to every method:
 * ``reference``: the library's SLSQP solver with a feasibility phase from several starts
   (``filletfold.vertex.reference.solve_apex_slsqp``);
 * ``batched``: ``filletfold.vertex.batch.solve_apex_batch``, one call for all problems of a
-  case.
+  case, with the numpy interior-point method;
+* ``batched-numba``: the same with the compiled kernel at every batch size (needs numba: the
+  ``fast`` extra; skipped without it; its one-time compilation is in the warm-up).
 
 A vertex is *feasible* when at least one method returned a point with every row
 ``g >= -1e-9 L`` (``L`` = the constraints' scale, the mean incident edge length); a method
@@ -39,6 +41,7 @@ and two small random polyhedra.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import statistics
 import sys
@@ -62,7 +65,7 @@ from examples import machine
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUNNY = os.path.join(ROOT, "examples", "bunny-lowres.obj")
 FEAS_TOL = 1e-9  # rows g >= -FEAS_TOL * L count as satisfied
-METHODS = ("slsqp-loop", "ipopt", "reference", "batched")
+METHODS = ("slsqp-loop", "ipopt", "reference", "batched", "batched-numba")
 
 
 # --------------------------------------------------------------------------- problems
@@ -303,11 +306,19 @@ def run_method(m: str, probs, repeat: int, solvers: dict, rng):
         ref = solvers["reference"]
         ref(probs[0].cons, probs[0].target, probs[0].starts)
         return timed(lambda: [ref(p.cons, p.target, p.starts).x for p in probs], repeat)
-    if m == "batched":
-        batch = solvers["batched"]
-        cons, targets, starts = zip(*((p.cons, p.target, p.starts) for p in probs), strict=True)
-        batch(list(cons[:1]), list(targets[:1]), list(starts[:1]))
-        sols, secs = timed(lambda: batch(list(cons), list(targets), list(starts)), repeat)
+    if m in ("batched", "batched-numba"):
+        from filletfold.vertex import batch as module
+
+        kernel = m == "batched-numba"
+        saved = module.USE_KERNEL, module.KERNEL_MIN_PROBLEMS
+        module.USE_KERNEL, module.KERNEL_MIN_PROBLEMS = kernel, 0
+        try:
+            batch = solvers["batched"]
+            cons, targets, starts = zip(*((p.cons, p.target, p.starts) for p in probs), strict=True)
+            batch(list(cons[:1]), list(targets[:1]), list(starts[:1]))
+            sols, secs = timed(lambda: batch(list(cons), list(targets), list(starts)), repeat)
+        finally:
+            module.USE_KERNEL, module.KERNEL_MIN_PROBLEMS = saved
         return [s.x for s in sols], secs
     raise ValueError(m)
 
@@ -348,6 +359,9 @@ def main(argv=None) -> int:
         if m not in METHODS:
             ap.error(f"unknown method {m!r}; choose from {', '.join(METHODS)}")
 
+    if "batched-numba" in methods and importlib.util.find_spec("numba") is None:
+        print("# batched-numba skipped: numba is not installed (pip install -e .[fast])")
+        methods.remove("batched-numba")
     print(f"# machine: {machine()}")
     print(f"# command: {' '.join([os.path.basename(sys.executable), *sys.argv])}")
     print(
