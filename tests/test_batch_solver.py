@@ -25,7 +25,7 @@ from filletfold.vertex.batch import pack, rows_of, solve_apex, solve_apex_batch
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems
 
-from .conftest import random_convex
+from .conftest import design_of, random_convex
 
 
 def first_attempts(
@@ -137,3 +137,27 @@ def test_mixed_batch_equals_separate_solves():
         assert alone.ok == t.ok
         if t.ok:
             np.testing.assert_allclose(t.x, alone.x, atol=1e-7 * cons.scale)
+
+
+def test_kkt_point_certifies_a_projection_and_rejects_a_point_short_of_it():
+    """The certificate that spares an SLSQP finish: at the solved apex of a vertex whose
+    target is infeasible it holds; moved back toward the target along the boundary or pulled
+    into the interior, it does not."""
+    from filletfold.vertex.batch import kkt_point
+
+    d = design_of("icosahedron", radius="10%", depth="60%")
+    probs = apex_problems(d.mesh, d.rounding, d.stages.depths)
+    checked = 0
+    for p in probs:
+        cons = p.constraints(9, 1.0)
+        sol = solve_apex_batch([cons], [p.target], [p.starts])[0]
+        if not sol.ok or sol.at_target:
+            continue
+        x = sol.x
+        assert kkt_point(cons, p.target, x)
+        inner = x + 0.01 * (p.target - x)  # not on the boundary toward P: infeasible
+        interior = x + 1e-3 * cons.scale * (x - p.target) / np.linalg.norm(x - p.target)
+        assert cons.values(inner).min() < 0 or not kkt_point(cons, p.target, inner)
+        assert not kkt_point(cons, p.target, interior)  # no active row: not a projection
+        checked += 1
+    assert checked > 0

@@ -31,6 +31,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import nnls
 
 from .apex import ApexConstraints, ApexSolution
 from .reference import project_slsqp, solve_apex_slsqp
@@ -45,6 +46,11 @@ USE_KERNEL = (
     importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
 )
 KERNEL_MIN_PROBLEMS = 256
+
+#: :func:`kkt_point`: rows within this share of the scale are active, and the gradient must be
+#: matched to this share of its size.
+KKT_ACTIVE = 1e-6
+KKT_TOL = 1e-6
 
 #: Most vertices per chunk, and most padded rows per chunk (keeps the arrays in cache).
 CHUNK = 2048
@@ -407,6 +413,31 @@ def solve_apex_batch(
     return out
 
 
+def kkt_point(cons: ApexConstraints, target: np.ndarray, x: np.ndarray) -> bool:
+    """Whether the feasible point ``x`` is a first-order (KKT) point of the projection of
+    ``target``: the objective's gradient is a nonnegative combination of the gradients of the
+    rows active at ``x`` (within :data:`KKT_ACTIVE` of the scale), to :data:`KKT_TOL` of its size.
+
+    The interior-point method can stop short of its stationarity test at a degenerate vertex
+    of the feasible set (many rows active together); such a point needs no SLSQP finish.
+
+    Parameters
+    ----------
+    cons : ApexConstraints
+    target, x : (n,) float
+    """
+    L = cons.scale
+    grad = 2 * (x - target) / L
+    size = np.linalg.norm(grad)
+    if size == 0:
+        return True
+    active = cons.values(x) <= KKT_ACTIVE * L
+    if not active.any():
+        return False
+    _, residual = nnls(cons.jacobian(x)[active].T, grad)
+    return bool(residual <= KKT_TOL * size)
+
+
 def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSolution:
     """One problem through :func:`solve_apex_batch` (same parameters, one of each)."""
     return solve_apex_batch([cons], [target], [list(starts) if starts is not None else []])[0]
@@ -476,7 +507,8 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
             result.append(ApexSolution(True, T[b].copy(), [], True, "target"))
         elif feasible[b]:
             x, how = T[b] + L[b] * y[b], "ipm"
-            if not converged[b]:  # rare: finish with SLSQP from the feasible point
+            if not converged[b] and not kkt_point(p, T[b], x):
+                # rare: finish with SLSQP from the feasible point
                 x_s = project_slsqp(p, T[b], x)
                 if np.sum((x_s - T[b]) ** 2) < np.sum((x - T[b]) ** 2):
                     x, how = x_s, "ipm+slsqp"
