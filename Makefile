@@ -12,6 +12,8 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[test]"
+	@# compile the numba solver kernel now (about 15 s, once), not in the first large design
+	$(BIN)/python -c "from filletfold.vertex.batch import warm_kernel; warm_kernel()"
 	touch $(STAMP)
 
 install: $(STAMP)

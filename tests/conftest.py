@@ -11,6 +11,7 @@ from scipy.spatial import ConvexHull
 
 import filletfold
 from filletfold.mesh import EXAMPLES, example_names
+from filletfold.vertex import batch
 
 ALL = example_names()
 CLOSED_CONVEX = [n for n, e in EXAMPLES.items() if "convex" in e.kinds and e.closed]
@@ -24,6 +25,15 @@ def design_of(
     return filletfold.round_mesh(
         name, radius=radius, depth=depth, samples=samples, arc_step=arc_step
     )
+
+
+@pytest.fixture(autouse=True)
+def _numpy_interior_point(request, monkeypatch):
+    """Every test but the kernel's own solves with the numpy interior-point method, whatever
+    is installed and whatever an earlier test loaded: the same bits in every order (the
+    kernel agrees to rounding, and test_batch_kernel.py checks that)."""
+    if request.node.path.name != "test_batch_kernel.py":
+        monkeypatch.setattr(batch, "USE_KERNEL", False)
 
 
 @pytest.fixture(params=ALL)

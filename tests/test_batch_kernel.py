@@ -242,6 +242,7 @@ def test_small_batches_stay_with_numpy(monkeypatch):
     """Below KERNEL_MIN_PROBLEMS problems the numpy version runs (no compile wait)."""
     called = []
     monkeypatch.setattr(batch, "USE_KERNEL", True)
+    monkeypatch.setattr(batch, "_kernel_loaded", False)
     monkeypatch.setattr(batch, "interior_point_numpy", lambda *a, **k: called.append("numpy"))
     monkeypatch.setattr(
         batch_kernel, "interior_point_numba", lambda *a, **k: called.append("numba")
@@ -259,3 +260,19 @@ def test_importing_filletfold_does_not_import_numba():
     """numba (0.2 s, 50 MB) is imported on the kernel's first use only."""
     code = "import sys, filletfold, filletfold.vertex.batch; assert 'numba' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+def test_a_warm_kernel_serves_every_batch(monkeypatch):
+    """After warm_kernel, small batches use the kernel too (the app warms it at start)."""
+    monkeypatch.setattr(batch, "USE_KERNEL", True)
+    monkeypatch.setattr(batch, "_kernel_loaded", False)
+    assert batch.warm_kernel() and batch._kernel_loaded
+    called = []
+    monkeypatch.setattr(batch, "interior_point_numpy", lambda *a, **k: called.append("numpy"))
+    calls = recorded_calls(problems_of(CASES[0]))
+    rows, q, c, y, kw = calls[0]
+    assert len(rows.a) < batch.KERNEL_MIN_PROBLEMS
+    batch.interior_point(rows, q, c, y, **kw)
+    assert called == []
+    monkeypatch.setattr(batch, "USE_KERNEL", False)
+    assert not batch.warm_kernel()

@@ -23,6 +23,7 @@ import webbrowser
 from ..design import DEFAULT_ARC_STEP, DEFAULT_SAMPLES
 from ..errors import FilletfoldError
 from ..mesh import example_names
+from ..vertex.batch import warm_kernel
 from .session import AppSession, nearest_vertex_to_ray
 from .view import (
     CAMERA_LOOK_AT,
@@ -521,6 +522,8 @@ def run_app(
         samples=DEFAULT_SAMPLES,
     )
     session.load(mesh)
+    # with numba (the fast extra), load the solver kernel now so every later change uses it
+    threading.Thread(target=warm_kernel, name="filletfold-kernel", daemon=True).start()
     with _quiet_stdout():  # viser prints its own banner; the URL is logged and returned
         server = viser.ViserServer(host=host, port=port, label="filletfold", verbose=False)
     try:

@@ -40,7 +40,9 @@ from .reference import project_slsqp, solve_apex_slsqp
 #: faster) when numba is installed (the ``fast`` extra); ``FILLETFOLD_NUMBA=0`` turns it off.
 #: Its first use compiles it (about 15 s, once: the result is cached on disk), so it is used
 #: for batches of at least :data:`KERNEL_MIN_PROBLEMS` problems only: a small design (the
-#: demo, the app's examples) never waits for the compiler, a large one does once.
+#: demo, the app's examples) never waits for the compiler, a large one does once. Once the
+#: kernel is loaded in this process (by a large batch or :func:`warm_kernel`), every batch
+#: uses it.
 #: (numba itself is imported on that first use, not with filletfold.)
 USE_KERNEL = (
     importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
@@ -139,11 +141,38 @@ def interior_point(rows: RowBlock, q, c, y, **kwargs) -> tuple[np.ndarray, np.nd
     """:func:`interior_point_numpy`, or its compiled twin
     :func:`~filletfold.vertex.batch_kernel.interior_point_numba` when :data:`USE_KERNEL` and
     the batch has at least :data:`KERNEL_MIN_PROBLEMS` problems."""
-    if USE_KERNEL and len(rows.a) >= KERNEL_MIN_PROBLEMS:
-        from .batch_kernel import interior_point_numba
-
-        return interior_point_numba(rows, q, c, y, **kwargs)
+    if USE_KERNEL and (_kernel_loaded or len(rows.a) >= KERNEL_MIN_PROBLEMS):
+        return _kernel(rows, q, c, y, **kwargs)
     return interior_point_numpy(rows, q, c, y, **kwargs)
+
+
+_kernel_loaded = False
+
+
+def _kernel(rows: RowBlock, q, c, y, **kwargs):
+    """:func:`~filletfold.vertex.batch_kernel.interior_point_numba`, noting it is loaded."""
+    global _kernel_loaded
+    from .batch_kernel import interior_point_numba
+
+    out = interior_point_numba(rows, q, c, y, **kwargs)
+    _kernel_loaded = True
+    return out
+
+
+def warm_kernel() -> bool:
+    """Load (or compile, the first time ever: about 15 s) the numba kernel now, e.g. in a
+    background thread of the app, so that from then on every batch uses it.
+
+    Returns
+    -------
+    bool
+        Whether the kernel is in use (False without numba or with ``FILLETFOLD_NUMBA=0``).
+    """
+    if not USE_KERNEL:
+        return False
+    rows = pack([(np.ones(2), np.eye(2, 3), np.zeros(2))], 3)
+    _kernel(rows, np.full(3, 2.0), np.ones((1, 3)), np.zeros((1, 3)))
+    return True
 
 
 def interior_point_numpy(
