@@ -32,7 +32,7 @@ from .pattern import CreasePattern
 from .rounding import EdgeRounding
 from .tolerances import tol
 from .vertex.apex import crease_length
-from .vertex.frame import SideArrays, VertexFrame, apply, to_chart
+from .vertex.frame import VertexFrame, apply, stack_sides, to_chart
 
 
 @dataclass
@@ -596,7 +596,7 @@ def _side_curves(frame: VertexFrame, sides: list, n_samples, apex, dev_apex, hei
     if frame.ring.closed:
         sa, idx = frame.arrays, which
     else:  # an open ring has no SideArrays: stack the sides asked for
-        sa, idx = _stacked_sides([frame.sides[i] for i in sides]), np.arange(len(sides))
+        sa, idx = stack_sides([frame.sides[i] for i in sides]), np.arange(len(sides))
     arc = sa.arc[idx]
     n = np.full(len(idx), n_samples) if np.ndim(n_samples) == 0 else n_samples[sa.edge[idx]]
     n = np.where(arc > 0, n, 1).astype(np.int64)
@@ -614,25 +614,6 @@ def _side_curves(frame: VertexFrame, sides: list, n_samples, apex, dev_apex, hei
         i: (s[a:b], C[a:b], F[a:b], z[a:b])
         for i, a, b in zip(sides, bounds[:-1], bounds[1:], strict=True)
     }
-
-
-def _stacked_sides(sides: list) -> SideArrays:
-    """The geometry of rounded :class:`Side` objects as :class:`SideArrays` (no charts)."""
-    return SideArrays(
-        edge=np.array([x.edge for x in sides], dtype=np.int64),
-        R=np.array([x.R for x in sides]),
-        M=np.array([x.M for x in sides]),
-        O=np.array([x.O for x in sides]),
-        N0=np.array([x.N0 for x in sides]),
-        B=np.array([x.B for x in sides]),
-        radius=np.array([x.radius for x in sides]),
-        kappa=np.array([x.kappa for x in sides], dtype=float),
-        arc=np.array([x.arc for x in sides]),
-        length=np.array([x.length for x in sides]),
-        Q=None,
-        t=None,
-        face_normal=None,
-    )
 
 
 def apply_rows(m: np.ndarray, p: np.ndarray) -> np.ndarray:

@@ -231,6 +231,26 @@ class SideArrays:
         return side, first, first + ks - 1, s, self.base(side, s), self.normal(side, s)
 
 
+def stack_sides(sides: list, Q=None, t=None, face_normal=None) -> SideArrays:
+    """Rounded :class:`Side` objects as :class:`SideArrays` (charts and face normals as given,
+    None by default)."""
+    return SideArrays(
+        edge=np.array([x.edge for x in sides], dtype=np.int64),
+        R=np.array([x.R for x in sides]),
+        M=np.array([x.M for x in sides]),
+        O=np.array([x.O for x in sides]),
+        N0=np.array([x.N0 for x in sides]),
+        B=np.array([x.B for x in sides]),
+        radius=np.array([x.radius for x in sides]),
+        kappa=np.array([x.kappa for x in sides], dtype=float),
+        arc=np.array([x.arc for x in sides]),
+        length=np.array([x.length for x in sides]),
+        Q=Q,
+        t=t,
+        face_normal=face_normal,
+    )
+
+
 @dataclass
 class VertexFrame:
     """Sides, charts and 2D maps of one vertex.
@@ -282,21 +302,11 @@ class VertexFrame:
     @functools.cached_property
     def arrays(self) -> SideArrays:
         """The sides' and faces' data stacked into arrays (closed rings)."""
-        sides = self.sides
         maps = np.array(self.cyl_map)  # (k, 3, 3) rigid: the inverse is [Q^T, -Q^T t]
         Q = maps[:, :2, :2].transpose(0, 2, 1)
         faces = np.array(self.face_frames)
-        return SideArrays(
-            edge=np.array([s.edge for s in sides], dtype=np.int64),
-            R=np.array([s.R for s in sides]),
-            M=np.array([s.M for s in sides]),
-            O=np.array([s.O for s in sides]),
-            N0=np.array([s.N0 for s in sides]),
-            B=np.array([s.B for s in sides]),
-            radius=np.array([s.radius for s in sides]),
-            kappa=np.array([s.kappa for s in sides], dtype=float),
-            arc=np.array([s.arc for s in sides]),
-            length=np.array([s.length for s in sides]),
+        return stack_sides(
+            self.sides,
             Q=Q,
             t=-np.einsum("kij,kj->ki", Q, maps[:, :2, 2]),
             face_normal=np.cross(faces[:, 1], faces[:, 2]),
