@@ -15,7 +15,8 @@ Cases, each skipped when it has more than ``--max-faces`` faces (default 1280, q
 * large tessellations with material loss: ``miura:20x20`` and ``miura:40x40`` (400 and 1600
   parallelograms) with ``material_loss=True`` and layout ``auto`` (one uncut sheet).
 
-Radius 10 %, depth 30 %, no tabs, 24 samples per arc at most and the library's arc step
+As the command line runs it (``keep_stages=False``: no state kept for reuse). Radius 10 %,
+depth 30 %, no tabs, 24 samples per arc at most and the library's arc step
 (``--arc-step 0``: every arc gets 24 points, as before adaptive sampling); layout ``modules``
 except for the tessellations. Every case
 runs in its own child process (so peak memory, ``ru_maxrss``, is the case's alone and includes
@@ -94,7 +95,7 @@ def child(name: str, repeat: int, arc_step: float | None = None) -> dict:
     _, spec, kwargs = CASES[name]
     mesh = case_mesh(spec)
     base = rss_mb()
-    kwargs = {"layout": "modules", "tabs": False, **kwargs}
+    kwargs = {"layout": "modules", "tabs": False, "keep_stages": False, **kwargs}  # as the CLI
     if arc_step is not None:
         kwargs["arc_step"] = arc_step
     runs = []

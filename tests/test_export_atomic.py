@@ -175,3 +175,24 @@ def test_write_file_atomic_rejects(tmp_path):
     with pytest.raises(ExportError, match="it is a folder"):
         write_file_atomic(tmp_path / "d", "x")
     assert sorted(x.name for x in tmp_path.iterdir()) == ["d"]
+
+
+def test_contents_built_when_written_and_a_failing_build_writes_nothing(tmp_path):
+    """Callables are built one at a time, in order, as their files are written (one file's
+    contents in memory at a time); one that fails leaves the folder as it was."""
+    calls = []
+
+    def first():
+        calls.append("a")
+        return "A"
+
+    def broken():
+        calls.append("b")
+        raise ValueError("boom")
+
+    out = tmp_path / "o"
+    with pytest.raises(ExportError, match="boom"):
+        write_outputs(out, {"a.txt": first, "b.txt": broken})
+    assert calls == ["a", "b"] and not out.exists()
+    write_outputs(out, {"a.txt": first, "b.bin": lambda: b"B"})
+    assert (out / "a.txt").read_text() == "A" and (out / "b.bin").read_bytes() == b"B"

@@ -70,3 +70,27 @@ def test_reuse_with_a_different_mesh_is_a_fresh_design():
     first = filletfold.round_mesh("cube")
     other = filletfold.round_mesh("tetrahedron", reuse=first)
     same_design(other, filletfold.round_mesh("tetrahedron"))
+
+
+def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
+    """keep_stages=False (the command line): the same pattern, no stages, and the vertex frames
+    are freed before the layout and export (a large design's peak memory)."""
+    import gc
+    import weakref
+
+    refs = []
+    classify = design_module.classify_vertices
+
+    def spy(*args, **kwargs):
+        frames = classify(*args, **kwargs)
+        refs.append(weakref.ref(frames[0]))
+        return frames
+
+    monkeypatch.setattr(design_module, "classify_vertices", spy)
+    kept = filletfold.round_mesh("icosahedron", tabs=False)
+    lean = filletfold.round_mesh("icosahedron", tabs=False, keep_stages=False)
+    assert kept.stages is not None and lean.stages is None
+    np.testing.assert_array_equal(kept.pattern.vertices_2d, lean.pattern.vertices_2d)
+    gc.collect()
+    assert refs[0]() is not None  # held by kept.stages
+    assert refs[1]() is None

@@ -272,6 +272,7 @@ def round_cmd(
                 tabs=not no_tabs,
                 coplanar_deg=coplanar_tol,
                 progress=progress,
+                keep_stages=False,  # nothing is reused: let frames and modules go early
             )
         if not quiet:
             console.print(design.summary(), highlight=False)

@@ -405,6 +405,7 @@ def round_mesh(
     coplanar_deg: float = tol.coplanar_deg,
     progress=None,
     reuse: Design | None = None,
+    keep_stages: bool = True,
 ) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
@@ -461,6 +462,10 @@ def round_mesh(
         An earlier design of the same mesh: when the rounding parameters are the same, its
         rounding, frames and normals are taken over and only the vertices whose depth changed
         are re-solved and rebuilt (see :class:`Stages`); the result is the same as without.
+    keep_stages : bool
+        Keep what ``reuse`` needs in ``design.stages`` (the default). False lets the vertex
+        frames and modules go as soon as the layout no longer needs them, which lowers the peak
+        memory of a large design by about a third (the command line does so: it never reuses).
 
     Returns
     -------
@@ -558,6 +563,7 @@ def round_mesh(
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]
+    frames_ = apices_ = developed_ = built = None
     for lo in range(0, len(todo), MODULE_CHUNK):  # in chunks, for the progress reports
         part = todo[lo : lo + MODULE_CHUNK]
         frames_, apices_, developed_ = zip(*[solved[u] for u in part], strict=True)
@@ -566,26 +572,35 @@ def round_mesh(
             modules[u] = module
         if progress is not None:
             progress("surface", lo + len(part), len(todo))
-    stages = Stages(
-        key=key,
-        loss=loss,
-        conical=conical,
-        rounding=rounding,
-        centres=centres,
-        frames=frames,
-        classified=classified,
-        depths=depths,
-        vertices=res,
-        solved=solved,
-        samples=points,
-        modules=modules,
+    stages = (
+        None
+        if not keep_stages
+        else Stages(
+            key=key,
+            loss=loss,
+            conical=conical,
+            rounding=rounding,
+            centres=centres,
+            frames=frames,
+            classified=classified,
+            depths=depths,
+            vertices=res,
+            solved=solved,
+            samples=points,
+            modules=modules,
+        )
     )
     pieces = [piece for module in modules for piece in module]
+    ring_closed = [f.ring.closed for f in frames]
+    if not keep_stages and not (layout == "net" or (layout == "auto" and sheet is not None)):
+        # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
+        del frames, classified, frames_, apices_, developed_, built
+        solved = modules = None
     layout_used, layout_note = "modules", ""
     eps = 1e-9 * ref
     if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
         not_closed = [
-            u for u, f in enumerate(frames) if f.ring.closed and res.kind[u] != "developable"
+            u for u, closed in enumerate(ring_closed) if closed and res.kind[u] != "developable"
         ]
         if not_closed:
             listed = ", ".join(map(str, not_closed[:8])) + (", ..." if len(not_closed) > 8 else "")

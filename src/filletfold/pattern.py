@@ -13,6 +13,9 @@ import numpy as np
 
 from .tolerances import tol
 
+#: Faces whose folded normals are computed together (bounds the temporaries).
+NORMAL_CHUNK = 100_000
+
 
 @dataclass
 class Label:
@@ -148,11 +151,19 @@ class CreasePattern:
         return self._face_normal_3d(*self._halfedges())
 
     def _face_normal_3d(self, a, b, start, nxt) -> np.ndarray:
-        """:meth:`face_normal_3d` from :meth:`_halfedges`."""
-        p = self.vertices_3d[a]
-        size = np.diff(start)
-        q = p - np.repeat(np.add.reduceat(p, start[:-1]) / size[:, None], size, axis=0)
-        n = np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)  # q[nxt]: the next corner
+        """:meth:`face_normal_3d` from :meth:`_halfedges`, ``NORMAL_CHUNK`` faces at a time
+        (the corners' temporaries of a large pattern would take hundreds of MB at once)."""
+        n_faces = len(start) - 1
+        n = np.empty((n_faces, 3))
+        for lo in range(0, n_faces, NORMAL_CHUNK):
+            hi = min(lo + NORMAL_CHUNK, n_faces)
+            h0, h1 = start[lo], start[hi]
+            p = self.vertices_3d[a[h0:h1]]
+            first = start[lo:hi] - h0
+            size = np.diff(start[lo : hi + 1])
+            q = p - np.repeat(np.add.reduceat(p, first) / size[:, None], size, axis=0)
+            q_next = q[nxt[h0:h1] - h0]  # the next corner of the same face
+            n[lo:hi] = np.add.reduceat(np.cross(q, q_next), first, axis=0)
         return n / np.linalg.norm(n, axis=1)[:, None]
 
     def _halfedges(self):

@@ -132,9 +132,11 @@ def write_outputs(folder, files: Mapping[str, str | bytes]) -> list[Path]:
     ----------
     folder : str or os.PathLike
         Destination folder; created, with its parents, when missing.
-    files : mapping of str to str or bytes
-        File name (a plain name, no directory part) to contents. ``str`` contents are written as
-        UTF-8 without newline translation.
+    files : mapping of str to str, bytes or callable
+        File name (a plain name, no directory part) to contents, or to a function without
+        arguments that returns them (called just before its file is written, so only one
+        file's contents need to be in memory at a time). ``str`` contents are written as UTF-8
+        without newline translation.
 
     Returns
     -------
@@ -171,8 +173,10 @@ def write_outputs(folder, files: Mapping[str, str | bytes]) -> list[Path]:
         old_dir.mkdir()
         staged = []
         for n in names:
-            data = _encode(n, files[n])
+            data = files[n]
+            data = _encode(n, data() if callable(data) else data)
             _write_synced(new_dir / n, data)
+            del data
             staged.append(n)
         for n in staged:
             target = folder / n

@@ -207,7 +207,8 @@ def cut_files(
     title: str = "",
     description: str = "",
     report: Mapping | str | None = None,
-) -> dict[str, str | bytes]:
+    lazy: bool = False,
+) -> dict:
     """Build the output files of ``formats`` for a crease pattern (nothing is written).
 
     Parameters
@@ -225,10 +226,14 @@ def cut_files(
         FOLD ``file_title`` and ``file_description``.
     report : mapping or str, optional
         The ``report.json`` content (a dict, or its text); required for the ``json`` format.
+    lazy : bool
+        Return, for each file, a function without arguments that builds its contents (for
+        :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
+        at a time); the pattern is still checked here, once.
 
     Returns
     -------
-    dict of str to str or bytes
+    dict of str to str or bytes (or to callables, with ``lazy``)
         File name to contents, in the order of :func:`output_names`. Text formats are ``str``,
         PDF and PNG ``bytes``.
 
@@ -259,25 +264,27 @@ def cut_files(
 
     from .report import report_json
 
-    out: dict[str, str | bytes] = {}
-    for fmt in formats:
-        if fmt == "fold":
-            doc = _fold_document(pattern, faces, title=title, description=description, arrays=True)
-            out["design.fold"] = fold_json(doc)
-        elif fmt == "json":
-            out["report.json"] = report if isinstance(report, str) else report_json(report)
-        elif fmt == "obj":
-            out["folded.obj"] = _folded_obj(pattern, faces)
-        elif fmt == "svg":
-            out["pattern.svg"] = _pattern_svg(scaled_pattern(pattern, scale), units=units)
-        elif fmt == "dxf":
-            out["pattern.dxf"] = pattern_dxf(pattern, units=units, scale=scale)
-        elif fmt == "pdf":
-            pdf_units, pdf_scale = units or "mm", scale
-            if not units and not scale_given:
-                pdf_scale = fit_page_scale(pattern, page)
-            out["pattern.pdf"] = pattern_pdf(pattern, page=page, units=pdf_units, scale=pdf_scale)
-        elif fmt == "png":
-            out["pattern.png"] = pattern_png(pattern)
-            out["preview.png"] = preview_png(pattern)
-    return out
+    def fold():
+        doc = _fold_document(pattern, faces, title=title, description=description, arrays=True)
+        return fold_json(doc)
+
+    def pdf():
+        pdf_units, pdf_scale = units or "mm", scale
+        if not units and not scale_given:
+            pdf_scale = fit_page_scale(pattern, page)
+        return pattern_pdf(pattern, page=page, units=pdf_units, scale=pdf_scale)
+
+    builders = {
+        "fold": {"design.fold": fold},
+        "json": {"report.json": lambda: report if isinstance(report, str) else report_json(report)},
+        "obj": {"folded.obj": lambda: _folded_obj(pattern, faces)},
+        "svg": {"pattern.svg": lambda: _pattern_svg(scaled_pattern(pattern, scale), units=units)},
+        "dxf": {"pattern.dxf": lambda: pattern_dxf(pattern, units=units, scale=scale)},
+        "pdf": {"pattern.pdf": pdf},
+        "png": {
+            "pattern.png": lambda: pattern_png(pattern),
+            "preview.png": lambda: preview_png(pattern),
+        },
+    }
+    out = {name: build for fmt in formats for name, build in builders[fmt].items()}
+    return out if lazy else {name: build() for name, build in out.items()}
