@@ -276,3 +276,22 @@ def test_a_warm_kernel_serves_every_batch(monkeypatch):
     assert called == []
     monkeypatch.setattr(batch, "USE_KERNEL", False)
     assert not batch.warm_kernel()
+
+
+def test_a_large_design_reports_the_kernel_loading(monkeypatch):
+    """The first large design with the kernel wanted but not loaded says so in its progress
+    (its first load compiles it, about 15 s); a small one does not load it."""
+    from filletfold.vertex.solve import KERNEL_STAGE
+
+    monkeypatch.setattr(batch, "USE_KERNEL", True)
+    for name, n_min, expected in (("icosahedron", 256, False), ("icosahedron", 5, True)):
+        monkeypatch.setattr(batch, "_kernel_loaded", False)
+        monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", n_min)
+        stages = []
+
+        def progress(stage, done, total, stages=stages):
+            stages.append(stage)
+
+        filletfold.round_mesh(name, tabs=False, progress=progress)
+        assert (KERNEL_STAGE in stages) == expected
+        assert batch._kernel_loaded == expected

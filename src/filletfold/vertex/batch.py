@@ -159,6 +159,12 @@ def _kernel(rows: RowBlock, q, c, y, **kwargs):
     return out
 
 
+def kernel_pending(n_problems: int) -> bool:
+    """Whether solving ``n_problems`` problems at once would load the numba kernel now (it is
+    wanted and not loaded yet)."""
+    return USE_KERNEL and not _kernel_loaded and n_problems >= KERNEL_MIN_PROBLEMS
+
+
 def warm_kernel() -> bool:
     """Load (or compile, the first time ever: about 15 s) the numba kernel now, e.g. in a
     background thread of the app, so that from then on every batch uses it.

@@ -13,6 +13,7 @@ import numpy as np
 from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
+from . import batch
 from .apex import KINDS, arc_samples, build_constraints, validate_apices
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
@@ -277,6 +278,9 @@ THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
 #: samples (a cutting plane), this many times per attempt, before the next attempt.
 CUT_ROUNDS = 2
 
+#: The progress stage shown while the numba kernel loads (compiles on its first use, ~15 s).
+KERNEL_STAGE = "loading the compiled solver (first use compiles it, about 15 s)"
+
 #: Vertices solved and validated together: bounds the memory of a round's sampled
 #: constraints and dense validation (about 100 kB per vertex at 65 validation samples).
 ROUND_SLICE = 2048
@@ -419,6 +423,11 @@ def solve_apices(
     vertices = list(vertices)
     out = dict.fromkeys(vertices, (None, None))
     pending = _set_up(frames, depths, res, vertices)
+    if progress is not None and batch.kernel_pending(len(pending)):
+        # the first large design after installing numba compiles the kernel: say so
+        progress(KERNEL_STAGE, 0, 1)
+        batch.warm_kernel()
+        progress(KERNEL_STAGE, 1, 1)
     total = len(pending)
     while pending:  # one attempt per vertex and round, ROUND_SLICE vertices at a time
         order = list(pending)
