@@ -295,3 +295,28 @@ def test_a_large_design_reports_the_kernel_loading(monkeypatch):
         filletfold.round_mesh(name, tabs=False, progress=progress)
         assert (KERNEL_STAGE in stages) == expected
         assert batch._kernel_loaded == expected
+
+
+def test_a_kernel_that_cannot_load_falls_back_to_numpy(monkeypatch):
+    """A numba that cannot compile the kernel (or be imported) turns it off with one warning;
+    the batch is solved by numpy, and later ones too."""
+    calls = recorded_calls(problems_of(CASES[0]))
+    rows, q, c, y, kw = calls[-1]
+    want = batch.interior_point_numpy(rows, q, c, y, **kw)
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("numba too old for this numpy\nmore lines")
+
+    monkeypatch.setattr(batch, "USE_KERNEL", True)
+    monkeypatch.setattr(batch, "_kernel_loaded", False)
+    monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", 0)
+    monkeypatch.setattr(batch_kernel, "interior_point_numba", broken)
+    with pytest.warns(RuntimeWarning, match="compiled solver is off .*numba too old"):
+        got = batch.interior_point(rows, q, c, y, **kw)
+    assert not batch.USE_KERNEL
+    np.testing.assert_array_equal(got[0], want[0])
+    assert not batch.warm_kernel()  # off for the rest of the process
+    monkeypatch.setattr(batch, "USE_KERNEL", True)
+    monkeypatch.setattr(batch_kernel, "AVAILABLE", False)
+    with pytest.warns(RuntimeWarning, match="numba cannot be imported"):
+        assert not batch.warm_kernel()

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -150,13 +151,37 @@ _kernel_loaded = False
 
 
 def _kernel(rows: RowBlock, q, c, y, **kwargs):
-    """:func:`~filletfold.vertex.batch_kernel.interior_point_numba`, noting it is loaded."""
-    global _kernel_loaded
-    from .batch_kernel import interior_point_numba
+    """:func:`~filletfold.vertex.batch_kernel.interior_point_numba`, noting it is loaded.
 
-    out = interior_point_numba(rows, q, c, y, **kwargs)
+    When numba cannot be imported or cannot compile the kernel (e.g. a numba too old for the
+    installed numpy), the kernel is turned off with a warning and numpy solves.
+    """
+    global _kernel_loaded
+    from . import batch_kernel
+
+    if _kernel_loaded:
+        return batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
+    try:
+        if not batch_kernel.AVAILABLE:
+            raise ImportError("numba cannot be imported")
+        out = batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
+    except Exception as exc:  # only the first call (import and compile) is guarded
+        _turn_kernel_off(f"{type(exc).__name__}: {exc}")
+        return interior_point_numpy(rows, q, c, y, **kwargs)
     _kernel_loaded = True
     return out
+
+
+def _turn_kernel_off(why: str) -> None:
+    """Stop using the numba kernel, and say why (once)."""
+    global USE_KERNEL
+    USE_KERNEL = False
+    warnings.warn(
+        f"filletfold: the compiled solver is off ({why.splitlines()[0]}); solving with numpy "
+        "(set FILLETFOLD_NUMBA=0 to skip the attempt)",
+        RuntimeWarning,
+        stacklevel=3,
+    )
 
 
 def kernel_pending(n_problems: int) -> bool:
@@ -172,13 +197,14 @@ def warm_kernel() -> bool:
     Returns
     -------
     bool
-        Whether the kernel is in use (False without numba or with ``FILLETFOLD_NUMBA=0``).
+        Whether the kernel is in use (False without numba, with ``FILLETFOLD_NUMBA=0``, or
+        when it could not be loaded: then with a warning).
     """
     if not USE_KERNEL:
         return False
     rows = pack([(np.ones(2), np.eye(2, 3), np.zeros(2))], 3)
     _kernel(rows, np.full(3, 2.0), np.ones((1, 3)), np.zeros((1, 3)))
-    return True
+    return USE_KERNEL
 
 
 def interior_point_numpy(
