@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import filletfold
 from filletfold.tolerances import tol
 from filletfold.vertex.apex import KINDS, ApexCheck, validate_apex, validate_apices
 
@@ -254,3 +255,37 @@ def test_cuts_are_the_worst_points_and_a_retry_with_them_holds_there():
             assert (rows >= -1e-9).all()
             held += 1
     assert held > 0.9 * len(retried)
+
+
+def test_constraints_of_many_vertices_are_those_of_each_alone():
+    """build_constraints_many with mixed sample counts, shortened creases, extra samples and
+    open and closed developments gives every vertex exactly its own build_constraints."""
+    import dataclasses
+
+    from filletfold.vertex.apex import build_constraints, build_constraints_many
+    from filletfold.vertex.solve import apex_problems
+
+    problems = []
+    for name, kwargs in (("blob", {}), ("torus", {}), ("miura", {"material_loss": True})):
+        d = filletfold.round_mesh(name, tabs=False, layout="modules", **kwargs)
+        problems += apex_problems(d.mesh, d.rounding, d.stages.depths)
+    assert any(p.closed for p in problems) and not all(p.closed for p in problems)
+    rng = np.random.default_rng(1)
+    args = []
+    for i, p in enumerate(problems):
+        if i % 3 == 1:
+            p.shrink = rng.uniform(0.5, 1.0, size=p.shrink.shape)
+        if i % 4 == 2:
+            side = rng.integers(0, len(p.frame.sides), size=2)
+            p.extra = np.stack([side, rng.uniform(0, 1, 2) * p.frame.arrays.arc[side]], axis=1)
+        args.append(p.constraint_args([9, 33, 5][i % 3], [1.0, 2.0][i % 2]))
+    many = build_constraints_many(*map(list, zip(*args, strict=True)))
+    assert len(many) == len(args)
+    for a, got in zip(args, many, strict=True):
+        want = build_constraints(*a)
+        for f in dataclasses.fields(want):
+            x, y = getattr(got, f.name), getattr(want, f.name)
+            if isinstance(y, np.ndarray):
+                assert np.array_equal(x, y), f.name
+            else:
+                assert x == y, f.name

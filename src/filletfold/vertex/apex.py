@@ -153,73 +153,151 @@ def build_constraints(
     samples : tuple, optional
         ``frame.arrays.samples(n_samples)`` when already computed (:func:`arc_samples`).
     """
-    sa = frame.arrays
-    k = len(sa.arc)
-    scale = float(sa.length.mean())
-    if lmax_scale is None:
-        lmax_scale = np.ones((k, 2))
-    lmax = np.stack([frame.lmax_start, frame.lmax_end], axis=1) * lmax_scale
-    side, first, last, s, C, N = sa.samples(n_samples) if samples is None else samples
-    if extra is not None and len(extra):
-        x_side, x_s = extra[:, 0].astype(np.int64), extra[:, 1]
-        side, s = np.concatenate([side, x_side]), np.concatenate([s, x_s])
-        C, N = np.vstack([C, sa.base(x_side, x_s)]), np.vstack([N, sa.normal(x_side, x_s)])
-    ends = np.arange(k)
-    # quadratic rows: l >= m at every sample, l <= l_max - m at both ends, Dn >= m
-    q_side = np.concatenate([side, ends, ends, ends])
-    q_sample = np.concatenate([np.arange(len(side)), first, last, first])
-    coef = np.concatenate(
-        [np.full(len(side), 2 * margin), -2 * (lmax[:, 0] - margin), -2 * (lmax[:, 1] - margin),
-         np.full(k, -scale)]
-    )  # fmt: skip
-    sign = np.concatenate([np.ones(len(side)), -np.ones(2 * k), np.zeros(k)])
-    const = np.concatenate([np.zeros(len(side) + 2 * k), np.full(k, -margin)])
-    # linear rows: non-intersection along the arc, the chord plane, every face
-    chord = np.nonzero(sa.arc > 0)[0]
+    return build_constraints_many(
+        [frame], [v], [sigma], [n_samples], [margin], [lmax_scale], [extra], [samples]
+    )[0]
+
+
+def build_constraints_many(
+    frames: Sequence[VertexFrame],
+    vs,
+    sigmas,
+    n_samples,
+    margins,
+    lmax_scales=None,
+    extras=None,
+    samples=None,
+) -> list[ApexConstraints]:
+    """:func:`build_constraints` of many vertices at once (one value of each parameter per
+    vertex, in sequences of equal length; ``lmax_scales``, ``extras`` and ``samples`` may be
+    None for all).
+
+    Every row of every vertex is computed in one pass over flat arrays, already in each
+    vertex's row order, so a vertex's constraints are views of them; each row's arithmetic is
+    the one of a vertex alone.
+
+    Returns
+    -------
+    list of ApexConstraints
+    """
+    n = len(frames)
+    if n == 0:
+        return []
+    arrays = [frame.arrays for frame in frames]
+    if samples is None or any(x is None for x in samples):
+        samples = arc_samples(frames, n_samples)
+    lmax_scales = [None] * n if lmax_scales is None else lmax_scales
+    extras = [None] * n if extras is None else extras
+    parts = []  # per vertex: (side, first, last, s, C, N) with the extra samples after
+    for a, smp, extra in zip(arrays, samples, extras, strict=True):
+        if extra is not None and len(extra):
+            side, first, last, s_, C, N = smp
+            x_side, x_s = extra[:, 0].astype(np.int64), extra[:, 1]
+            smp = (
+                np.concatenate([side, x_side]), first, last, np.concatenate([s_, x_s]),
+                np.vstack([C, a.base(x_side, x_s)]), np.vstack([N, a.normal(x_side, x_s)]),
+            )  # fmt: skip
+        parts.append(smp)
+    sa = _stack(arrays)
+    k = np.array([len(a.arc) for a in arrays])  # sides (= ring faces) per vertex
+    m = np.array([len(p[0]) for p in parts])  # samples per vertex
+    so, mo = np.cumsum(k) - k, np.cumsum(m) - m  # first side and sample of each vertex
+    sv, mv = np.repeat(np.arange(n), k), np.repeat(np.arange(n), m)
+    side = np.concatenate([p[0] for p in parts]) + so[mv]  # (M,) global side of each sample
+    first = np.concatenate([p[1] for p in parts]) + mo[sv]  # (K,) global samples
+    last = np.concatenate([p[2] for p in parts]) + mo[sv]
+    s = np.concatenate([p[3] for p in parts])
+    C = np.concatenate([p[4] for p in parts])
+    N = np.concatenate([p[5] for p in parts])
+    margin = np.asarray(margins, dtype=float).reshape(n)
+    sigma = np.asarray(sigmas).reshape(n)
+    scale = np.array([float(a.length.mean()) for a in arrays])
+    lmax = np.concatenate(
+        [
+            np.stack([f.lmax_start, f.lmax_end], axis=1) * (1.0 if x is None else x)
+            for f, x in zip(frames, lmax_scales, strict=True)
+        ]
+    )
+    # quadratic rows, per vertex: l >= m at every sample, l <= l_max - m at both ends, Dn >= m
+    q_start = np.cumsum(m + 3 * k) - (m + 3 * k)
+    at = np.arange(len(s)) - mo[mv] + q_start[mv]  # the samples' rows
+    end = np.arange(len(sv)) - so[sv] + q_start[sv] + m[sv]  # the sides' first end row
+    rows = int((m + 3 * k).sum())
+    q_side, q_sample = np.empty(rows, dtype=np.int64), np.empty(rows, dtype=np.int64)
+    coef, sign, const = np.empty(rows), np.empty(rows), np.empty(rows)
+    sides = np.arange(len(sv))
+    q_side[at], q_sample[at] = side, np.arange(len(s))
+    coef[at], sign[at], const[at] = 2 * margin[mv], 1.0, 0.0
+    ms = margin[sv]
+    for block, (smp, c_, g_) in enumerate(
+        [
+            (first, -2 * (lmax[:, 0] - ms), 0.0),
+            (last, -2 * (lmax[:, 1] - ms), 0.0),
+            (first, -scale[sv], -ms),
+        ]
+    ):
+        r = end + block * k[sv]
+        q_side[r], q_sample[r] = sides, smp
+        coef[r], sign[r], const[r] = c_, (-1.0 if block < 2 else 0.0), g_
+    # linear rows, per vertex: non-intersection along the arc, the chord plane, every face
+    chord = np.flatnonzero(sa.arc > 0)
+    c = np.bincount(sv[chord], minlength=n)
+    l_start = np.cumsum(m + c + k) - (m + c + k)
     ne = np.cross(C[last[chord]] - C[first[chord]], sa.R[chord])
     ne /= np.linalg.norm(ne, axis=1)[:, None]
-    n_f = sa.face_normal
-    lin_a = sigma * np.concatenate([N, ne, n_f])
-    lin_b = (
-        -np.concatenate(
-            [
-                np.einsum("ij,ij->i", lin_a[: len(side)], C),
-                np.einsum(
-                    "ij,ij->i", lin_a[len(side) : len(side) + len(chord)], frame.T_start[chord]
-                ),
-                np.einsum("ij,ij->i", lin_a[len(side) + len(chord) :], frame.T_end[: len(n_f)]),
-            ]
+    T_start = np.concatenate([f.T_start for f in frames])
+    T_end = np.concatenate([f.T_end[: len(f.ring.faces)] for f in frames])
+    lin_rows = int((m + c + k).sum())
+    lin_a, lin_b = np.empty((lin_rows, 3)), np.empty(lin_rows)
+    chord_rank = np.arange(len(chord)) - (np.cumsum(c) - c)[sv[chord]]
+    for idx, vert, normal, point in (
+        (np.arange(len(s)) - mo[mv] + l_start[mv], mv, N, C),
+        (chord_rank + l_start[sv[chord]] + m[sv[chord]], sv[chord], ne, T_start[chord]),
+        (sides - so[sv] + l_start[sv] + m[sv] + c[sv], sv, sa.face_normal, T_end),
+    ):
+        a_ = sigma[vert][:, None] * normal
+        lin_a[idx] = a_
+        lin_b[idx] = -np.einsum("ij,ij->i", a_, point) - margin[vert]
+    quad_c, quad_s = C[q_sample], s[q_sample]
+    quad_R, quad_M, quad_Q, quad_t = sa.R[q_side], sa.M[q_side], sa.Q[q_side], sa.t[q_side]
+    out = []
+    for j, frame in enumerate(frames):
+        q0, q1 = int(q_start[j]), int(q_start[j] + m[j] + 3 * k[j])
+        l0, l1 = int(l_start[j]), int(l_start[j] + m[j] + c[j] + k[j])
+        edge_name = [f"edge {e}" for e in arrays[j].edge.tolist()]
+        local_side = parts[j][0].tolist()
+        local_chord = (chord[sv[chord] == j] - so[j]).tolist()
+        kind = (
+            ["l_min"] * m[j] + ["l_max"] * (2 * k[j]) + ["patch"] * k[j]
+            + ["nonint"] * m[j] + ["chord"] * c[j] + ["face"] * k[j]
+        )  # fmt: skip
+        element = (
+            [edge_name[i] for i in local_side] + edge_name * 3
+            + [edge_name[i] for i in local_side]
+            + [edge_name[i] for i in local_chord]
+            + [f"face {f}" for f in np.asarray(frame.ring.faces).tolist()]
+        )  # fmt: skip
+        v = vs[j]
+        out.append(
+            ApexConstraints(
+                scale=float(scale[j]),
+                v_fixed=None if v is None else np.asarray(v, dtype=float),
+                quad_c=quad_c[q0:q1],
+                quad_R=quad_R[q0:q1],
+                quad_M=quad_M[q0:q1],
+                quad_Q=quad_Q[q0:q1],
+                quad_t=quad_t[q0:q1],
+                quad_s=quad_s[q0:q1],
+                quad_coef=coef[q0:q1],
+                quad_sign=sign[q0:q1],
+                quad_const=const[q0:q1],
+                lin_a=lin_a[l0:l1],
+                lin_b=lin_b[l0:l1],
+                kind=kind,
+                element=element,
+            )
         )
-        - margin
-    )
-    edge_name = [f"edge {e}" for e in sa.edge]
-    kind = (
-        ["l_min"] * len(side) + ["l_max"] * (2 * k) + ["patch"] * k
-        + ["nonint"] * len(side) + ["chord"] * len(chord) + ["face"] * len(n_f)
-    )  # fmt: skip
-    element = (
-        [edge_name[i] for i in q_side]
-        + [edge_name[i] for i in side]
-        + [edge_name[i] for i in chord]
-        + [f"face {int(f)}" for f in frame.ring.faces]
-    )
-    return ApexConstraints(
-        scale=scale,
-        v_fixed=None if v is None else np.asarray(v, dtype=float),
-        quad_c=C[q_sample],
-        quad_R=sa.R[q_side],
-        quad_M=sa.M[q_side],
-        quad_Q=sa.Q[q_side],
-        quad_t=sa.t[q_side],
-        quad_s=s[q_sample],
-        quad_coef=coef,
-        quad_sign=sign,
-        quad_const=const,
-        lin_a=lin_a,
-        lin_b=lin_b,
-        kind=kind,
-        element=element,
-    )
+    return out
 
 
 def arc_samples(frames: Sequence[VertexFrame], n_samples: Sequence[int]) -> list[tuple]:

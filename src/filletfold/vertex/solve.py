@@ -14,7 +14,7 @@ from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
 from . import batch
-from .apex import KINDS, arc_samples, build_constraints, validate_apices
+from .apex import KINDS, build_constraints, build_constraints_many, validate_apices
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angle_front, vertex_normals
@@ -256,14 +256,17 @@ class ApexProblem:
     extra: np.ndarray
     cut_rounds: int
 
-    def constraints(self, n_samples: int, scale: float, samples: tuple | None = None):
-        """The sampled constraints of the next attempt (:func:`build_constraints`; ``samples``
-        from :func:`~filletfold.vertex.apex.arc_samples` when known)."""
+    def constraints(self, n_samples: int, scale: float):
+        """The sampled constraints of the next attempt (:func:`build_constraints`)."""
+        return build_constraints(*self.constraint_args(n_samples, scale))
+
+    def constraint_args(self, n_samples: int, scale: float) -> tuple:
+        """The arguments of :func:`build_constraints` for the next attempt: frame, fixed
+        developed apex (None when closed), sigma, samples, margin, crease factors, extra
+        samples."""
         m = min(self.margin * scale, 0.25 * self.low)
         v = None if self.closed else self.v
-        return build_constraints(
-            self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra, samples
-        )
+        return self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra
 
 
 #: Attempts per vertex: (samples per arc, margin scale), the next one after a failed dense
@@ -471,10 +474,8 @@ def _solve_round(order: list, pending: dict, res: VertexResult, out: dict, centr
     """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
     solved ones at once, and settle every vertex that is done (ok, or out of attempts)."""
     tries = [pending[u].attempts.pop(0) for u in order]
-    samples = arc_samples([pending[u].frame for u in order], [t[0] for t in tries])
-    cons = [
-        pending[u].constraints(*t, samples=x) for u, t, x in zip(order, tries, samples, strict=True)
-    ]
+    args = [pending[u].constraint_args(*t) for u, t in zip(order, tries, strict=True)]
+    cons = build_constraints_many(*map(list, zip(*args, strict=True)))
     sols = solve_apex_batch(
         cons,
         [pending[u].target for u in order],
