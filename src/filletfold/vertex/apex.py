@@ -129,7 +129,6 @@ def build_constraints(
     margin: float,
     lmax_scale: np.ndarray | None = None,
     extra: np.ndarray | None = None,
-    samples: tuple | None = None,
 ) -> ApexConstraints:
     """Sample the sec. 3.2 constraints of a closed-ring vertex.
 
@@ -150,11 +149,9 @@ def build_constraints(
     extra : (m, 2) float, optional
         ``(side, s)``: further arc parameters at which ``l >= m`` and the non-intersection
         condition are sampled (where an earlier solution failed between the samples).
-    samples : tuple, optional
-        ``frame.arrays.samples(n_samples)`` when already computed (:func:`arc_samples`).
     """
     return build_constraints_many(
-        [frame], [v], [sigma], [n_samples], [margin], [lmax_scale], [extra], [samples]
+        [frame], [v], [sigma], [n_samples], [margin], [lmax_scale], [extra]
     )[0]
 
 
@@ -166,11 +163,10 @@ def build_constraints_many(
     margins,
     lmax_scales=None,
     extras=None,
-    samples=None,
 ) -> list[ApexConstraints]:
     """:func:`build_constraints` of many vertices at once (one value of each parameter per
-    vertex, in sequences of equal length; ``lmax_scales``, ``extras`` and ``samples`` may be
-    None for all).
+    vertex, in sequences of equal length; ``lmax_scales`` and ``extras`` may be None for
+    all). The arcs of all vertices are sampled together (:func:`arc_samples`).
 
     Every row of every vertex is computed in one pass over flat arrays, already in each
     vertex's row order, so a vertex's constraints are views of them; each row's arithmetic is
@@ -184,8 +180,7 @@ def build_constraints_many(
     if n == 0:
         return []
     arrays = [frame.arrays for frame in frames]
-    if samples is None or any(x is None for x in samples):
-        samples = arc_samples(frames, n_samples)
+    samples = arc_samples(frames, n_samples)
     lmax_scales = [None] * n if lmax_scales is None else lmax_scales
     extras = [None] * n if extras is None else extras
     parts = []  # per vertex: (side, first, last, s, C, N) with the extra samples after
