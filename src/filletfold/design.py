@@ -22,7 +22,6 @@ from .material_loss import MaterialLoss, solve_material_loss
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
 from .module import Piece, assemble_pattern, face_piece_centres, piece_area
-from .module_batch import CHUNK as MODULE_CHUNK
 from .module_batch import build_modules
 from .pattern import CreasePattern
 from .rounding import EdgeRounding, clamp_radii, round_edges
@@ -563,15 +562,17 @@ def round_mesh(
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]
-    frames_ = apices_ = developed_ = built = None
-    for lo in range(0, len(todo), MODULE_CHUNK):  # in chunks, for the progress reports
-        part = todo[lo : lo + MODULE_CHUNK]
-        frames_, apices_, developed_ = zip(*[solved[u] for u in part], strict=True)
-        built = build_modules(pm, frames_, centres, points, apices_, developed_)
-        for u, module in zip(part, built, strict=True):
-            modules[u] = module
-        if progress is not None:
-            progress("surface", lo + len(part), len(todo))
+    built = build_modules(
+        pm,
+        [solved[u][0] for u in todo],
+        centres,
+        points,
+        [solved[u][1] for u in todo],
+        [solved[u][2] for u in todo],
+        progress,
+    )
+    for u, module in zip(todo, built, strict=True):
+        modules[u] = module
     stages = (
         None
         if not keep_stages
@@ -594,8 +595,8 @@ def round_mesh(
     ring_closed = [f.ring.closed for f in frames]
     if not keep_stages and not (layout == "net" or (layout == "auto" and sheet is not None)):
         # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
-        del frames, classified, frames_, apices_, developed_, built
-        solved = modules = None
+        del frames, classified
+        solved = modules = built = None
     layout_used, layout_note = "modules", ""
     eps = 1e-9 * ref
     if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):

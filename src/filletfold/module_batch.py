@@ -34,7 +34,7 @@ from .module import (
     polygon_area2,
 )
 from .vertex.apex import _stack
-from .vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps
+from .vertex.frame import VertexFrame, _dot, _gluing_maps
 
 #: Most vertices built together (bounds the flat arrays' size).
 CHUNK = 2048
@@ -44,7 +44,9 @@ CHUNK = 2048
 _WIDTH = 5
 
 
-def build_modules(mesh, frames, centres, n_samples, apices, developed) -> list[list[Piece]]:
+def build_modules(
+    mesh, frames, centres, n_samples, apices, developed, progress=None
+) -> list[list[Piece]]:
     """The modules of many vertices: ``build_module(mesh, frame, centres, n_samples, apex, v)``
     for every ``(frame, apex, v)``.
 
@@ -61,6 +63,8 @@ def build_modules(mesh, frames, centres, n_samples, apices, developed) -> list[l
         Spatial apex of each frame's vertex (None: a hole border).
     developed : sequence of ((2,) float or None)
         Its developed apex.
+    progress : callable, optional
+        ``progress("surface", done, total)`` after every :data:`CHUNK` of vertices.
 
     Returns
     -------
@@ -91,9 +95,13 @@ def build_modules(mesh, frames, centres, n_samples, apices, developed) -> list[l
         for j, piece in zip(which, pieces, strict=True):
             if piece is not None:
                 modules[j] = [piece]
+        if progress is not None:
+            progress("surface", c + len(which), len(frames))
     for j, module in enumerate(modules):
         if module is None:
             modules[j] = build_module(mesh, frames[j], centres, n_samples, apices[j], developed[j])
+    if progress is not None:
+        progress("surface", len(frames), len(frames))
     return modules
 
 
@@ -112,20 +120,6 @@ def _common_case(frame: VertexFrame, apex, v) -> bool:
         and len(set(np.asarray(faces).tolist())) == n
         and not (np.asarray(frame.corner_angle) > np.pi).any()
     )
-
-
-def _start_gluings(sa: SideArrays, p: np.ndarray, frames: np.ndarray) -> np.ndarray:
-    """:meth:`VertexFrame.gluing_start` of sides ``p`` (k,) into the face charts ``frames``
-    (k, 3, 3): the tangent and base point at ``s = 0`` as :class:`Side` computes them."""
-    s = np.zeros(len(p))
-    R, N0, B, O = sa.R[p], sa.N0[p], sa.B[p], sa.O[p]
-    radius, kappa = sa.radius[p], sa.kappa[p]
-    curved = (radius != 0)[:, None]
-    t = (s / np.where(radius != 0, radius, 1.0))[:, None]
-    normal = np.where(curved, np.cos(t) * N0 + np.sin(t) * B, N0)
-    tangent = np.where(curved, kappa[:, None] * (-np.sin(t) * N0 + np.cos(t) * B), np.cross(R, N0))
-    base = O + (kappa * radius)[:, None] * normal
-    return _gluing_maps(tangent, R, frames, base, s)
 
 
 def _cone_pieces(frames: list, centres, n_samples, apex: np.ndarray, dev: np.ndarray) -> list:
@@ -171,7 +165,9 @@ def _cone_pieces(frames: list, centres, n_samples, apex: np.ndarray, dev: np.nda
     # the cut's end copies of side 0's start, in the chart after face f_{n-1}
     p0 = so
     lastf = so + ne - 1
-    m = face_map[lastf] @ _start_gluings(sa, p0, face_frame[lastf])
+    s0 = np.zeros(len(p0))  # VertexFrame.gluing_start of side 0, into the chart of f_{n-1}
+    start = _gluing_maps(sa.tangent(p0, s0), sa.R[p0], face_frame[lastf], sa.base(p0, s0), s0)
+    m = face_map[lastf] @ start
     g0 = first[p0]
     end_b2 = apply_rows(m, np.stack([s[g0], np.zeros(n_vert)], axis=1))
     end_t2 = apply_rows(m, np.stack([s[g0], z[g0]], axis=1))
