@@ -188,9 +188,10 @@ def build_constraints_many(
         if extra is not None and len(extra):
             side, first, last, s_, C, N = smp
             x_side, x_s = extra[:, 0].astype(np.int64), extra[:, 1]
+            x_C, x_N = a.base_normal(x_side, x_s)
             smp = (
                 np.concatenate([side, x_side]), first, last, np.concatenate([s_, x_s]),
-                np.vstack([C, a.base(x_side, x_s)]), np.vstack([N, a.normal(x_side, x_s)]),
+                np.vstack([C, x_C]), np.vstack([N, x_N]),
             )  # fmt: skip
         parts.append(smp)
     sa = _stack(arrays)
@@ -623,11 +624,11 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
         step = np.where(d2 > 0, d1 / np.where(d2 > 0, d2, 1.0), 0.0)
         t = np.clip(t - step, 0.0, arc)
     i = np.arange(len(first))
-    C = sa.base(i, t)
+    C, N = sa.base_normal(i, t)
     if vi is not None:
         dv = V - C
         num = (vi[:, 0] - t) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", dv, dv)
         val = 0.5 * num / np.where(dn > 0, dn, 1.0)
     else:
-        val = sigma * np.einsum("ij,ij->i", V - C, sa.normal(i, t))
+        val = sigma * np.einsum("ij,ij->i", V - C, N)
     return np.where(ok, np.minimum(best, val), best), np.where(ok & (val < best), t, s[arg])

@@ -433,8 +433,9 @@ def solve_apex_batch(
         One per vertex; 3 variables (open development) and 5 (closed) may be mixed.
     targets : sequence of (3,) or (5,) float
         ``P = U + d D`` (followed by the developed apex's target for 5 variables).
-    starts : sequence of sequences of (3,) or (5,) float, optional
-        Further starting points per problem for the feasibility phase.
+    starts : sequence of (k, 3) or (k, 5) float, optional
+        Further starting points per problem for the feasibility phase (arrays, or sequences
+        of points).
     thorough : bool or sequence of bool
         Per problem (or for all): before calling a problem infeasible, try every start,
         continue the feasibility phase from the best point without the give-up rule, and last
@@ -464,7 +465,10 @@ def solve_apex_batch(
             sols = _solve_chunk(
                 [problems[i] for i in chunk],
                 [np.asarray(targets[i], dtype=float) for i in chunk],
-                [list(starts[i]) if starts is not None else [] for i in chunk],
+                [
+                    np.asarray(starts[i] if starts is not None else [], dtype=float).reshape(-1, n)
+                    for i in chunk
+                ],
                 thorough[chunk],
                 n,
                 max_iter,
@@ -511,14 +515,15 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
     T = np.stack(targets)
     at_target = rows.min_slack(np.zeros((B, n))) >= 0
     # candidate starts in y coordinates, the target (y = 0) first
-    n_s = 1 + max((len(s) for s in starts), default=0)
+    n_starts = np.array([len(s) for s in starts])
+    n_s = 1 + int(n_starts.max(initial=0))
     cand = np.zeros((B, n_s, n))
-    valid = np.zeros((B, n_s), dtype=bool)
-    valid[:, 0] = True
-    for b, s in enumerate(starts):
-        for j, x in enumerate(s):
-            cand[b, j + 1] = (np.asarray(x, dtype=float) - T[b]) / L[b]
-            valid[b, j + 1] = True
+    if n_s > 1 and (n_starts == n_s - 1).all():
+        cand[:, 1:] = (np.stack(starts) - T[:, None]) / L[:, None, None]
+    else:
+        for b, s in enumerate(starts):
+            cand[b, 1 : 1 + len(s)] = (s - T[b]) / L[b]
+    valid = np.arange(n_s) <= n_starts[:, None]
     gmin = np.stack([rows.min_slack(cand[:, j]) for j in range(n_s)], axis=1)
     gmin = np.where(valid, gmin, -np.inf)
     order = np.argsort(-gmin, axis=1)

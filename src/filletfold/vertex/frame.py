@@ -208,7 +208,13 @@ class SideArrays:
 
     def base(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
         """(m, 3) base-curve points ``C(s)`` of sides ``i``."""
-        return self.O[i] + (self.kappa[i] * self.radius[i])[:, None] * self.normal(i, s)
+        return self.base_normal(i, s)[0]
+
+    def base_normal(self, i: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(m, 3) base-curve points ``C(s)`` and (m, 3) front normals ``N(s)`` of sides ``i``
+        (the normals computed once for both)."""
+        N = self.normal(i, s)
+        return self.O[i] + (self.kappa[i] * self.radius[i])[:, None] * N, N
 
     def samples(self, n_samples: int):
         """Evenly spaced samples along every arc, ends included (one on a flat side).
@@ -228,7 +234,7 @@ class SideArrays:
         side = np.repeat(np.arange(len(ks)), ks)
         first = np.concatenate([[0], np.cumsum(ks)[:-1]])
         s = self.arc[side] * (np.arange(len(side)) - first[side]) / np.maximum(ks[side] - 1, 1)
-        return side, first, first + ks - 1, s, self.base(side, s), self.normal(side, s)
+        return side, first, first + ks - 1, s, *self.base_normal(side, s)
 
 
 def stack_sides(sides: list, Q=None, t=None, face_normal=None) -> SideArrays:

@@ -224,8 +224,8 @@ class ApexProblem:
         Developed apex (fixed point of rho), or its start for a closed development.
     target : (3,) or (5,) float
         ``P = U + d D`` (and ``v`` when closed).
-    starts : list of (3,) or (5,) float
-        Further starts for the feasibility phase, along ``D``.
+    starts : (k, 3) or (k, 5) float
+        Further starts for the feasibility phase, along ``D`` (:data:`START_DEPTHS`).
     margin : float
         The safety margin ``m`` at scale 1.
     low : float
@@ -247,7 +247,7 @@ class ApexProblem:
     sigma: int
     v: np.ndarray
     target: np.ndarray
-    starts: list
+    starts: np.ndarray
     margin: float
     low: float
     shrink: np.ndarray
@@ -284,17 +284,13 @@ CUT_ROUNDS = 2
 #: The progress stage shown while the numba kernel loads (compiles on its first use, ~15 s).
 KERNEL_STAGE = "loading the compiled solver (first use compiles it, about 15 s)"
 
+#: Starts of the feasibility phase: ``U + t L D`` for these ``t`` (``L`` the mean incident
+#: edge length).
+START_DEPTHS = np.array([0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5])
+
 #: Vertices solved and validated together: bounds the memory of a round's sampled
 #: constraints and dense validation (about 100 kB per vertex at 65 validation samples).
 ROUND_SLICE = 2048
-
-
-def _margin_length(frame: VertexFrame) -> float:
-    """The length the safety margin is a fraction of: the shortest incident edge, or four times
-    the shortest rounded arc when that is shorter (nearly flat vertices have thin windows)."""
-    arcs = np.array([s.arc for s in frame.sides])
-    length = min(s.length for s in frame.sides)
-    return float(min(length, 4 * arcs[arcs > 0].min())) if np.any(arcs > 0) else length
 
 
 def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexProblem | None:
@@ -302,56 +298,11 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
 
     Records the requested depth and the developed apex in ``res``. A vertex gets no problem
     (status ``infeasible`` with the reason) when it has no developed apex, a reflex face
-    corner, or a tangent-line crossing beyond an edge midpoint.
+    corner, or a tangent-line crossing beyond an edge midpoint. The one-vertex case of
+    :func:`_set_up`.
     """
     u = frame.vertex
-    res.depth_requested[u] = depth
-    D = res.normal[u]
-    closed = res.kind[u] == "developable"  # rho is the identity: v is a variable (sec. 3)
-    v = central_rulings_crossing(frame) if closed else frame.developed_apex()
-    if v is None:
-        res.status[u] = "infeasible"
-        res.reason[u] = (
-            "no developed apex: the central rulings of the developed cylinders are parallel"
-            if closed
-            else "the development does not turn (rho is a translation): no developed apex"
-        )
-        return None
-    res.apex_developed[u] = v
-    if np.any(frame.corner_angle > np.pi):
-        res.status[u] = "infeasible"
-        res.reason[u] = (
-            "a face has a reflex corner at this vertex: the straight crease on it "
-            "would leave the face"
-        )
-        return None
-    U = frame.U
-    mean_length = np.array([s.length for s in frame.sides]).mean()
-    target = U + depth * D
-    starts = [U + t * mean_length * D for t in (0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5)]
-    if closed:
-        target = np.concatenate([target, v])
-        starts = [np.concatenate([x, v]) for x in starts]
-    low = float(np.fmin(frame.lmax_start, frame.lmax_end).min())
-    if not low > 0:
-        res.status[u] = "infeasible"
-        res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
-        return None
-    return ApexProblem(
-        frame=frame,
-        closed=closed,
-        sigma=int(res.sigma[u]),
-        v=np.asarray(v, dtype=float),
-        target=target,
-        starts=starts,
-        margin=tol.margin * _margin_length(frame),
-        low=low,
-        shrink=np.ones((len(frame.sides), 2)),
-        attempts=list(ATTEMPTS),
-        failing=[],
-        extra=np.zeros((0, 2)),
-        cut_rounds=0,
-    )
+    return _set_up({u: frame}, {u: depth}, res, [u]).get(u)
 
 
 def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) -> list[ApexProblem]:
@@ -372,13 +323,104 @@ def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) ->
 
 def _set_up(frames, depths, res: VertexResult, vertices) -> dict:
     """The apex problems of ``vertices`` (vertex -> ApexProblem; those without one are
-    marked in ``res`` and left out)."""
+    marked in ``res`` and left out): :func:`apex_problem` of every vertex, computed together
+    (each vertex's arithmetic is the one of :func:`apex_problem`)."""
+    vertices = [int(u) for u in vertices]
+    if not vertices:
+        return {}
+    fr = [frames[u] for u in vertices]
+    idx = np.array(vertices)
+    depth = np.array([float(depths[u]) for u in vertices])
+    res.depth_requested[idx] = depth
+    closed = np.array([res.kind[u] == "developable" for u in vertices])
+    # developed apex: the fixed point of rho, or where central rulings cross (closed)
+    rho = np.array([f.rho for f in fr])  # (n, 3, 3)
+    a = np.eye(2) - rho[:, :2, :2]
+    turns = ~closed & (np.abs(np.linalg.det(a)) >= 1e-14)
+    v = np.full((len(fr), 2), np.nan)
+    if turns.any():
+        v[turns] = np.linalg.solve(a[turns], rho[turns, :2, 2, None])[..., 0]
+    for j in np.flatnonzero(closed).tolist():
+        crossing = central_rulings_crossing(fr[j])
+        if crossing is not None:
+            v[j] = crossing
+    has_v = turns | (closed & np.isfinite(v[:, 0]))
+    # per vertex over its sides and faces: reflex corner, shortest l_max, lengths, arcs
+    sa = [f.arrays for f in fr]
+    k = np.array([len(x.arc) for x in sa])
+    first = np.cumsum(k) - k
+    nf = np.array([len(f.corner_angle) for f in fr])
+    corner = np.concatenate([f.corner_angle for f in fr])
+    reflex = np.maximum.reduceat(corner, np.cumsum(nf) - nf) > np.pi
+    lmax = np.fmin(
+        np.concatenate([f.lmax_start for f in fr]), np.concatenate([f.lmax_end for f in fr])
+    )
+    low = np.minimum.reduceat(lmax, first)
+    length = np.concatenate([x.length for x in sa])
+    arc = np.concatenate([x.arc for x in sa])
+    shortest = np.minimum.reduceat(length, first)
+    shortest_arc = np.minimum.reduceat(np.where(arc > 0, arc, np.inf), first)
+    margin_length = np.where(
+        np.isfinite(shortest_arc), np.minimum(shortest, 4 * shortest_arc), shortest
+    )  # or four times the shortest arc, when shorter: nearly flat vertices have thin windows
+    mean_length = _means(length, k)
+    U = np.array([f.U for f in fr])
+    D = res.normal[idx]
+    target = U + depth[:, None] * D
+    starts = U[:, None] + (START_DEPTHS[None, :] * mean_length[:, None])[..., None] * D[:, None]
     problems = {}
-    for u in vertices:
-        p = apex_problem(frames[u], float(depths[u]), res)
-        if p is not None:
-            problems[u] = p
+    for j, u in enumerate(vertices):
+        if not has_v[j]:
+            res.status[u] = "infeasible"
+            res.reason[u] = (
+                "no developed apex: the central rulings of the developed cylinders are parallel"
+                if closed[j]
+                else "the development does not turn (rho is a translation): no developed apex"
+            )
+            continue
+        res.apex_developed[u] = v[j]
+        if reflex[j]:
+            res.status[u] = "infeasible"
+            res.reason[u] = (
+                "a face has a reflex corner at this vertex: the straight crease on it "
+                "would leave the face"
+            )
+            continue
+        if not low[j] > 0:
+            res.status[u] = "infeasible"
+            res.reason[u] = "a tangent-line crossing lies beyond an edge midpoint: radius too large"
+            continue
+        t, st = target[j], starts[j]
+        if closed[j]:
+            t = np.concatenate([t, v[j]])
+            st = np.concatenate([st, np.broadcast_to(v[j], (len(st), 2))], axis=1)
+        problems[u] = ApexProblem(
+            frame=fr[j],
+            closed=bool(closed[j]),
+            sigma=int(res.sigma[u]),
+            v=v[j].copy(),
+            target=t,
+            starts=st,
+            margin=tol.margin * float(margin_length[j]),
+            low=float(low[j]),
+            shrink=np.ones((k[j], 2)),
+            attempts=list(ATTEMPTS),
+            failing=[],
+            extra=np.zeros((0, 2)),
+            cut_rounds=0,
+        )
     return problems
+
+
+def _means(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """(n,) mean of each of ``n`` consecutive runs of ``values`` of lengths ``counts``, each
+    the same float as ``np.mean`` of the run alone (runs of equal length reduced together)."""
+    out = np.empty(len(counts))
+    first = np.cumsum(counts) - counts
+    for c in np.unique(counts).tolist():
+        which = np.flatnonzero(counts == c)
+        out[which] = values[first[which, None] + np.arange(c)].mean(axis=1)
+    return out
 
 
 def solve_apices(
