@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from filletfold.material_loss import solve_material_loss
 from filletfold.mesh import load_mesh
 from filletfold.rounding import clamp_radii, round_edges
-from filletfold.vertex.batch import pack, rows_of, solve_apex, solve_apex_batch
+from filletfold.vertex.batch import pack, pack_problems, rows_of, solve_apex, solve_apex_batch
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems
 
@@ -29,9 +29,15 @@ from .conftest import design_of, random_convex
 
 
 def first_attempts(
-    mesh, radius_frac: float, depth_frac: float, margin_scale: float = 1.0, loss: bool = False
+    mesh,
+    radius_frac: float,
+    depth_frac: float,
+    margin_scale: float = 1.0,
+    loss: bool = False,
+    samples: int = 9,
 ):
-    """(cons, target, starts) of every cone vertex's first attempt (9 samples per arc).
+    """(cons, target, starts) of every cone vertex's first attempt (9 samples per arc unless
+    ``samples`` says otherwise).
 
     With ``loss`` the radii come from the consistent-material-loss programme, so developable
     vertices close and get a 5-variable problem.
@@ -45,7 +51,7 @@ def first_attempts(
         r = clamp_radii(pm, np.full(pm.n_edges, radius_frac * ref))
     depths = np.full(pm.n_vertices, depth_frac * ref)
     return [
-        (p.constraints(9, margin_scale), p.target, p.starts)
+        (p.constraints(samples, margin_scale), p.target, p.starts)
         for p in apex_problems(pm, round_edges(pm, r), depths)
     ]
 
@@ -110,17 +116,34 @@ def test_rows_reproduce_the_constraints():
                 np.testing.assert_allclose(got, cons.values(x), atol=1e-12 * cons.scale)
 
 
+@pytest.mark.parametrize(("mesh", "loss"), [("random-convex", False), ("miura", True)])
+def test_rows_of_many_problems_packed_at_once(mesh, loss):
+    """pack_problems (rows of all problems computed together) is pack(rows_of) of each, bit
+    for bit, with problems of different row counts in any order."""
+    problems = first_attempts(mesh, 0.12, 0.3, loss=loss)
+    problems += first_attempts(mesh, 0.12, 0.3, 2.0, loss=loss, samples=33)
+    order = np.random.default_rng(5).permutation(len(problems))
+    cons = [problems[i][0] for i in order]
+    targets = np.stack([problems[i][1] for i in order])
+    n = cons[0].n_vars
+    assert len({len(c.quad_s) + len(c.lin_b) for c in cons}) > 1  # padding is exercised
+    want = pack([rows_of(c, t) for c, t in zip(cons, targets, strict=True)], n)
+    got = pack_problems(cons, targets, n)
+    for name in ("a", "A", "alpha", "e", "mask"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(want, name), err_msg=name)
+
+
 def test_infeasible_problem_names_its_constraints():
     """Two contradictory face rows: no feasible point; the failing rows are named."""
     cons, target, starts = first_attempts("icosahedron", 0.15, 0.3)[0]
-    k = cons.kind.index("face") - len(cons.quad_s)
+    k = int(np.flatnonzero(cons.lin_kind == "face")[0])
     gap = 0.01 * cons.scale
     bad = dataclasses.replace(
         cons,
         lin_a=np.vstack([cons.lin_a, -cons.lin_a[k]]),
         lin_b=np.append(cons.lin_b, -cons.lin_b[k] - gap),
-        kind=[*cons.kind, "face"],
-        element=[*cons.element, cons.element[len(cons.quad_s) + k]],
+        lin_kind=np.append(cons.lin_kind, "face"),
+        lin_element=np.append(cons.lin_element, cons.lin_element[k]),
     )
     sol = solve_apex(bad, target, starts)
     assert not sol.ok

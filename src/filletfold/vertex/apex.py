@@ -29,6 +29,9 @@ import numpy as np
 from ..tolerances import tol
 from .frame import SideArrays, VertexFrame
 
+#: numpy string type of a row's kind (the longest key of ``KINDS``).
+_KIND_TYPE = "<U6"
+
 KINDS = {
     "patch": "valid patch (developed height above spatial height)",
     "l_min": "crease beyond the midpoint base curve (l < 0)",
@@ -58,8 +61,10 @@ class ApexConstraints:
     scale : float
         Length used to scale quadratic rows (mean incident edge length).
     v_fixed : (2,) float or None
-    kind, element : list of str
-        What each row is (see ``KINDS``) and the mesh edge or face it belongs to.
+    quad_kind, lin_kind : (q,) and (p,) str
+        What each row is (a key of ``KINDS``).
+    quad_element, lin_element : (q,) and (p,) int
+        The mesh edge (or, for a ``face`` row, the mesh face) each row belongs to.
     """
 
     scale: float
@@ -75,8 +80,20 @@ class ApexConstraints:
     quad_const: np.ndarray  # (q,)
     lin_a: np.ndarray
     lin_b: np.ndarray
-    kind: list = field(default_factory=list)
-    element: list = field(default_factory=list)
+    quad_kind: np.ndarray
+    quad_element: np.ndarray
+    lin_kind: np.ndarray
+    lin_element: np.ndarray
+
+    @property
+    def kind(self) -> np.ndarray:
+        """(n_rows,) str: what each row of :meth:`values` is (a key of ``KINDS``)."""
+        return np.concatenate([self.quad_kind, self.lin_kind])
+
+    @property
+    def element(self) -> np.ndarray:
+        """(n_rows,) int: the mesh edge, or face for a ``face`` row, of each row."""
+        return np.concatenate([self.quad_element, self.lin_element])
 
     @property
     def n_vars(self) -> int:
@@ -95,7 +112,9 @@ class ApexConstraints:
         num = (vi[:, 0] - self.quad_s) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", d, d)
         dn = vi[:, 1] - np.einsum("ij,ij->i", V - self.quad_M, self.quad_R)
         quad = (self.quad_sign * num - self.quad_coef * dn) / self.scale + self.quad_const
-        return np.concatenate([quad, self.lin_a @ V + self.lin_b])
+        # einsum, not BLAS: the same sums as the rows of many problems together
+        # (batch.pack_problems)
+        return np.concatenate([quad, np.einsum("ij,j->i", self.lin_a, V) + self.lin_b])
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """(n_rows, n_vars) derivative of :meth:`values`."""
@@ -114,8 +133,10 @@ class ApexConstraints:
     def describe(self, rows) -> list[str]:
         """Human-readable names of constraint rows, one per distinct (kind, element)."""
         seen = []
+        kinds, elements = self.kind, self.element
         for r in rows:
-            text = f"{KINDS[self.kind[r]]} at {self.element[r]}"
+            kind = str(kinds[r])
+            text = f"{KINDS[kind]} at {'face' if kind == 'face' else 'edge'} {elements[r]}"
             if text not in seen:
                 seen.append(text)
         return seen
@@ -225,6 +246,7 @@ def build_constraints_many(
     q_side[at], q_sample[at] = side, np.arange(len(s))
     coef[at], sign[at], const[at] = 2 * margin[mv], 1.0, 0.0
     ms = margin[sv]
+    q_kind = np.full(rows, "l_min", dtype=_KIND_TYPE)
     for block, (smp, c_, g_) in enumerate(
         [
             (first, -2 * (lmax[:, 0] - ms), 0.0),
@@ -235,6 +257,7 @@ def build_constraints_many(
         r = end + block * k[sv]
         q_side[r], q_sample[r] = sides, smp
         coef[r], sign[r], const[r] = c_, (-1.0 if block < 2 else 0.0), g_
+        q_kind[r] = "l_max" if block < 2 else "patch"
     # linear rows, per vertex: non-intersection along the arc, the chord plane, every face
     chord = np.flatnonzero(sa.arc > 0)
     c = np.bincount(sv[chord], minlength=n)
@@ -245,34 +268,29 @@ def build_constraints_many(
     T_end = np.concatenate([f.T_end[: len(f.ring.faces)] for f in frames])
     lin_rows = int((m + c + k).sum())
     lin_a, lin_b = np.empty((lin_rows, 3)), np.empty(lin_rows)
+    l_kind = np.empty(lin_rows, dtype=_KIND_TYPE)
+    l_element = np.empty(lin_rows, dtype=np.int64)
     chord_rank = np.arange(len(chord)) - (np.cumsum(c) - c)[sv[chord]]
-    for idx, vert, normal, point in (
-        (np.arange(len(s)) - mo[mv] + l_start[mv], mv, N, C),
-        (chord_rank + l_start[sv[chord]] + m[sv[chord]], sv[chord], ne, T_start[chord]),
-        (sides - so[sv] + l_start[sv] + m[sv] + c[sv], sv, sa.face_normal, T_end),
-    ):
+    ring_faces = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
+    for idx, vert, normal, point, kind, element in (
+        (np.arange(len(s)) - mo[mv] + l_start[mv], mv, N, C, "nonint", sa.edge[side]),
+        (chord_rank + l_start[sv[chord]] + m[sv[chord]], sv[chord], ne, T_start[chord], "chord",
+         sa.edge[chord]),
+        (sides - so[sv] + l_start[sv] + m[sv] + c[sv], sv, sa.face_normal, T_end, "face",
+         ring_faces),
+    ):  # fmt: skip
         a_ = sigma[vert][:, None] * normal
         lin_a[idx] = a_
         lin_b[idx] = -np.einsum("ij,ij->i", a_, point) - margin[vert]
+        l_kind[idx], l_element[idx] = kind, element
     quad_c, quad_s = C[q_sample], s[q_sample]
     quad_R, quad_M, quad_Q, quad_t = sa.R[q_side], sa.M[q_side], sa.Q[q_side], sa.t[q_side]
+    q_element = sa.edge[q_side]
+    q_end, l_end = q_start + m + 3 * k, l_start + m + c + k
     out = []
-    for j, frame in enumerate(frames):
-        q0, q1 = int(q_start[j]), int(q_start[j] + m[j] + 3 * k[j])
-        l0, l1 = int(l_start[j]), int(l_start[j] + m[j] + c[j] + k[j])
-        edge_name = [f"edge {e}" for e in arrays[j].edge.tolist()]
-        local_side = parts[j][0].tolist()
-        local_chord = (chord[sv[chord] == j] - so[j]).tolist()
-        kind = (
-            ["l_min"] * m[j] + ["l_max"] * (2 * k[j]) + ["patch"] * k[j]
-            + ["nonint"] * m[j] + ["chord"] * c[j] + ["face"] * k[j]
-        )  # fmt: skip
-        element = (
-            [edge_name[i] for i in local_side] + edge_name * 3
-            + [edge_name[i] for i in local_side]
-            + [edge_name[i] for i in local_chord]
-            + [f"face {f}" for f in np.asarray(frame.ring.faces).tolist()]
-        )  # fmt: skip
+    for j, (q0, q1, l0, l1) in enumerate(
+        zip(q_start.tolist(), q_end.tolist(), l_start.tolist(), l_end.tolist(), strict=True)
+    ):
         v = vs[j]
         out.append(
             ApexConstraints(
@@ -289,8 +307,10 @@ def build_constraints_many(
                 quad_const=const[q0:q1],
                 lin_a=lin_a[l0:l1],
                 lin_b=lin_b[l0:l1],
-                kind=kind,
-                element=element,
+                quad_kind=q_kind[q0:q1],
+                quad_element=q_element[q0:q1],
+                lin_kind=l_kind[l0:l1],
+                lin_element=l_element[l0:l1],
             )
         )
     return out

@@ -123,6 +123,64 @@ def rows_of(cons: ApexConstraints, target: np.ndarray):
     return a, A, alpha
 
 
+def pack_problems(problems: Sequence[ApexConstraints], targets: np.ndarray, n: int) -> RowBlock:
+    """:func:`pack` of :func:`rows_of` of every problem, computed on their rows together.
+
+    Parameters
+    ----------
+    problems : sequence of ApexConstraints
+        ``B`` problems with ``n`` variables each.
+    targets : (B, n) float
+
+    Returns
+    -------
+    RowBlock
+    """
+    B = len(problems)
+    T = np.asarray(targets, dtype=float).reshape(B, n)
+    nq = np.array([len(p.quad_s) for p in problems])
+    nl = np.array([len(p.lin_b) for p in problems])
+    L = np.array([p.scale for p in problems])
+    qb, lb = np.repeat(np.arange(B), nq), np.repeat(np.arange(B), nl)  # problem of each row
+
+    def cat(name: str) -> np.ndarray:
+        return np.concatenate([getattr(p, name) for p in problems])
+
+    Q, c, s = cat("quad_Q"), cat("quad_c"), cat("quad_s")
+    sign, coef = cat("quad_sign"), cat("quad_coef")
+    lin_a = cat("lin_a")
+    V = T[:, :3]
+    v = T[:, 3:5] if n == 5 else np.array([p.v_fixed for p in problems])
+    # ApexConstraints.values and .jacobian, row by row
+    vi = np.einsum("qij,qj->qi", Q, v[qb]) + cat("quad_t")
+    d = V[qb] - c
+    num = (vi[:, 0] - s) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", d, d)
+    dn = vi[:, 1] - np.einsum("ij,ij->i", V[qb] - cat("quad_M"), cat("quad_R"))
+    quad = (sign * num - coef * dn) / L[qb] + cat("quad_const")
+    lin = np.einsum("ij,ij->i", lin_a, V[lb]) + cat("lin_b")
+    g_quad = -2 * sign[:, None] * d + coef[:, None] * cat("quad_R")
+    if n == 5:
+        r = vi - np.stack([s, np.zeros_like(s)], axis=1)
+        g_v = 2 * sign[:, None] * np.einsum("qji,qj->qi", Q, r) - coef[:, None] * Q[:, 1, :]
+        g_quad = np.hstack([g_quad, g_v])
+    R = int((nq + nl).max(initial=0))
+    out = RowBlock(
+        np.ones((B, R)),
+        np.zeros((B, R, n)),
+        np.zeros((B, R)),
+        np.array([-1.0, -1.0, -1.0, 1.0, 1.0][:n]),
+        np.zeros((B, R), dtype=bool),
+    )
+    q_at = np.arange(len(qb)) - (np.cumsum(nq) - nq)[qb]  # place of each row in its problem
+    l_at = np.arange(len(lb)) - (np.cumsum(nl) - nl)[lb] + nq[lb]
+    out.a[qb, q_at], out.a[lb, l_at] = quad / L[qb], lin / L[lb]
+    out.A[qb, q_at] = g_quad / L[qb, None]
+    out.A[lb, l_at, :3] = lin_a
+    out.alpha[qb, q_at] = sign / L[qb] * L[qb]
+    out.mask[qb, q_at] = out.mask[lb, l_at] = True
+    return out
+
+
 def pack(rows: Sequence[tuple], n: int) -> RowBlock:
     """Stack per-problem rows (from :func:`rows_of`) into one padded :class:`RowBlock`."""
     B = len(rows)
@@ -510,9 +568,9 @@ def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSo
 
 def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexSolution]:
     B = len(problems)
-    rows = pack([rows_of(p, t) for p, t in zip(problems, targets, strict=True)], n)
-    L = np.array([p.scale for p in problems])
     T = np.stack(targets)
+    rows = pack_problems(problems, T, n)
+    L = np.array([p.scale for p in problems])
     at_target = rows.min_slack(np.zeros((B, n))) >= 0
     # candidate starts in y coordinates, the target (y = 0) first
     n_starts = np.array([len(s) for s in starts])
