@@ -274,7 +274,7 @@ def test_constraints_of_many_vertices_are_those_of_each_alone():
     args = []
     for i, p in enumerate(problems):
         if i % 3 == 1:
-            p.shrink = rng.uniform(0.5, 1.0, size=p.shrink.shape)
+            p.shrink = rng.uniform(0.5, 1.0, size=(len(p.frame.sides), 2))
         if i % 4 == 2:
             side = rng.integers(0, len(p.frame.sides), size=2)
             p.extra = np.stack([side, rng.uniform(0, 1, 2) * p.frame.arrays.arc[side]], axis=1)

@@ -187,7 +187,7 @@ def build_constraints_many(
 ) -> list[ApexConstraints]:
     """:func:`build_constraints` of many vertices at once (one value of each parameter per
     vertex, in sequences of equal length; ``lmax_scales`` and ``extras`` may be None for
-    all). The arcs of all vertices are sampled together (:func:`arc_samples`).
+    all). The arcs of all vertices are sampled together.
 
     Every row of every vertex is computed in one pass over flat arrays, already in each
     vertex's row order, so a vertex's constraints are views of them; each row's arithmetic is
@@ -201,40 +201,39 @@ def build_constraints_many(
     if n == 0:
         return []
     arrays = [frame.arrays for frame in frames]
-    samples = arc_samples(frames, n_samples)
-    lmax_scales = [None] * n if lmax_scales is None else lmax_scales
-    extras = [None] * n if extras is None else extras
-    parts = []  # per vertex: (side, first, last, s, C, N) with the extra samples after
-    for a, smp, extra in zip(arrays, samples, extras, strict=True):
-        if extra is not None and len(extra):
-            side, first, last, s_, C, N = smp
-            x_side, x_s = extra[:, 0].astype(np.int64), extra[:, 1]
-            x_C, x_N = a.base_normal(x_side, x_s)
-            smp = (
-                np.concatenate([side, x_side]), first, last, np.concatenate([s_, x_s]),
-                np.vstack([C, x_C]), np.vstack([N, x_N]),
-            )  # fmt: skip
-        parts.append(smp)
     sa = _stack(arrays)
     k = np.array([len(a.arc) for a in arrays])  # sides (= ring faces) per vertex
-    m = np.array([len(p[0]) for p in parts])  # samples per vertex
-    so, mo = np.cumsum(k) - k, np.cumsum(m) - m  # first side and sample of each vertex
-    sv, mv = np.repeat(np.arange(n), k), np.repeat(np.arange(n), m)
-    side = np.concatenate([p[0] for p in parts]) + so[mv]  # (M,) global side of each sample
-    first = np.concatenate([p[1] for p in parts]) + mo[sv]  # (K,) global samples
-    last = np.concatenate([p[2] for p in parts]) + mo[sv]
-    s = np.concatenate([p[3] for p in parts])
-    C = np.concatenate([p[4] for p in parts])
-    N = np.concatenate([p[5] for p in parts])
+    so, sv = np.cumsum(k) - k, np.repeat(np.arange(n), k)  # first side, vertex of each side
+    side, first, last, s, C, N = sa.samples(np.repeat(np.asarray(n_samples).reshape(n), k))
+    extras = [] if extras is None else [(j, x) for j, x in enumerate(extras) if x is not None]
+    if any(len(x) for _, x in extras):  # each vertex's extra samples after its own
+        x_vert = np.concatenate([np.full(len(x), j) for j, x in extras])
+        x_side = np.concatenate([x[:, 0] for _, x in extras]).astype(np.int64) + so[x_vert]
+        x_s = np.concatenate([x[:, 1] for _, x in extras])
+        x_C, x_N = sa.base_normal(x_side, x_s)
+        order = np.argsort(np.concatenate([2 * sv[side], 2 * x_vert + 1]), kind="stable")
+        side, s = np.concatenate([side, x_side])[order], np.concatenate([s, x_s])[order]
+        C, N = np.vstack([C, x_C])[order], np.vstack([N, x_N])[order]
+        n_x = np.bincount(x_vert, minlength=n)
+        first, last = first + (np.cumsum(n_x) - n_x)[sv], last + (np.cumsum(n_x) - n_x)[sv]
+    m = np.bincount(sv[side], minlength=n)  # samples per vertex
+    mo, mv = np.cumsum(m) - m, np.repeat(np.arange(n), m)  # first sample, vertex of each
     margin = np.asarray(margins, dtype=float).reshape(n)
     sigma = np.asarray(sigmas).reshape(n)
-    scale = np.array([float(a.length.mean()) for a in arrays])
-    lmax = np.concatenate(
+    scale = run_means(sa.length, k)
+    lmax = np.stack(
         [
-            np.stack([f.lmax_start, f.lmax_end], axis=1) * (1.0 if x is None else x)
-            for f, x in zip(frames, lmax_scales, strict=True)
-        ]
+            np.concatenate([f.lmax_start for f in frames]),
+            np.concatenate([f.lmax_end for f in frames]),
+        ],
+        axis=1,
     )
+    if lmax_scales is not None and any(x is not None for x in lmax_scales):
+        factor = np.ones_like(lmax)
+        for j, x in enumerate(lmax_scales):
+            if x is not None:
+                factor[so[j] : so[j] + k[j]] = x
+        lmax = lmax * factor
     # quadratic rows, per vertex: l >= m at every sample, l <= l_max - m at both ends, Dn >= m
     q_start = np.cumsum(m + 3 * k) - (m + 3 * k)
     at = np.arange(len(s)) - mo[mv] + q_start[mv]  # the samples' rows
@@ -313,34 +312,6 @@ def build_constraints_many(
                 lin_element=l_element[l0:l1],
             )
         )
-    return out
-
-
-def arc_samples(frames: Sequence[VertexFrame], n_samples: Sequence[int]) -> list[tuple]:
-    """``frame.arrays.samples(n)`` of many closed-ring vertices, computed together.
-
-    Parameters
-    ----------
-    frames : sequence of VertexFrame
-    n_samples : sequence of int
-        Samples per arc, per vertex.
-
-    Returns
-    -------
-    list of tuple
-        Per vertex ``(side, first, last, s, C, N)`` as :meth:`SideArrays.samples` returns them.
-    """
-    out: list = [None] * len(frames)
-    n_samples = np.asarray(n_samples, dtype=np.int64).reshape(-1)
-    for n in np.unique(n_samples).tolist():
-        which = np.flatnonzero(n_samples == n).tolist()
-        arrays = [frames[j].arrays for j in which]
-        side, first, last, s, C, N = _stack(arrays).samples(n)
-        k = np.array([len(a.arc) for a in arrays])
-        lo = np.concatenate([[0], np.cumsum(k)])  # sides of each vertex
-        for j, a, b in zip(which, lo[:-1].tolist(), lo[1:].tolist(), strict=True):
-            p, q = int(first[a]), int(last[b - 1]) + 1  # its samples
-            out[j] = (side[p:q] - a, first[a:b] - p, last[a:b] - p, s[p:q], C[p:q], N[p:q])
     return out
 
 
@@ -523,7 +494,7 @@ def validate_apices(
     vert = np.repeat(np.arange(n), n_sides)  # (K,) vertex of each side
     fvert = np.repeat(np.arange(n), n_faces)  # (F,) vertex of each face
     offset = np.concatenate([[0], np.cumsum(n_sides)[:-1]])  # first side of each vertex
-    scale = np.array([a.length.mean() for a in arrs])  # (add.reduceat sums in another order)
+    scale = run_means(sa.length, n_sides)  # (add.reduceat sums in another order)
     eps = tol.validate * scale  # (n,)
     sigma = np.asarray(sigmas).reshape(n)
     V = np.asarray(apices, dtype=float).reshape(n, 3)[vert]  # (K, 3) per side
@@ -596,6 +567,18 @@ def validate_apices(
         ApexCheck(not fail, float(m), fail, np.array(c, dtype=float).reshape(-1, 2))
         for fail, m, c in zip(failing, margin, cuts, strict=True)
     ]
+
+
+def run_means(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """(n,) mean of each of ``n`` consecutive runs of ``values`` of lengths ``counts``, each
+    the same float as ``np.mean`` of the run alone (runs of equal length reduced together).
+    """
+    out = np.empty(len(counts))
+    first = np.cumsum(counts) - counts
+    for c in np.unique(counts).tolist():
+        which = np.flatnonzero(counts == c)
+        out[which] = values[first[which, None] + np.arange(c)].mean(axis=1)
+    return out
 
 
 def _stack(arrays: Sequence[SideArrays]) -> SideArrays:

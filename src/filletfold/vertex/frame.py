@@ -216,8 +216,13 @@ class SideArrays:
         N = self.normal(i, s)
         return self.O[i] + (self.kappa[i] * self.radius[i])[:, None] * N, N
 
-    def samples(self, n_samples: int):
+    def samples(self, n_samples):
         """Evenly spaced samples along every arc, ends included (one on a flat side).
+
+        Parameters
+        ----------
+        n_samples : int or (k,) int
+            Samples per arc, for all sides or per side.
 
         Returns
         -------

@@ -14,7 +14,7 @@ from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
 from . import batch
-from .apex import KINDS, build_constraints, build_constraints_many, validate_apices
+from .apex import KINDS, build_constraints, build_constraints_many, run_means, validate_apices
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angle_front, vertex_normals
@@ -230,8 +230,8 @@ class ApexProblem:
         The safety margin ``m`` at scale 1.
     low : float
         The shortest ``l_max``: margins stay under a quarter of it.
-    shrink : (n_sides, 2) float
-        Factors on ``l_max`` (shortened creases after a face-centre crossing).
+    shrink : (n_sides, 2) float or None
+        Factors on ``l_max`` (shortened creases after a face-centre crossing; None: all 1).
     attempts : list of (int, float)
         Remaining (samples per arc, margin scale) to try, in order.
     failing : list of str
@@ -250,7 +250,7 @@ class ApexProblem:
     starts: np.ndarray
     margin: float
     low: float
-    shrink: np.ndarray
+    shrink: np.ndarray | None
     attempts: list
     failing: list
     extra: np.ndarray
@@ -363,7 +363,7 @@ def _set_up(frames, depths, res: VertexResult, vertices) -> dict:
     margin_length = np.where(
         np.isfinite(shortest_arc), np.minimum(shortest, 4 * shortest_arc), shortest
     )  # or four times the shortest arc, when shorter: nearly flat vertices have thin windows
-    mean_length = _means(length, k)
+    mean_length = run_means(length, k)
     U = np.array([f.U for f in fr])
     D = res.normal[idx]
     target = U + depth[:, None] * D
@@ -403,24 +403,13 @@ def _set_up(frames, depths, res: VertexResult, vertices) -> dict:
             starts=st,
             margin=tol.margin * float(margin_length[j]),
             low=float(low[j]),
-            shrink=np.ones((k[j], 2)),
+            shrink=None,
             attempts=list(ATTEMPTS),
             failing=[],
             extra=np.zeros((0, 2)),
             cut_rounds=0,
         )
     return problems
-
-
-def _means(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """(n,) mean of each of ``n`` consecutive runs of ``values`` of lengths ``counts``, each
-    the same float as ``np.mean`` of the run alone (runs of equal length reduced together)."""
-    out = np.empty(len(counts))
-    first = np.cumsum(counts) - counts
-    for c in np.unique(counts).tolist():
-        which = np.flatnonzero(counts == c)
-        out[which] = values[first[which, None] + np.arange(c)].mean(axis=1)
-    return out
 
 
 def solve_apices(
@@ -502,9 +491,11 @@ def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
     """After a failed validation: when only face-centre crossings fail, retry ``attempt``
     with shorter creases on those faces."""
     crossing = [f for f in p.failing if "face piece's centre" in f]
-    if crossing and len(crossing) == len(p.failing) and p.shrink.min() > 0.2:
+    n_sides = len(p.frame.sides)
+    shrink = np.ones((n_sides, 2)) if p.shrink is None else p.shrink
+    if crossing and len(crossing) == len(p.failing) and shrink.min() > 0.2:
         faces = {int(f.rsplit(" ", 1)[1]) for f in crossing}
-        n_sides = len(p.frame.sides)
+        p.shrink = shrink
         for i, f in enumerate(p.frame.ring.faces):
             if int(f) in faces:
                 p.shrink[i, 1] *= 0.7
