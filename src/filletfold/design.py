@@ -343,12 +343,15 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
 
     tree = cKDTree(pattern.vertices_3d)
     cones = {int(s.split()[1]) for s in set(pattern.face_patch) if s.startswith("cone ")}
-    for u in np.nonzero(np.isfinite(res.apex[:, 0]))[0]:
-        if int(u) not in cones:
-            continue
-        dist, k = tree.query(res.apex[u])
-        if dist < 1e-9 * (1 + np.abs(res.apex[u]).max()):
-            res.apex_2d[u] = pattern.vertices_2d[k]
+    us = np.array(
+        [u for u in np.flatnonzero(np.isfinite(res.apex[:, 0])).tolist() if u in cones],
+        dtype=np.int64,
+    )
+    if not len(us):
+        return
+    dist, k = tree.query(res.apex[us])
+    near = dist < 1e-9 * (1 + np.abs(res.apex[us]).max(axis=1))
+    res.apex_2d[us[near]] = pattern.vertices_2d[k[near]]
 
 
 def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg):

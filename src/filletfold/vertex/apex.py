@@ -28,6 +28,7 @@ import numpy as np
 
 from ..tolerances import tol
 from .frame import SideArrays, VertexFrame
+from .runs import run_means
 
 #: numpy string type of a row's kind (the longest key of ``KINDS``).
 _KIND_TYPE = "<U6"
@@ -494,7 +495,7 @@ def validate_apices(
     vert = np.repeat(np.arange(n), n_sides)  # (K,) vertex of each side
     fvert = np.repeat(np.arange(n), n_faces)  # (F,) vertex of each face
     offset = np.concatenate([[0], np.cumsum(n_sides)[:-1]])  # first side of each vertex
-    scale = run_means(sa.length, n_sides)  # (add.reduceat sums in another order)
+    scale = run_means(sa.length, n_sides)
     eps = tol.validate * scale  # (n,)
     sigma = np.asarray(sigmas).reshape(n)
     V = np.asarray(apices, dtype=float).reshape(n, 3)[vert]  # (K, 3) per side
@@ -567,18 +568,6 @@ def validate_apices(
         ApexCheck(not fail, float(m), fail, np.array(c, dtype=float).reshape(-1, 2))
         for fail, m, c in zip(failing, margin, cuts, strict=True)
     ]
-
-
-def run_means(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """(n,) mean of each of ``n`` consecutive runs of ``values`` of lengths ``counts``, each
-    the same float as ``np.mean`` of the run alone (runs of equal length reduced together).
-    """
-    out = np.empty(len(counts))
-    first = np.cumsum(counts) - counts
-    for c in np.unique(counts).tolist():
-        which = np.flatnonzero(counts == c)
-        out[which] = values[first[which, None] + np.arange(c)].mean(axis=1)
-    return out
 
 
 def _stack(arrays: Sequence[SideArrays]) -> SideArrays:

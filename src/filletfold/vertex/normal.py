@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..tolerances import tol
+from .runs import run_sums
 
 # Numerical constants of the exact solvers below (rounding level, not modelling tolerances);
 # lengths are relative to the largest |u_k| of the problem.
@@ -504,7 +505,26 @@ def solid_angle_front(kappa: np.ndarray, half_angle: np.ndarray) -> float:
     The back side is the geodesic polygon of the edge directions on the unit sphere, with
     interior angles ``pi - kappa 2 gamma``; its area is ``2 pi - sum(kappa 2 gamma)``.
     """
-    return float(2 * np.pi + np.sum(kappa * 2 * half_angle))
+    kappa = np.asarray(kappa)
+    return float(solid_angles_front(kappa, np.asarray(half_angle), np.array([len(kappa)]))[0])
+
+
+def solid_angles_front(kappa: np.ndarray, half_angle: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """:func:`solid_angle_front` of many closed vertices at once.
+
+    Parameters
+    ----------
+    kappa : (m,) int
+    half_angle : (m,) float
+        Per incident edge, the edges of each vertex one after another.
+    count : (n,) int
+        Incident edges per vertex.
+
+    Returns
+    -------
+    (n,) float
+    """
+    return 2 * np.pi + run_sums(kappa * 2 * half_angle, count)
 
 
 def is_developable(angle_sum: float) -> bool:

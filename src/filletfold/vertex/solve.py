@@ -14,10 +14,16 @@ from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding
 from ..tolerances import tol
 from . import batch
-from .apex import KINDS, build_constraints, build_constraints_many, run_means, validate_apices
+from .apex import (
+    KINDS,
+    build_constraints,
+    build_constraints_many,
+    validate_apices,
+)
 from .batch import solve_apex_batch
 from .frame import VertexFrame, vertex_frames
-from .normal import is_developable, solid_angle_front, vertex_normals
+from .normal import is_developable, solid_angles_front, vertex_normals
+from .runs import run_means
 
 STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
 
@@ -133,34 +139,36 @@ def classify_vertices(
         start_edge = [None] * len(vertices)
     frames = vertex_frames(mesh, rounding, vertices, start_edge)
     closed = [k for k, f in enumerate(frames) if f.ring.closed]
+    verts = np.array(vertices, dtype=np.int64)
+    res.angle_sum[verts] = mesh.vertex_angle_sum[verts]
+    res.defect[verts] = 2 * np.pi - res.angle_sum[verts]
     for k, frame in enumerate(frames):
-        u = vertices[k]
-        res.angle_sum[u] = mesh.vertex_angle_sum[u]
-        res.defect[u] = 2 * np.pi - res.angle_sum[u]
         if not frame.ring.closed:
+            u = vertices[k]
             res.kind[u] = res.status[u] = "boundary"
             res.reason[u] = "boundary vertex: no cone; its module ends at the sheet's edge"
     if not closed:
         return frames
-    width = max(len(frames[k].sides) for k in closed)
-    edge_dir = np.zeros((len(closed), width, 3))
-    face_normal = np.zeros((len(closed), width, 3))
-    count = np.zeros(len(closed), dtype=np.int64)
-    for j, k in enumerate(closed):
-        ring = frames[k].ring
-        n = len(frames[k].sides)
-        edge_dir[j, :n] = [s.R for s in frames[k].sides]
-        face_normal[j, : len(ring.faces)] = mesh.face_normal[ring.faces]
-        count[j] = n
+    # the sides of the closed rings, ring after ring (as many ring faces as sides)
+    sides = [frames[k].arrays for k in closed]
+    count = np.array([len(a.arc) for a in sides], dtype=np.int64)
+    edges = np.concatenate([a.edge for a in sides])
+    row = np.repeat(np.arange(len(closed)), count)
+    col = np.arange(len(row)) - np.repeat(np.cumsum(count) - count, count)
+    edge_dir = np.zeros((len(closed), int(count.max()), 3))
+    face_normal = np.zeros_like(edge_dir)
+    edge_dir[row, col] = np.concatenate([a.R for a in sides])
+    face_normal[row, col] = mesh.face_normal[np.concatenate([frames[k].ring.faces for k in closed])]
     D, bound, sigma = vertex_normals(edge_dir, face_normal, count, count)
-    for j, k in enumerate(closed):
-        frame, u = frames[k], vertices[k]
-        ring = frame.ring
-        kappa = rounding.kappa[ring.edges]
-        res.solid_angle[u] = solid_angle_front(kappa, rounding.half_angle[ring.edges])
-        b = float(bound[j])
-        res.normal[u], res.normal_bound[u], res.sigma[u] = D[j], b, sigma[j]
-        if is_developable(res.angle_sum[u]):
+    u_closed = verts[closed]
+    res.normal[u_closed], res.normal_bound[u_closed], res.sigma[u_closed] = D, bound, sigma
+    res.solid_angle[u_closed] = solid_angles_front(
+        rounding.kappa[edges], rounding.half_angle[edges], count
+    )
+    developable = is_developable(res.angle_sum[u_closed])
+    for j, (k, u, b) in enumerate(zip(closed, u_closed.tolist(), bound.tolist(), strict=True)):
+        if developable[j]:
+            frame = frames[k]
             res.kind[u] = "developable"
             gap = float(np.linalg.norm(frame.rho[:2, 2]))
             scale = float(np.mean([s.length for s in frame.sides]))
