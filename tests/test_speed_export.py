@@ -295,3 +295,127 @@ def test_validate_pattern_still_names_the_face(faces, match):
         validate_pattern(_square(faces))
     with pytest.raises(ExportError, match=match):
         cut_files(_square(faces), "fold,obj,svg")
+
+
+# ---------------------------------------------------------------- report.json by columns
+
+
+def ref_report_json(report) -> str:
+    return json.dumps(to_json_data(report), indent=2, allow_nan=False) + "\n"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_report_records_write_the_report_of_dicts(name):
+    from filletfold.reporting import design_report, report_records
+
+    d = design_of(name)
+    report = design_report(d)
+    assert report_json(report_records(d)) == ref_report_json(report)
+    assert all(type(v) is dict for key in ("edges", "vertices") for v in report[key])
+
+
+FLOATS = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, -0.0, 1.0, 0.1, -2.5, 1e300, 5e-324, float("nan"), float("inf")]),
+)
+SCALARS = st.one_of(FLOATS, st.none(), st.booleans(), st.integers(-5, 5), st.text(max_size=4))
+VALUES = st.one_of(
+    SCALARS,
+    st.lists(st.one_of(FLOATS, st.none(), st.integers(-3, 3)), max_size=4),
+    st.lists(st.text(max_size=3), max_size=3),
+    st.lists(st.lists(FLOATS, max_size=3), max_size=3),
+    st.dictionaries(st.sampled_from("xy"), FLOATS, max_size=2),
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    st.lists(
+        st.dictionaries(st.sampled_from(["kind", "status", "reason", "a", "b"]), VALUES),
+        max_size=12,
+    ),
+    st.booleans(),
+)
+def test_report_json_of_records_is_json_dumps(records, ordered):
+    if ordered:  # one common key order, some keys missing: written a column at a time
+        order = ["kind", "status", "reason", "a", "b"]
+        records = [{k: r[k] for k in order if k in r} for r in records]
+    doc = {"records": records, "nested": {"list": records[:3]}, "rows": [[1.0, None], None]}
+    assert report_json(doc) == ref_report_json(doc)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.integers(0, 40),
+    st.integers(1, 3),
+    st.lists(st.sampled_from([0.0, -0.0, 1.5, 0.1, np.nan, np.inf, -np.inf]), min_size=1),
+    st.randoms(use_true_random=False),
+)
+def test_records_of_arrays_write_their_dicts(n, k, pool, rnd):
+    from filletfold.export.report import Records
+
+    pick = np.array(pool)[[rnd.randrange(len(pool)) for _ in range(n * (k + 1))]]
+    rows = pick[: n * k].reshape(n, k) * rnd.choice([1.0, 1e-7, 3.3])
+    mask = np.array([rnd.random() < 0.3 for _ in range(n)], dtype=bool)
+    table = Records(
+        {
+            "kind": [rnd.choice(["cone", "saddle"]) for _ in range(n)],
+            "reason": [rnd.choice([None, 'no "cone"', "é"]) for _ in range(n)],
+            "value": pick[n * k :],
+            "row": rows,
+            "ids": np.arange(n * 2).reshape(n, 2),
+            "flag": mask,
+            "sigma": np.arange(n) % 3 - 1,
+        },
+        present={"reason": ~mask},
+        nulls={"row": mask, "sigma": np.arange(n) % 3 == 1},
+    )
+    if n == 0:
+        assert report_json({"t": table}) == '{\n  "t": []\n}\n'
+        return
+    dicts = table.dicts()
+    assert [("reason" in r) for r in dicts] == (~mask).tolist()
+    assert all(r["row"] is None for r, m in zip(dicts, mask, strict=True) if m)
+    assert report_json({"t": table}) == ref_report_json({"t": dicts})
+    assert to_json_data({"t": table}) == to_json_data({"t": dicts})
+
+
+def test_report_json_arrays_and_repeated_floats():
+    zeros = [0.0, -0.0] * 50 + [0.1] * 20
+    doc = {
+        "a": np.array([[1.0, np.nan], [np.inf, -0.0]]),
+        "faces": [np.array([1, 2, 3]), np.array([4, 5, 6, 7]), np.array([], dtype=int)],
+        "mixed": [np.array([1, 2]), np.array([0.5])],
+        "zeros": zeros,
+        "zeros_or_none": [*zeros, None],
+        "flags": np.array([True, False]),
+        "empty": np.zeros((0, 3)),
+    }
+    assert report_json(doc) == ref_report_json(doc)
+    assert '"-0.0"' not in report_json(doc) and "-0.0" in report_json(doc)
+
+
+def test_report_records_reject_ragged_columns():
+    from filletfold.export.report import Records
+
+    with pytest.raises(ExportError, match="one length"):
+        Records({"a": [1, 2], "b": [1]})
+    with pytest.raises(ExportError, match="one length"):
+        Records({"a": [1, 2]}, nulls={"b": [True, False]})
+
+
+def test_indented_still_rejects_non_finite_json_data():
+    from filletfold.export.report import _indented
+
+    for bad in ([1.0, float("nan")], [None, float("inf")], [[1.0, float("-inf")]]):
+        with pytest.raises(ValueError, match="not JSON compliant"):
+            _indented(bad, "\n")
+
+
+def test_group_names_all_at_once_are_obj_group_name():
+    from filletfold.export.obj import _group_names
+
+    names = ["cone 3", "  a  b ", "x\t\ny", "", "   ", "é\u2028z", "\u3000q\u3000", "a%d", "z"]
+    assert _group_names(names) == [obj_group_name(n) for n in names]
+    assert _group_names([*names, "p\x00q"]) == [obj_group_name(n) for n in [*names, "p\x00q"]]
+    assert _group_names([]) == []

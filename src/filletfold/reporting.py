@@ -10,6 +10,7 @@ import numpy as np
 from . import __version__
 from .export import report_json, write_outputs
 from .export.cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
+from .export.report import Records
 from .rounding import loss_from_radius
 from .tabs import assembly_text
 
@@ -23,36 +24,38 @@ def _num(x):
     return None if not np.isfinite(x) else x
 
 
-def _vec(x):
-    x = np.asarray(x, dtype=float)
-    return None if not np.all(np.isfinite(x)) else x.tolist()
-
-
-def _floats(x) -> list:
-    """``[float(v) for v in x]`` of a float array (n,)."""
-    return np.asarray(x, dtype=float).tolist()
-
-
-def _nums(x) -> list:
-    """``[_num(v) for v in x]``: floats, None for NaN and infinities."""
-    x = np.asarray(x, dtype=float)
-    out = x.tolist()
-    for i in np.flatnonzero(~np.isfinite(x)).tolist():
-        out[i] = None
-    return out
-
-
-def _vecs(x) -> list:
-    """``[_vec(row) for row in x]``: lists, None for a row with NaN or infinity."""
-    x = np.asarray(x, dtype=float)
-    out = x.tolist()
-    for i in np.flatnonzero(~np.isfinite(x).all(axis=1)).tolist():
-        out[i] = None
-    return out
-
-
 def design_report(design) -> dict:
     """The content of ``report.json`` (see the README for every key).
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    dict
+        Numbers and lists only: ``edges`` and ``vertices`` hold one dict per edge and vertex.
+    """
+    report = report_records(design)
+    return {k: _listed(v) if k in ("mesh", "edges", "vertices") else v for k, v in report.items()}
+
+
+def _listed(value):
+    """A value of :func:`report_records` as :func:`design_report` has it: records as dicts,
+    arrays as lists."""
+    if isinstance(value, Records):
+        return value.dicts()
+    if isinstance(value, dict):
+        return {k: _listed(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return list(map(_listed, value))
+    return value.tolist() if isinstance(value, np.ndarray) else value
+
+
+def report_records(design) -> dict:
+    """:func:`design_report` with its mesh as arrays and its ``edges`` and ``vertices`` as
+    :class:`~filletfold.export.report.Records` of arrays: the same ``report.json`` from
+    :func:`~filletfold.export.report.report_json`, without a dict or list per edge and vertex.
 
     Parameters
     ----------
@@ -64,88 +67,7 @@ def design_report(design) -> dict:
     """
     mesh = design.mesh
     rd = design.rounding
-    res = design.vertices
     pat = design.pattern
-    boundary = (mesh.edge_faces < 0).any(axis=1)
-    assignment = np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist()
-    bent = rd.half_angle > 0
-    loss_limit = np.full(mesh.n_edges, np.nan)
-    loss_limit[bent] = loss_from_radius(rd.limit[bent], rd.half_angle[bent])
-    edges = [
-        {
-            "vertices": ab,
-            "faces": None if bd else fg,
-            "length": length,
-            "radius": radius,
-            "half_angle": half,
-            "assignment": kind,
-            "arc_length": arc,
-            "strip_width": width,
-            "material_loss": loss,
-            "radius_limit": limit,
-            "material_loss_limit": limit_loss if bend else None,
-        }
-        for ab, fg, bd, length, radius, half, kind, arc, width, loss, limit, limit_loss, bend in (
-            zip(
-                mesh.edges.tolist(),
-                mesh.edge_faces.tolist(),
-                boundary.tolist(),
-                _floats(mesh.edge_length),
-                _floats(rd.radius),
-                _floats(rd.half_angle),
-                assignment,
-                _floats(rd.arc_length),
-                _floats(rd.strip_width),
-                _floats(rd.loss),
-                _nums(rd.limit),
-                _nums(loss_limit),
-                bent.tolist(),
-                strict=True,
-            )
-        )
-    ]
-    vertices = []
-    vertex_values = zip(
-        _nums(res.angle_sum),
-        _nums(res.defect),
-        _nums(res.solid_angle),
-        _vecs(res.normal),
-        _nums(res.normal_bound),
-        _vecs(res.apex),
-        _vecs(res.apex_developed),
-        _vecs(res.apex_2d),
-        _nums(res.depth_requested),
-        _nums(res.depth),
-        _nums(res.margin),
-        strict=True,
-    )
-    for u, values in enumerate(vertex_values):
-        item = {
-            "kind": res.kind[u],
-            "status": res.status[u],
-        }
-        if res.status[u] != "ok":
-            item["reason"] = res.reason[u]
-        angle_sum, defect, solid, normal, bound, apex, developed, apex_2d, asked, depth, margin = (
-            values
-        )
-        item.update(
-            {
-                "angle_sum": angle_sum,
-                "angle_defect": defect,
-                "solid_angle": solid,
-                "sigma": int(res.sigma[u]) or None,
-                "normal": normal,
-                "normal_bound": bound,
-                "apex": apex,
-                "apex_developed": developed,
-                "apex_2d": apex_2d,
-                "depth_requested": asked,
-                "depth": depth,
-                "margin": margin,
-            }
-        )
-        vertices.append(item)
     mismatch, relative = _mismatches(pat)
     counts = {k: int(np.sum(pat.edge_assignment == k)) for k in ("M", "V", "B", "F")}
     return {
@@ -155,12 +77,9 @@ def design_report(design) -> dict:
         "mean_edge_length": float(mesh.mean_edge_length),
         "uniform_radius_limit": _num(rd.uniform_limit),
         "status_counts": design.status_counts(),
-        "mesh": {
-            "vertices": mesh.vertices.tolist(),
-            "faces": [f.tolist() for f in mesh.faces],
-        },
-        "edges": edges,
-        "vertices": vertices,
+        "mesh": {"vertices": mesh.vertices, "faces": list(mesh.faces)},
+        "edges": _edge_records(mesh, rd),
+        "vertices": _vertex_records(design.vertices),
         "pattern": {
             "pieces": int(pat.n_pieces),
             "cut_edges": int(pat.cut_mask().sum()),
@@ -175,6 +94,71 @@ def design_report(design) -> dict:
         "material_loss": _loss_report(design.material_loss),
         "timings": {k: float(v) for k, v in design.timings.items()},
     }
+
+
+def _not_finite(x: np.ndarray) -> np.ndarray:
+    """(n,) bool: the values (n,), or rows (n, k), of ``x`` with a NaN or infinity."""
+    bad = ~np.isfinite(x)
+    return bad.any(axis=1) if bad.ndim == 2 else bad
+
+
+def _edge_records(mesh, rd) -> Records:
+    """The ``edges`` of the report: one record per mesh edge."""
+    boundary = (mesh.edge_faces < 0).any(axis=1)
+    bent = rd.half_angle > 0
+    loss_limit = np.full(mesh.n_edges, np.nan)  # None where not bent
+    loss_limit[bent] = loss_from_radius(rd.limit[bent], rd.half_angle[bent])
+    limit = np.asarray(rd.limit, dtype=float)
+    return Records(
+        {
+            "vertices": mesh.edges,
+            "faces": mesh.edge_faces,
+            "length": np.asarray(mesh.edge_length, dtype=float),
+            "radius": np.asarray(rd.radius, dtype=float),
+            "half_angle": np.asarray(rd.half_angle, dtype=float),
+            "assignment": np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist(),
+            "arc_length": np.asarray(rd.arc_length, dtype=float),
+            "strip_width": np.asarray(rd.strip_width, dtype=float),
+            "material_loss": np.asarray(rd.loss, dtype=float),
+            "radius_limit": limit,
+            "material_loss_limit": loss_limit,
+        },
+        nulls={
+            "faces": boundary,
+            "radius_limit": _not_finite(limit),
+            "material_loss_limit": _not_finite(loss_limit),
+        },
+    )
+
+
+def _vertex_records(res) -> Records:
+    """The ``vertices`` of the report: one record per mesh vertex (``reason`` unless ok);
+    None for a number, or vector, that is not finite, and for a zero ``sigma``."""
+
+    def floats(x) -> np.ndarray:
+        return np.asarray(x, dtype=float)
+
+    sigma = np.asarray(res.sigma).astype(np.int64)
+    columns = {
+        "kind": list(res.kind),
+        "status": list(res.status),
+        "reason": list(res.reason),
+        "angle_sum": floats(res.angle_sum),
+        "angle_defect": floats(res.defect),
+        "solid_angle": floats(res.solid_angle),
+        "sigma": sigma,
+        "normal": floats(res.normal),
+        "normal_bound": floats(res.normal_bound),
+        "apex": floats(res.apex),
+        "apex_developed": floats(res.apex_developed),
+        "apex_2d": floats(res.apex_2d),
+        "depth_requested": floats(res.depth_requested),
+        "depth": floats(res.depth),
+        "margin": floats(res.margin),
+    }
+    nulls = {k: _not_finite(v) for k, v in columns.items() if isinstance(v, np.ndarray)}
+    nulls["sigma"] = sigma == 0
+    return Records(columns, present={"reason": [s != "ok" for s in res.status]}, nulls=nulls)
 
 
 def _fabrication_report(design) -> dict:
@@ -336,7 +320,7 @@ def export_design(
 
         def report() -> str:
             design.timings["export"] = time.perf_counter() - t  # the files written before it
-            return report_json(design_report(design))
+            return report_json(report_records(design))
 
         files["report.json"] = report
     names = list(output_names(formats))

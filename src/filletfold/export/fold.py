@@ -577,16 +577,25 @@ def _compact(obj) -> str:
     return "[" + ",".join(map(_compact, obj)) + "]"
 
 
-def _dump(obj, depth: int) -> str:
-    """Dicts and lists of dicts one entry per line, everything else compact on one line."""
+def _dump(obj, depth: int, out: list[str]) -> list[str]:
+    """Dicts and lists of dicts one entry per line, everything else compact on one line: the
+    text's pieces appended to ``out`` (joined once by :func:`fold_json`), which is returned."""
     pad = "  " * depth
     if isinstance(obj, dict) and obj:
-        items = [f"{pad}  {json.dumps(k)}: {_dump(v, depth + 1)}" for k, v in obj.items()]
-        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
-    if isinstance(obj, list) and dict in set(map(type, obj)):  # _plain made mappings dicts
-        items = [f"{pad}  {_dump(v, depth + 1)}" for v in obj]
-        return "[\n" + ",\n".join(items) + "\n" + pad + "]"
-    return _compact(obj)
+        out.append("{\n")
+        for k, v in obj.items():
+            out += (pad, "  ", json.dumps(k), ": ")
+            _dump(v, depth + 1, out).append(",\n")
+        out[-1] = "\n" + pad + "}"
+    elif isinstance(obj, list) and dict in set(map(type, obj)):  # _plain made mappings dicts
+        out.append("[\n")
+        for v in obj:
+            out += (pad, "  ")
+            _dump(v, depth + 1, out).append(",\n")
+        out[-1] = "\n" + pad + "]"
+    else:
+        out.append(_compact(obj))
+    return out
 
 
 def fold_json(doc: Mapping) -> str:
@@ -613,4 +622,6 @@ def fold_json(doc: Mapping) -> str:
     """
     if not isinstance(doc, Mapping):
         raise ExportError(f"a FOLD document must be a mapping, got {type(doc).__name__}")
-    return _dump(_plain(doc, ""), 0) + "\n"
+    parts = _dump(_plain(doc, ""), 0, [])
+    parts.append("\n")
+    return "".join(parts)

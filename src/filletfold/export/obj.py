@@ -19,6 +19,20 @@ def obj_group_name(patch: str) -> str:
     return name or "patch"
 
 
+#: Whitespace next to the NUL that :func:`_group_names` puts between names.
+_SPACE_AROUND_NUL = re.compile(r"\s*\0\s*")
+_SPACES = re.compile(r"\s+")
+
+
+def _group_names(patches: list[str]) -> list[str]:
+    """:func:`obj_group_name` of every patch, all names in one text (NUL between them)."""
+    joined = "\0".join(patches)
+    if not patches or joined.count("\0") != len(patches) - 1:  # none, or a name with a NUL
+        return list(map(obj_group_name, patches))
+    names = _SPACES.sub("_", _SPACE_AROUND_NUL.sub("\0", joined).strip()).split("\0")
+    return [name or "patch" for name in names]
+
+
 def vertex_normal_3d(vertices_3d: np.ndarray, faces: list) -> np.ndarray:
     """Area-weighted vertex normals of the folded form.
 
@@ -101,8 +115,8 @@ def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) 
         parts.append(_xyz_lines("vn", vertex_normal_3d(v3, pattern.faces)))
     # groups in order of their first face; faces in pattern order within a group
     group_id: dict[str, int] = {}
-    for p in patches:
-        patches[p] = group_id.setdefault(obj_group_name(p), len(group_id))
+    for p, name in zip(patches, _group_names(list(patches)), strict=True):
+        patches[p] = group_id.setdefault(name, len(group_id))
     group = np.fromiter(
         map(patches.__getitem__, pattern.face_patch), dtype=np.int64, count=len(pattern.face_patch)
     )
