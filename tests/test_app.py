@@ -26,6 +26,8 @@ from filletfold.app.view import (
 from filletfold.cli import main
 from filletfold.errors import MeshReadError, ParameterError
 
+from .conftest import design_of
+
 TETRA_OBJ = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
 ZIP_NAMES = {"design.fold", "report.json", "folded.obj", "pattern.svg", "pattern.dxf"}
 
@@ -228,6 +230,36 @@ def test_triangulate_faces_covers_every_face():
         areas = [_area(points[t]) for t in mine]
         assert min(areas) > 0
         assert_allclose(sum(areas), _area(points[f]), rtol=1e-12)
+
+
+@pytest.mark.parametrize("as_arrays", [False, True])
+def test_triangulate_faces_is_triangulate_polygon_face_by_face(as_arrays):
+    """The triangles of every face, convex or not (resch has non-convex face shares), as
+    triangulate_polygon gives them, face after face; faces of fewer than 3 corners give none."""
+    pattern = design_of("resch").pattern
+    faces = [f if as_arrays else f.tolist() for f in pattern.faces[:600]]
+    faces[3:3] = [faces[3][:2], faces[7][:1]]
+    tris, owner = triangulate_faces(pattern.vertices_2d, faces)
+    want = [np.asarray(f)[triangulate_polygon(pattern.vertices_2d[f])] for f in faces if len(f) > 2]
+    assert tris.dtype == np.int64 and np.array_equal(tris, np.vstack(want))
+    sizes = np.array([len(f) for f in faces])
+    assert np.array_equal(owner, np.repeat(np.arange(len(faces)), np.maximum(sizes - 2, 0)))
+
+
+def test_scene_meshes_number_their_points_in_order():
+    """Each patch kind's mesh holds the points its triangles use, in increasing order
+    (numpy.unique's numbering)."""
+    design = design_of("resch")
+    arrays = scene_arrays(design)
+    tris, owner = triangulate_faces(design.pattern.vertices_2d, design.pattern.faces)
+    kinds = np.array([p.split()[0] for p in design.pattern.face_patch])[owner]
+    v3 = arrays.to_scene(design.pattern.vertices_3d)
+    assert list(arrays.folded) == [k for k in ("cone", "cylinder", "face") if k in kinds]
+    for kind, (v, t) in arrays.folded.items():
+        used, inverse = np.unique(tris[kinds == kind], return_inverse=True)
+        assert np.array_equal(t, inverse.reshape(-1, 3)) and np.array_equal(v, v3[used])
+        flat_v, flat_t = arrays.flat[kind]
+        assert len(flat_v) == len(used) and np.array_equal(flat_t, t)
 
 
 def test_scene_arrays_match_the_pattern(cube_session):

@@ -184,12 +184,59 @@ def faces_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9) -> bool:
     """:meth:`Piece.overlaps` of the polygons ``faces`` (index lists) over ``points_2d`` (k, 2)."""
     if faces_interior_disjoint(points_2d, faces):
         return False
+    return measured_overlap(points_2d, faces, rel)
+
+
+#: Share of the faces' total area by which two faces must overlap for
+#: :func:`measured_overlap` to answer from them without the union: a million times its ``rel``,
+#: far beyond any rounding of the union's area.
+SURE_OVERLAP = 1e-6
+
+
+def measured_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9, pairs=None) -> bool:
+    """:func:`faces_overlap` without the proof: a face is not a valid polygon, or the union of
+    the faces is smaller than the sum of their areas by more than ``rel`` of it.
+
+    The union is not computed when two faces of ``pairs`` overlap by more than
+    :data:`SURE_OVERLAP` of the total area: the union is then smaller than the total by at least
+    that much (``|A u B u ...| <= |A| + |B| - |A n B| + ...``), far beyond ``rel``.
+
+    Parameters
+    ----------
+    points_2d : (k, 2) float
+    faces : list of list of int
+        Index lists into ``points_2d``.
+    rel : float
+    pairs : (m, 2) int, optional
+        Pairs of distinct faces likely to overlap, tried first.
+
+    Returns
+    -------
+    bool
+    """
     polys = face_polygons(points_2d, faces)
     if not shapely.is_valid(polys).all():
         return True
     total = shapely.area(polys).sum()
+    if pairs is not None and _clear_overlap(polys, np.asarray(pairs), SURE_OVERLAP * total):
+        return True
     union = shapely.union_all(polys).area
     return bool(union < total * (1 - rel))
+
+
+def _clear_overlap(polys: np.ndarray, pairs: np.ndarray, area: float) -> bool:
+    """Whether the valid polygons ``polys`` (n,) of some pair of ``pairs`` (m, 2) int overlap by
+    more than ``area`` (only pairs whose bounding boxes overlap by that much are intersected)."""
+    box = shapely.bounds(polys)  # (n, 4): xmin, ymin, xmax, ymax
+    a, b = box[pairs[:, 0]], box[pairs[:, 1]]
+    w = np.minimum(a[:, 2], b[:, 2]) - np.maximum(a[:, 0], b[:, 0])
+    h = np.minimum(a[:, 3], b[:, 3]) - np.maximum(a[:, 1], b[:, 1])
+    near = pairs[(w > 0) & (h > 0) & (w * h > area)]
+    if not len(near):
+        return False
+    return bool(
+        (shapely.area(shapely.intersection(polys[near[:, 0]], polys[near[:, 1]])) > area).any()
+    )
 
 
 def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: float):

@@ -96,7 +96,8 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
     """Triangles of many simple counter-clockwise polygons at once.
 
     Faces of one corner count are handled together: convex ones become fans in one array
-    operation, the others go through :func:`triangulate_polygon`.
+    operation, the others go through :func:`triangulate_polygon`. A face of ``k >= 3`` corners
+    gives ``k - 2`` triangles, placed face after face.
 
     Parameters
     ----------
@@ -109,30 +110,27 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
     triangles : (t, 3) int
         Indices into ``points_2d``.
     face : (t,) int
-        The face each triangle came from.
+        The face each triangle came from (non-decreasing).
     """
     p = np.asarray(points_2d, dtype=float)
-    sizes = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
-    tris, owner = [np.zeros((0, 3), np.int64)], [np.zeros(0, np.int64)]
-    for k in np.unique(sizes):
+    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    flat = np.concatenate(faces).astype(np.int64, copy=False) if faces else np.zeros(0, np.int64)
+    count = np.maximum(sizes - 2, 0)
+    start, t_start = np.cumsum(sizes) - sizes, np.cumsum(count) - count
+    triangles = np.zeros((int(count.sum()), 3), dtype=np.int64)
+    for k in np.unique(sizes[sizes >= 3]).tolist():
         which = np.flatnonzero(sizes == k)
-        f = np.array([faces[i] for i in which], dtype=np.int64).reshape(len(which), k)
-        if k < 3:
-            continue
+        f = flat[start[which][:, None] + np.arange(k)]
         q = p[f]
         turn = _cross(q - np.roll(q, 1, axis=1), np.roll(q, -1, axis=1) - q)
         scale = np.maximum(np.ptp(q, axis=1).max(axis=1) ** 2, 1e-300)
         convex = np.all(turn >= -1e-12 * scale[:, None], axis=1)
         fan = np.array([[0, i, i + 1] for i in range(1, k - 1)], dtype=np.int64)
-        tris.append(f[convex][:, fan].reshape(-1, 3))
-        owner.append(np.repeat(which[convex], k - 2))
-        for row, i in zip(f[~convex], which[~convex], strict=True):
-            t = row[triangulate_polygon(p[row])]
-            tris.append(t)
-            owner.append(np.full(len(t), i))
-    triangles, face = np.vstack(tris), np.concatenate(owner)
-    order = np.argsort(face, kind="stable")
-    return triangles[order], face[order]
+        rows = t_start[which][:, None] + np.arange(k - 2)
+        triangles[rows[convex]] = f[convex][:, fan]
+        for row, at in zip(f[~convex], rows[~convex], strict=True):
+            triangles[at] = row[triangulate_polygon(p[row])]
+    return triangles, np.repeat(np.arange(len(faces)), count)
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -241,14 +239,16 @@ def scene_arrays(design: Design) -> SceneArrays:
     v3, flat3 = out.to_scene(v3), out.to_scene(flat3)
 
     triangles, owner = triangulate_faces(v2, pattern.faces)
-    kinds = np.array([patch.split()[0] for patch in pattern.face_patch])
-    tri_kind = kinds[owner] if len(owner) else np.zeros(0, dtype=kinds.dtype)
-    for kind in [*PATCH_RGB, *sorted(set(kinds) - set(PATCH_RGB))]:
-        t = triangles[tri_kind == kind]
+    kind_of = {patch: patch.split()[0] for patch in set(pattern.face_patch)}
+    kinds = [*PATCH_RGB, *sorted(set(kind_of.values()) - set(PATCH_RGB))]
+    code = {patch: kinds.index(kind) for patch, kind in kind_of.items()}
+    face_kind = np.fromiter(map(code.__getitem__, pattern.face_patch), dtype=np.int64)
+    tri_kind = face_kind[owner]
+    for c, kind in enumerate(kinds):
+        t = triangles[tri_kind == c]
         if not len(t):
             continue
-        used, inverse = np.unique(t, return_inverse=True)
-        local = inverse.reshape(t.shape)
+        used, local = _compact(t, len(v2))
         out.folded[kind] = (v3[used], local)
         out.flat[kind] = (flat3[used], local)
     assign = np.asarray(pattern.edge_assignment)
@@ -268,3 +268,23 @@ def scene_arrays(design: Design) -> SceneArrays:
     marker = 0.08 * float(lengths.mean()) if len(lengths) else 0.05 * size
     out.point_size = marker * out.scale
     return out
+
+
+def _compact(index: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(index, return_inverse=True)`` of indices below ``n``, without sorting.
+
+    Parameters
+    ----------
+    index : (t, 3) int
+    n : int
+
+    Returns
+    -------
+    used : (u,) int
+        The indices that occur, increasing.
+    local : (t, 3) int
+        ``index`` renumbered into ``used``.
+    """
+    seen = np.zeros(n, dtype=bool)
+    seen[index] = True
+    return np.flatnonzero(seen), (np.cumsum(seen) - 1)[index]
