@@ -23,6 +23,8 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("numba")
 
@@ -320,3 +322,40 @@ def test_a_kernel_that_cannot_load_falls_back_to_numpy(monkeypatch):
     monkeypatch.setattr(batch_kernel, "AVAILABLE", False)
     with pytest.warns(RuntimeWarning, match="numba cannot be imported"):
         assert not batch.warm_kernel()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    groups=st.lists(st.integers(0, 40), min_size=0, max_size=400),
+    n_threads=st.integers(1, 5),
+)
+def test_parts_keep_a_problems_copies_together(groups, n_threads):
+    """Every problem in exactly one part; the copies of a problem (same group) in one part;
+    no part below MIN_PER_THREAD problems unless there is only one."""
+    groups = np.array(groups, dtype=np.int64)
+    _, dense = np.unique(groups, return_inverse=True)
+    parts = batch_kernel._parts(dense.reshape(-1), n_threads)
+    assert 1 <= len(parts) <= max(1, n_threads)
+    np.testing.assert_array_equal(np.sort(np.concatenate(parts)), np.arange(len(groups)))
+    owner = {}
+    for i, part in enumerate(parts):
+        for g in set(groups[part].tolist()):
+            assert owner.setdefault(g, i) == i
+    if len(parts) > 1:
+        assert min(len(p) for p in parts) >= 1
+        assert len(groups) >= batch_kernel.MIN_PER_THREAD * len(parts)
+
+
+def test_threads_give_the_results_of_one_thread(monkeypatch):
+    """A batch split over threads (parts by group) gives each problem the point and flag it
+    gets in one batch, in both phases."""
+    calls = recorded_calls(first_attempts("geodesic-sphere:level=3", 0.1, 0.3, 1.0))
+    big = [call for call in calls if len(call[3]) >= 2 * batch_kernel.MIN_PER_THREAD]
+    assert {call[4].get("stop_slack") is None for call in big} == {True, False}
+    for rows, q, c, y, kw in big:
+        monkeypatch.setenv("FILLETFOLD_THREADS", "1")
+        want = interior_point_numba(rows, q, c, y, **kw)
+        monkeypatch.setenv("FILLETFOLD_THREADS", "2")
+        got = interior_point_numba(rows, q, c, y, **kw)
+        np.testing.assert_array_equal(got[1], want[1])
+        np.testing.assert_array_equal(got[0][want[1]], want[0][want[1]])

@@ -28,13 +28,22 @@ a dozen array arguments costs ~100 ns, a problem's iteration ~1 µs), rows index
 count updates), the gradients stored by variable (``G[b, k, j] = A[b, j, k]``) so that the
 inner loops run over contiguous rows and vectorise.
 
+A batch of at least ``2 * MIN_PER_THREAD`` problems is split into parts (the copies of a
+problem in one part) that run in threads at once, the compiled kernel releasing the GIL
+(:func:`threads`; ``FILLETFOLD_THREADS`` sets their number). Each part is a batch of its own;
+a problem's iterations depend on the rest of its batch only through the rule for dropping
+finished problems, which changes nothing for a problem that converges.
+
 numba is optional: without it this module still imports, :data:`AVAILABLE` is False and
 :func:`interior_point_numba` runs the same code as plain (very slow) Python.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -92,25 +101,70 @@ def interior_point_numba(
     else:
         dense, n_groups = np.zeros(B, dtype=np.int64), 0
     f8 = np.float64
-    args = (
+    arrays = (
         np.ascontiguousarray(rows.a, dtype=f8),
         np.ascontiguousarray(np.asarray(rows.A, dtype=f8).transpose(0, 2, 1)),
         np.ascontiguousarray(rows.alpha, dtype=f8),
-        np.ascontiguousarray(rows.e, dtype=f8),
         np.ascontiguousarray(rows.mask, dtype=f8),
-        np.ascontiguousarray(q, dtype=f8),
         np.ascontiguousarray(c, dtype=f8),
         np.ascontiguousarray(y, dtype=f8),
-        -1 if stop_slack is None else int(stop_slack),
-        dense,
-        n_groups,
-        bool(give_up),
-        int(max_iter),
-        float(tol),
-        float(batch.T_CAP),
-        float(batch.STAT_TOL),
     )
-    return _kernel(*args)
+    e, q = np.ascontiguousarray(rows.e, dtype=f8), np.ascontiguousarray(q, dtype=f8)
+    rules = (bool(give_up), int(max_iter), float(tol), float(batch.T_CAP), float(batch.STAT_TOL))
+    slack = -1 if stop_slack is None else int(stop_slack)
+
+    def run(idx):
+        """The kernel on problems ``idx`` (all when None)."""
+        a, G, al, mf, c_, y_ = (x if idx is None else x[idx] for x in arrays)
+        grp = dense if idx is None else dense[idx]
+        if idx is not None and n_groups:
+            _, grp = np.unique(grp, return_inverse=True)
+        k = int(grp.max()) + 1 if n_groups and len(grp) else 0
+        return _kernel(a, G, al, e, mf, q, c_, y_, slack, grp.astype(np.int64), k, *rules)
+
+    parts = _parts(dense if n_groups else np.arange(B), threads())
+    if len(parts) == 1:
+        return run(None)
+    y_out, conv = np.empty((B, y.shape[1])), np.empty(B, dtype=bool)
+    for idx, (y_p, conv_p) in zip(parts, _pool().map(run, parts), strict=True):
+        y_out[idx], conv[idx] = y_p, conv_p
+    return y_out, conv
+
+
+#: Problems per thread below which the kernel runs in one thread.
+MIN_PER_THREAD = 64
+
+
+def threads() -> int:
+    """Threads the kernel may use: the CPUs this process may run on (``FILLETFOLD_THREADS``
+    sets it; 1 runs every batch in the calling thread)."""
+    env = os.environ.get("FILLETFOLD_THREADS", "")
+    if env.strip():
+        return max(1, int(env))
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _parts(groups: np.ndarray, n_threads: int) -> list[np.ndarray]:
+    """Problems split into at most ``n_threads`` parts of at least :data:`MIN_PER_THREAD`,
+    the copies of a problem (same ``groups`` value) in the same part.
+
+    Every problem's iterations are independent of the others' except through its group and
+    the batch's rule for dropping finished problems, so each part is a batch of its own.
+    """
+    n = min(n_threads, len(groups) // MIN_PER_THREAD)
+    if n <= 1:
+        return [np.arange(len(groups))]
+    part = np.minimum(groups * n // (int(groups.max()) + 1), n - 1)
+    return [np.flatnonzero(part == i) for i in range(n)]
+
+
+@functools.cache
+def _pool() -> ThreadPoolExecutor:
+    """The threads that run kernel parts (the compiled kernel releases the GIL)."""
+    return ThreadPoolExecutor(max_workers=threads(), thread_name_prefix="filletfold-kernel")
 
 
 # --------------------------------------------------------------------------- drivers
@@ -126,7 +180,7 @@ def interior_point_numba(
 # and its results: y (B, n) float, converged (B,) bool.
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _kernel(a, G, al, e, mf, q, c, y0, stop_slack, groups, n_groups, give_up, max_iter, tol,
             t_cap, stat_tol):  # fmt: skip
     """The iterations of all problems (see the comment above for the parameters)."""
