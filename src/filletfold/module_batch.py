@@ -24,7 +24,6 @@ A vertex takes the per-vertex :func:`~filletfold.module.build_module` instead wh
 from __future__ import annotations
 
 import dataclasses
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -118,11 +117,11 @@ def _batched_case(frame: VertexFrame, apex, v) -> bool:
         return False
     faces = np.asarray(frame.ring.faces).tolist()
     n = len(faces)
-    rounded = [m is not None for m in frame.cyl_map]
+    rounded = frame.rounded
     return (
         n > 0
-        and len(frame.sides) == n + (not closed)
-        and rounded == [closed or 0 < i < n for i in range(len(frame.sides))]
+        and len(rounded) == n + (not closed)
+        and (rounded.all() if closed else rounded.tolist() == [0 < i < n for i in range(n + 1)])
         and len(set(faces)) == n
         and not (np.asarray(frame.corner_angle) > np.pi).any()
     )
@@ -216,7 +215,7 @@ class _Chunk:
     def of(cls, frames: list, centres, n_samples, apices: list, developed: list) -> _Chunk:
         """The chunk of ``frames`` with their apices (None: a hole border)."""
         sa = _stack([_ring_arrays(f) for f in frames])
-        ne = np.array([len(f.sides) for f in frames], dtype=np.int64)
+        ne = np.array([f.n_sides for f in frames], dtype=np.int64)
         nf = np.array([len(f.ring.faces) for f in frames], dtype=np.int64)
         side_first = np.concatenate([[0], np.cumsum(ne)])
         sv = np.repeat(np.arange(len(frames)), ne)
@@ -230,21 +229,20 @@ class _Chunk:
         n = np.full(len(sv), n) if n.ndim == 0 else n[sa.edge]
         vi = np.einsum("kij,kj->ki", sa.Q, dev[sv]) + sa.t
         ring_face = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
-        chain = itertools.chain.from_iterable
         return cls(
             frames=frames,
             sides=sa,
             side_first=side_first,
             face_first=np.concatenate([[0], np.cumsum(nf)]),
             side_vertex=sv,
-            rounded=np.array([s.rounded for f in frames for s in f.sides], dtype=bool),
+            rounded=np.concatenate([f.rounded for f in frames]),
             samples=np.where(sa.arc > 0, n, 1).astype(np.int64),
-            cyl=_or_nan(list(chain(f.cyl_map for f in frames)), (3, 3)),
+            cyl=np.concatenate([f.cyl_maps for f in frames]),
             lmax_start=np.concatenate([f.lmax_start for f in frames]),
             lmax_end=np.concatenate([f.lmax_end for f in frames]),
             height=np.concatenate([hole_heights(f) for f in frames]),
-            face_map=np.array(list(chain(f.face_map for f in frames))),
-            face_frame=np.array(list(chain(f.face_frames for f in frames))),
+            face_map=np.concatenate([np.reshape(f.face_map, (-1, 3, 3)) for f in frames]),
+            face_frame=np.concatenate([np.reshape(f.face_frames, (-1, 3, 3)) for f in frames]),
             centre=np.asarray(centres)[ring_face],
             cone=cone,
             apex=apex,

@@ -19,6 +19,7 @@ angle defect; the developed apex is its fixed point (METHOD-NOTES, "one common 2
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -263,6 +264,67 @@ def stack_sides(sides: list, Q=None, t=None, face_normal=None) -> SideArrays:
 
 
 @dataclass
+class _SideStore:
+    """The sides of many vertices on flat arrays (:func:`vertex_frames`), from which each
+    vertex's :class:`Side` objects are made when first asked for (:class:`_Sides`)."""
+
+    sides: SideArrays
+    rounded: np.ndarray  # (P,) bool
+    gamma: np.ndarray  # (P,) float
+
+    def side(self, p: int) -> Side:
+        """Side ``p`` as a :class:`Side` (Python scalars, rows of the arrays as vectors)."""
+        sa = self.sides
+        head = (int(sa.edge[p]), bool(self.rounded[p]), sa.R[p], sa.M[p], float(sa.length[p]))
+        if not head[1]:
+            return Side(*head)
+        return Side(
+            *head,
+            float(sa.radius[p]),
+            float(self.gamma[p]),
+            float(sa.arc[p]),
+            int(sa.kappa[p]),
+            sa.O[p],
+            sa.N0[p],
+            sa.B[p],
+        )
+
+
+class _Sides(Sequence):
+    """The :class:`Side` objects of one vertex, made from a :class:`_SideStore` on first use."""
+
+    __slots__ = ("_items", "_lo", "_n", "_store")
+
+    def __init__(self, store: _SideStore, lo: int, hi: int):
+        self._store, self._lo, self._n, self._items = store, lo, hi - lo, None
+
+    def __len__(self) -> int:
+        return self._n
+
+    def __getitem__(self, i):
+        if self._items is None:
+            self._items = [self._store.side(p) for p in range(self._lo, self._lo + self._n)]
+        return self._items[i]
+
+
+class _Maps(Sequence):
+    """A vertex's cylinder maps: (3, 3) rows of an array, None on an unrounded side."""
+
+    __slots__ = ("maps", "rounded")
+
+    def __init__(self, maps: np.ndarray, rounded: np.ndarray):
+        self.maps, self.rounded = maps, rounded
+
+    def __len__(self) -> int:
+        return len(self.maps)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        return self.maps[i] if self.rounded[i] else None
+
+
+@dataclass
 class VertexFrame:
     """Sides, charts and 2D maps of one vertex.
 
@@ -271,13 +333,13 @@ class VertexFrame:
     vertex : int
     ring : VertexRing
     U : (3,) float
-    sides : list of Side
-        One per ring edge.
-    face_frames : list of (3, 3) float
+    sides : sequence of Side
+        One per ring edge (made on first use in the frames of :func:`vertex_frames`).
+    face_frames : sequence of (3, 3) float
         Chart of each ring face (origin U).
-    cyl_map : list of (3, 3) float or None
+    cyl_map : sequence of (3, 3) float or None
         Map of each rounded side's cylinder chart ``(s, z)`` into the common frame.
-    face_map : list of (3, 3) float
+    face_map : sequence of (3, 3) float
         Map of each ring face's chart into the common frame (for a closed ring, face ``n-1``
         maps by ``rho``, i.e. it is ``tau'``; ``tau`` itself is the identity).
     rho : (3, 3) float or None
@@ -309,6 +371,20 @@ class VertexFrame:
     @property
     def n_sides(self) -> int:
         return len(self.sides)
+
+    @property
+    def rounded(self) -> np.ndarray:
+        """(n_sides,) bool: which sides have a cylinder chart (``cyl_map`` not None)."""
+        if isinstance(self.cyl_map, _Maps):
+            return self.cyl_map.rounded
+        return np.array([m is not None for m in self.cyl_map], dtype=bool)
+
+    @property
+    def cyl_maps(self) -> np.ndarray:
+        """(n_sides, 3, 3) float: ``cyl_map`` as one array, NaN on an unrounded side."""
+        if isinstance(self.cyl_map, _Maps):
+            return self.cyl_map.maps
+        return np.array([np.full((3, 3), np.nan) if m is None else m for m in self.cyl_map])
 
     @functools.cached_property
     def arrays(self) -> SideArrays:
@@ -637,18 +713,8 @@ def vertex_frames(
     sa.t = -np.einsum("kij,kj->ki", sa.Q, cyl_map[:, :2, 2])
     sa.face_normal = np.cross(frames[:, 1], frames[:, 2])
 
-    # ---- objects
-    sides = []
-    columns = (edge, rounded, R, M, length, radius, gamma, arc, kappa, O, N0, B)
-    for e, rnd, r3, m3, ln, rad, gam, a, kap, o3, n3, b3 in zip(
-        *[c.tolist() if c.ndim == 1 else c for c in columns], strict=True
-    ):
-        if rnd:
-            sides.append(Side(e, True, r3, m3, ln, rad, gam, a, kap, o3, n3, b3))
-        else:
-            sides.append(Side(e, False, r3, m3, ln))
-    cyl_list = [m if r else None for m, r in zip(cyl_map, rounded.tolist(), strict=True)]
-    frame_list, face_map_list = list(frames), list(face_map)
+    # ---- objects: each vertex's views of the flat arrays (its Side objects made on first use)
+    store = _SideStore(sa, rounded, gamma)
     per_side = [(fd.name, getattr(sa, fd.name)) for fd in fields(SideArrays)]
     per_side = [(name, a) for name, a in per_side if name != "face_normal"]
     result = []
@@ -665,10 +731,10 @@ def vertex_frames(
             vertex=u,
             ring=ring,
             U=mesh.vertices[u],
-            sides=sides[s:s2],
-            face_frames=frame_list[f:f2],
-            cyl_map=cyl_list[s:s2],
-            face_map=face_map_list[f:f2],
+            sides=_Sides(store, s, s2),
+            face_frames=frames[f:f2],
+            cyl_map=_Maps(cyl_map[s:s2], rounded[s:s2]),
+            face_map=face_map[f:f2],
             rho=current[j] if ring.closed else None,
             lmax_start=lmax_start[s:s2],
             lmax_end=lmax_end[s:s2],
