@@ -38,6 +38,7 @@ from .module import (
     measured_overlap,
     polygon_area2,
 )
+from .parallel import thread_map
 from .vertex.apex import _stack
 from .vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
 
@@ -68,7 +69,8 @@ def build_modules(
     developed : sequence of ((2,) float or None)
         Its developed apex.
     progress : callable, optional
-        ``progress("surface", done, total)`` after every :data:`CHUNK` of vertices.
+        ``progress("surface", done, total)`` after every :data:`CHUNK` of vertices (chunks are
+        built in threads, :func:`~filletfold.parallel.thread_map`).
 
     Returns
     -------
@@ -87,8 +89,9 @@ def build_modules(
     ]
     if np.size(n_samples) == 0 or np.min(n_samples) < 1:
         batched = []  # no arc samples: let build_module handle (or refuse) it
-    for c in range(0, len(batched), CHUNK):
-        which = batched[c : c + CHUNK]
+    chunks = [batched[c : c + CHUNK] for c in range(0, len(batched), CHUNK)]
+
+    def chunk_modules(which: list) -> list:
         chunk = _Chunk.of(
             [frames[j] for j in which],
             centres,
@@ -96,10 +99,15 @@ def build_modules(
             [apices[j] for j in which],
             [developed[j] for j in which],
         )
-        for j, module in zip(which, _chunk_modules(chunk), strict=True):
+        return _chunk_modules(chunk)
+
+    done = 0
+    for which, built in zip(chunks, thread_map(chunk_modules, chunks), strict=True):
+        for j, module in zip(which, built, strict=True):
             modules[j] = module
+        done += len(which)
         if progress is not None:
-            progress("surface", c + len(which), len(frames))
+            progress("surface", done, len(frames))
     for j, module in enumerate(modules):
         if module is None:
             modules[j] = build_module(mesh, frames[j], centres, n_samples, apices[j], developed[j])

@@ -30,9 +30,9 @@ inner loops run over contiguous rows and vectorise.
 
 A batch of at least ``2 * MIN_PER_THREAD`` problems is split into parts (the copies of a
 problem in one part) that run in threads at once, the compiled kernel releasing the GIL
-(:func:`threads`; ``FILLETFOLD_THREADS`` sets their number). Each part is a batch of its own;
-a problem's iterations depend on the rest of its batch only through the rule for dropping
-finished problems, which changes nothing for a problem that converges.
+(:func:`filletfold.parallel.threads`; ``FILLETFOLD_THREADS`` sets their number). Each part
+is a batch of its own; a problem's iterations depend on the rest of its batch only through
+the rule for dropping finished problems, which changes nothing for a problem that converges.
 
 numba is optional: without it this module still imports, :data:`AVAILABLE` is False and
 :func:`interior_point_numba` runs the same code as plain (very slow) Python.
@@ -40,13 +40,12 @@ numba is optional: without it this module still imports, :data:`AVAILABLE` is Fa
 
 from __future__ import annotations
 
-import functools
 import math
-import os
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from ..parallel import thread_map, threads
 
 try:
     from numba import njit
@@ -126,25 +125,13 @@ def interior_point_numba(
     if len(parts) == 1:
         return run(None)
     y_out, conv = np.empty((B, y.shape[1])), np.empty(B, dtype=bool)
-    for idx, (y_p, conv_p) in zip(parts, _pool().map(run, parts), strict=True):
+    for idx, (y_p, conv_p) in zip(parts, thread_map(run, parts, "kernel"), strict=True):
         y_out[idx], conv[idx] = y_p, conv_p
     return y_out, conv
 
 
 #: Problems per thread below which the kernel runs in one thread.
 MIN_PER_THREAD = 64
-
-
-def threads() -> int:
-    """Threads the kernel may use: the CPUs this process may run on (``FILLETFOLD_THREADS``
-    sets it; 1 runs every batch in the calling thread)."""
-    env = os.environ.get("FILLETFOLD_THREADS", "")
-    if env.strip():
-        return max(1, int(env))
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not on Linux
-        return max(1, os.cpu_count() or 1)
 
 
 def _parts(groups: np.ndarray, n_threads: int) -> list[np.ndarray]:
@@ -159,12 +146,6 @@ def _parts(groups: np.ndarray, n_threads: int) -> list[np.ndarray]:
         return [np.arange(len(groups))]
     part = np.minimum(groups * n // (int(groups.max()) + 1), n - 1)
     return [np.flatnonzero(part == i) for i in range(n)]
-
-
-@functools.cache
-def _pool() -> ThreadPoolExecutor:
-    """The threads that run kernel parts (the compiled kernel releases the GIL)."""
-    return ThreadPoolExecutor(max_workers=threads(), thread_name_prefix="filletfold-kernel")
 
 
 # --------------------------------------------------------------------------- drivers

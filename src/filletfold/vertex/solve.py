@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..mesh.polymesh import PolyMesh
+from ..parallel import thread_map
 from ..rounding import EdgeRounding
 from ..tolerances import tol
 from . import batch
@@ -433,7 +434,8 @@ def solve_apices(
     All vertices still without a status are solved together, one attempt per round, by
     :func:`~filletfold.vertex.batch.solve_apex_batch`, and validated together by
     :func:`~filletfold.vertex.apex.validate_apices`, :data:`ROUND_SLICE` vertices at a time
-    (``progress`` is called after each); a vertex whose attempt fails the dense
+    (slices of a round in threads, :func:`~filletfold.parallel.thread_map`; ``progress`` is
+    called after each); a vertex whose attempt fails the dense
     validation goes to its next attempt in the next round (more samples and margin, shorter
     creases when a straight crease passes a face piece's centre, a tenth of the margin when
     the sampled problem is infeasible: see :data:`ATTEMPTS`).
@@ -473,8 +475,9 @@ def solve_apices(
     total = len(pending)
     while pending:  # one attempt per vertex and round, ROUND_SLICE vertices at a time
         order = list(pending)
-        for lo in range(0, len(order), ROUND_SLICE):
-            _solve_round(order[lo : lo + ROUND_SLICE], pending, res, out, centres)
+        slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
+        # the slices are independent (each settles its own vertices): in threads
+        for _ in thread_map(lambda part: _solve_round(part, pending, res, out, centres), slices):
             if progress is not None:
                 progress("apices", total - len(pending), total)
     return out
