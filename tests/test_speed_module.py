@@ -353,3 +353,23 @@ def test_merge_coincident_of_a_doubled_module(name):
         reference_merge(b, 1e-9)
         _same(a, b)
         assert len(a.points_2d) == len(piece.points_2d)
+
+
+def test_face_lists_read_as_lists_of_int():
+    """A batched piece's faces (one flat array) read exactly as the lists build_module makes,
+    and a face added afterwards turns them into a plain list."""
+    from filletfold.module import FaceLists, Piece
+
+    faces = FaceLists(np.array([0, 1, 2, 2, 1, 3, 4]), np.array([3, 4]))
+    assert len(faces) == 2 and faces[1] == [2, 1, 3, 4] and faces[-1] == [2, 1, 3, 4]
+    assert list(faces) == [[0, 1, 2], [2, 1, 3, 4]] == faces
+    assert all(type(i) is int for f in faces for i in f)
+    piece = Piece(
+        vertex=0,
+        points_2d=np.array([[0.0, 0], [1, 0], [0, 1], [1, 1], [2, 2]]),
+        points_3d=np.zeros((5, 3)),
+        faces=faces,
+        patches=["face 0", "face 1"],
+    )
+    piece.face([1, 4, 3], "face 2")
+    assert piece.faces == [[0, 1, 2], [2, 1, 3, 4], [1, 4, 3]]

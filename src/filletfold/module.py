@@ -18,6 +18,7 @@ into runs of consecutive sectors, each its own piece.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,6 +36,37 @@ from .vertex.apex import crease_length
 from .vertex.frame import VertexFrame, apply, stack_sides, to_chart
 
 
+class FaceLists(Sequence):
+    """A piece's faces held as one flat array of corner indices (with each face's corner
+    count), read as a list of lists of int; the lists are made on first use.
+
+    Parameters
+    ----------
+    flat : (m,) int
+        The corners of every face, face after face.
+    size : (n_faces,) int
+        Corners per face.
+    """
+
+    __slots__ = ("_lists", "flat", "size")
+
+    def __init__(self, flat: np.ndarray, size: np.ndarray):
+        self.flat, self.size, self._lists = flat, size, None
+
+    def __len__(self) -> int:
+        return len(self.size)
+
+    def __getitem__(self, i):
+        if self._lists is None:
+            values = self.flat.tolist()
+            bounds = np.concatenate([[0], np.cumsum(self.size)]).tolist()
+            self._lists = [values[a:b] for a, b in itertools.pairwise(bounds)]
+        return self._lists[i]
+
+    def __eq__(self, other) -> bool:
+        return list(self) == list(other)
+
+
 @dataclass
 class Piece:
     """One flat piece: points in 2D (piece frame) and 3D, polygon faces, patch names.
@@ -45,7 +77,7 @@ class Piece:
         The mesh vertex of the module.
     points_2d : (k, 2) float
     points_3d : (k, 3) float
-    faces : list of list of int
+    faces : list of list of int, or FaceLists
         Counter-clockwise in 2D.
     patches : list of str
     apex_index : int or None
@@ -120,6 +152,8 @@ class Piece:
             return
         if area < 0:
             out = out[::-1]
+        if isinstance(self.faces, FaceLists):
+            self.faces = list(self.faces)
         self.faces.append(out)
         self.patches.append(patch)
 
@@ -892,6 +926,17 @@ def _build_run(
     return piece, p2
 
 
+def _flat_faces(piece: Piece) -> tuple[np.ndarray, np.ndarray]:
+    """(m,) int corners of the piece's faces, face after face, and (n_faces,) int their
+    counts."""
+    faces = piece.faces
+    if isinstance(faces, FaceLists):
+        return faces.flat.astype(np.int64, copy=False), faces.size.astype(np.int64, copy=False)
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    flat = np.fromiter(itertools.chain.from_iterable(faces), dtype=np.int64, count=int(size.sum()))
+    return flat, size
+
+
 def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     """Merge translated pieces into one crease pattern, all faces at once.
 
@@ -913,20 +958,21 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     v2 = np.vstack([p2 for p2, _ in points]) if pieces else np.zeros((0, 2))
     v3 = np.vstack([p3 for _, p3 in points]) if pieces else np.zeros((0, 3))
     v2 = v2 + np.repeat(np.asarray(offsets, dtype=float).reshape(-1, 2), n_points, axis=0)
-    all_faces = list(itertools.chain.from_iterable(piece.faces for piece in pieces))
-    size = np.fromiter(map(len, all_faces), dtype=np.int64, count=len(all_faces))
-    flat = np.fromiter(
-        itertools.chain.from_iterable(all_faces), dtype=np.int64, count=int(size.sum())
-    )
+    flats, sizes = zip(*map(_flat_faces, pieces), strict=True) if pieces else ((), ())
+    size = np.concatenate([np.zeros(0, dtype=np.int64), *sizes])
+    flat = np.concatenate([np.zeros(0, dtype=np.int64), *flats])
     base = np.concatenate([[0], np.cumsum(n_points)[:-1]])
     flat += np.repeat(np.repeat(base, n_faces), size)
     start = np.concatenate([[0], np.cumsum(size)])
-    faces = [None] * len(all_faces)
-    for k in np.unique(size).tolist():  # faces of k corners as rows of one (n_k, k) block
-        idx = np.flatnonzero(size == k)
-        block = flat[start[idx][:, None] + np.arange(k)]
-        for i, row in zip(idx.tolist(), block, strict=True):
-            faces[i] = row
+    # faces of k corners as rows of one (n_k, k) block, put back in order
+    groups = [np.flatnonzero(size == k) for k in np.unique(size).tolist()]
+    rows = list(
+        itertools.chain.from_iterable(
+            flat[start[idx][:, None] + np.arange(size[idx[0]])] for idx in groups
+        )
+    )
+    order = np.argsort(np.concatenate([np.zeros(0, dtype=np.int64), *groups]), kind="stable")
+    faces = list(map(rows.__getitem__, order.tolist()))
     return CreasePattern(
         vertices_2d=v2,
         vertices_3d=v3,

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .module import (
+    FaceLists,
     Piece,
     _arc_parameters,
     apply_rows,
@@ -460,9 +461,10 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
     unused[flat] = False
     good[point_run[unused]] = False
     proved = faces_interior_disjoint_many(P2, flat, size, face_run, n_runs)
-    faces = _index_lists(corners - lay.first[face_run][:, None], size)
+    local = (corners - lay.first[face_run][:, None])[np.arange(_WIDTH) < size[:, None]]
     patches = list(map(chunk.patch.__getitem__, code.tolist()))
     fb = np.concatenate([[0], np.cumsum(np.bincount(face_run, minlength=n_runs))]).tolist()
+    cb = np.concatenate([[0], np.cumsum(size)])[fb].tolist()  # each run's first corner
     pb = lay.first.tolist()
     pieces = []
     for r, v in enumerate(lay.vertex.tolist()):
@@ -472,7 +474,7 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
                 vertex=chunk.frames[v].vertex,
                 points_2d=P2[a:b].copy(),
                 points_3d=P3[a:b].copy(),
-                faces=faces[fa:fz],
+                faces=FaceLists(local[cb[r] : cb[r + 1]], size[fa:fz]),
                 patches=patches[fa:fz],
                 apex_index=0 if chunk.cone[v] else None,
             )
@@ -620,19 +622,6 @@ def _oriented(P2: np.ndarray, corners: np.ndarray, size: np.ndarray):
         corners[rows, :w] = corners[rows, w - 1 :: -1]
         area[rows] = polygon_area2(P2[corners[rows, :w]])
     return keep, area
-
-
-def _index_lists(corners: np.ndarray, size: np.ndarray) -> list:
-    """Rows of ``corners`` (k, w) cut to their ``size`` (k,) as lists of int, in order."""
-    order, rows = [], []
-    for w in np.unique(size).tolist():
-        idx = np.flatnonzero(size == w)
-        order.append(idx)
-        rows += corners[idx, :w].tolist()
-    if not rows:
-        return []
-    inverse = np.argsort(np.concatenate(order), kind="stable")
-    return list(map(rows.__getitem__, inverse.tolist()))
 
 
 def _nothing_merges(
