@@ -363,3 +363,38 @@ def test_tolerances_are_used():
     mesh, log = clean_mesh(far, faces2)  # now a crack: face 0 no longer shares vertex 0
     assert log.merged_vertices == 0 and mesh.n_vertices == 9
     assert not mesh.is_closed
+
+
+@pytest.mark.parametrize(
+    "faces, message",
+    [
+        # the first repeat in face order, with the face it repeats (sizes mixed)
+        ([[0, 1, 2], [0, 2, 3], [3, 0, 1, 4], [2, 0, 1], [4, 1, 0, 3]], r"face 3: .* face 0"),
+        ([[0, 1, 2], [1, 2, 3, 4], [0, 2, 3], [4, 3, 2, 1], [2, 1, 0]], r"face 3: .* face 1"),
+    ],
+)
+def test_duplicate_faces_are_named_in_face_order(faces, message):
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.2], [0.5, -1, 0.3]], dtype=float)
+    with pytest.raises(MeshError, match=message + r" \(duplicate face\)"):
+        clean_mesh(v, [np.array(f) for f in faces])
+
+
+@pytest.mark.parametrize("bad", [[0, 1, 9], [0, -1, 2], [0.0, 1.5, 2.0], [0.0, np.nan, 2.0]])
+def test_face_arrays_are_checked_like_face_lists(bad):
+    """A rectangular face array (checked all at once) fails with the message of the
+    row-by-row check, at the same face."""
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    faces = [[0, 2, 1], [0, 1, 3], bad, [0, 3, 2]]
+    with pytest.raises(MeshError) as as_lists:
+        clean_mesh(v, [np.asarray(f) for f in faces[:2]] + [np.asarray(bad)] + [np.array(faces[3])])
+    with pytest.raises(MeshError) as as_array:
+        clean_mesh(v, np.array(faces, dtype=float if isinstance(bad[0], float) else int))
+    assert str(as_array.value) == str(as_lists.value) and as_array.value.face == 2
+
+
+def test_face_array_and_face_lists_give_one_mesh():
+    v, f = example_mesh("geodesic-sphere:level=2")
+    a, _ = clean_mesh(v, np.asarray(f))
+    b, _ = clean_mesh(v, [*[list(map(int, x)) for x in f][:-1], np.asarray(f[-1], dtype=float)])
+    np.testing.assert_array_equal(a.vertices, b.vertices)
+    assert [x.tolist() for x in a.faces] == [x.tolist() for x in b.faces]

@@ -175,6 +175,9 @@ def _validate(vertices, faces) -> tuple[np.ndarray, list[np.ndarray]]:
     if faces is None or len(faces) == 0:
         raise MeshError("the mesh is empty: it has no faces")
     n = len(v)
+    block = _face_block(faces)
+    if block is not None and _valid_block(block, n):
+        return v, list(block.astype(np.int64))
     out = []
     for i, f in enumerate(faces):
         a = np.asarray(f)
@@ -191,6 +194,29 @@ def _validate(vertices, faces) -> tuple[np.ndarray, list[np.ndarray]]:
             )
         out.append(a)
     return v, out
+
+
+def _face_block(faces) -> np.ndarray | None:
+    """The faces as one (n_faces, k) array of numbers when they all have ``k`` corners (a
+    numeric 2-D array, or a sequence of equal-length rows), else None."""
+    try:
+        block = np.asarray(faces)
+    except (TypeError, ValueError):  # ragged
+        return None
+    if block.ndim != 2 or block.dtype.kind not in "iuf":
+        return None
+    return block
+
+
+def _valid_block(block: np.ndarray, n: int) -> bool:
+    """Whether every row of ``block`` is a face of whole vertex indices in ``0 .. n - 1``: the
+    checks of :func:`_validate` on all rows at once (False: let the row-by-row checks find and
+    report the first bad face)."""
+    if block.dtype.kind == "f" and not (
+        np.isfinite(block).all() and (block == np.round(block)).all()
+    ):
+        return False
+    return block.size == 0 or (block.min() >= 0 and block.max() < n)
 
 
 # ------------------------------------------------------------------ 2. duplicates, degenerate
@@ -313,17 +339,33 @@ def _remap_faces(face_list, rep, v) -> list[np.ndarray]:
             f"(tol.area * mean_edge**2)",
             face=i,
         )
-    seen: dict[tuple, int] = {}
-    for i, f in enumerate(out):
-        key = tuple(sorted(f.tolist()))
-        if key in seen:
-            raise MeshError(
-                f"degenerate face {i}: it uses the same vertices as face {seen[key]} "
-                f"(duplicate face)",
-                face=i,
-            )
-        seen[key] = i
+    twin = _first_duplicate(fl)
+    if twin is not None:
+        i, first = twin
+        raise MeshError(
+            f"degenerate face {i}: it uses the same vertices as face {first} (duplicate face)",
+            face=i,
+        )
     return out
+
+
+def _first_duplicate(fl: _Flat) -> tuple[int, int] | None:
+    """The first face (in order) with the same set of vertices as an earlier face, and that
+    earlier face's index; None when every face has its own set."""
+    best = None
+    for k in np.unique(fl.size).tolist():
+        rows = np.flatnonzero(fl.size == k)
+        keys = np.sort(fl.index[fl.start[rows][:, None] + np.arange(k)], axis=1)
+        _, first, inverse, count = np.unique(
+            keys, axis=0, return_index=True, return_inverse=True, return_counts=True
+        )
+        inverse = inverse.reshape(-1)
+        later = np.flatnonzero((count[inverse] > 1) & (np.arange(len(rows)) != first[inverse]))
+        if len(later):
+            j = int(later[0])  # rows are in face order: the first repeat of its size
+            hit = (int(rows[j]), int(rows[first[inverse[j]]]))
+            best = hit if best is None or hit[0] < best[0] else best
+    return best
 
 
 # --------------------------------------------------------------------------- half-edges
