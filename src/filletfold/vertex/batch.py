@@ -63,6 +63,10 @@ T_CAP = 1e-3
 #: Stationarity (gradient of the Lagrangian over the size of its terms) at which a problem
 #: is done.
 STAT_TOL = 1e-8
+#: Mean complementarity at which phase 2 (the projection of ``P``) is done, relative to the
+#: squared length scale: its duality gap bounds the objective's error, so a target a hair
+#: from the feasible set (objective ~1e-7) still gets its optimum to ~1e-7 relative.
+PROJECTION_TOL = 1e-13
 #: Proximal weight of phase 1 (maximise t - PROX / 2 |y - y0|^2): keeps the search near its
 #: start, where the developed apex of a closed development would otherwise drift away.
 PROX = 1e-2
@@ -623,7 +627,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
     if len(solve):
         y[solve], converged[solve] = interior_point(
             rows.take(solve), np.full(n, 2.0), np.zeros((len(solve), n)), best[solve],
-            max_iter=max_iter,
+            max_iter=max_iter, tol=PROJECTION_TOL,
         )  # fmt: skip
     result = []
     for b, p in enumerate(problems):
