@@ -56,15 +56,32 @@ class FaceLists(Sequence):
     def __len__(self) -> int:
         return len(self.size)
 
-    def __getitem__(self, i):
+    def lists(self) -> list[list[int]]:
+        """The faces as lists of int (made once)."""
         if self._lists is None:
             values = self.flat.tolist()
             bounds = np.concatenate([[0], np.cumsum(self.size)]).tolist()
             self._lists = [values[a:b] for a, b in itertools.pairwise(bounds)]
-        return self._lists[i]
+        return self._lists
+
+    def __getitem__(self, i):
+        return self.lists()[i]
+
+    def __iter__(self):
+        return iter(self.lists())
 
     def __eq__(self, other) -> bool:
-        return list(self) == list(other)
+        return self.lists() == list(other)
+
+
+def flat_faces(faces) -> tuple[np.ndarray, np.ndarray]:
+    """(m,) int corners of ``faces`` (index lists, or :class:`FaceLists`), face after face,
+    and (n_faces,) int their counts."""
+    if isinstance(faces, FaceLists):
+        return faces.flat.astype(np.int64, copy=False), faces.size.astype(np.int64, copy=False)
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    flat = np.fromiter(itertools.chain.from_iterable(faces), dtype=np.int64, count=int(size.sum()))
+    return flat, size
 
 
 @dataclass
@@ -153,7 +170,7 @@ class Piece:
         if area < 0:
             out = out[::-1]
         if isinstance(self.faces, FaceLists):
-            self.faces = list(self.faces)
+            self.faces = list(self.faces.lists())
         self.faces.append(out)
         self.patches.append(patch)
 
@@ -186,11 +203,8 @@ class Piece:
         used = np.unique(flat)
         new = np.full(n, -1)
         new[used] = np.arange(len(used))
-        self.points_2d = [self.points_2d[i] for i in used.tolist()]
-        self.points_3d = [self.points_3d[i] for i in used.tolist()]
-        index = new[flat].tolist()
-        bounds = np.concatenate([[0], np.cumsum(size)]).tolist()
-        self.faces = [index[a:b] for a, b in itertools.pairwise(bounds)]
+        self.points_2d, self.points_3d = p2[used], p3[used]  # arrays, as compact() keeps them
+        self.faces = FaceLists(new[flat], size)
         self.patches = [p for p, k in zip(self.patches, kept.tolist(), strict=True) if k]
         self._keys = {k: int(new[root[i]]) for k, i in self._keys.items() if new[root[i]] >= 0}
         if self.apex_index is not None:
@@ -288,8 +302,8 @@ def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: floa
     kept : (n_faces,) bool
     """
     n_faces = len(faces)
-    size = np.fromiter(map(len, faces), dtype=np.int64, count=n_faces)
-    idx = root[np.fromiter(itertools.chain.from_iterable(faces), np.int64, int(size.sum()))]
+    flat, size = flat_faces(faces)
+    idx = root[flat]
     face = np.repeat(np.arange(n_faces), size)
     start = np.concatenate([[0], np.cumsum(size)])
     keep = np.ones(len(idx), dtype=bool)
@@ -323,8 +337,7 @@ def piece_area(piece: Piece) -> float:
 
 def face_polygons(points_2d: np.ndarray, faces) -> np.ndarray:
     """(n_faces,) shapely Polygons of faces given as index lists into ``points_2d`` (k, 2)."""
-    sizes = np.array([len(f) for f in faces])
-    idx = np.concatenate(faces)
+    idx, sizes = flat_faces(faces)
     rings = shapely.linearrings(points_2d[idx], indices=np.repeat(np.arange(len(faces)), sizes))
     return shapely.polygons(rings)
 
@@ -356,8 +369,7 @@ def faces_interior_disjoint(points_2d: np.ndarray, faces) -> bool:
     n_faces = len(faces)
     if n_faces == 0:
         return True
-    size = np.fromiter(map(len, faces), dtype=np.int64, count=n_faces)
-    flat = np.fromiter(itertools.chain.from_iterable(faces), np.int64, int(size.sum()))
+    flat, size = flat_faces(faces)
     piece = np.zeros(n_faces, dtype=np.int64)
     return bool(faces_interior_disjoint_many(points_2d, flat, size, piece, 1)[0])
 
@@ -926,17 +938,6 @@ def _build_run(
     return piece, p2
 
 
-def _flat_faces(piece: Piece) -> tuple[np.ndarray, np.ndarray]:
-    """(m,) int corners of the piece's faces, face after face, and (n_faces,) int their
-    counts."""
-    faces = piece.faces
-    if isinstance(faces, FaceLists):
-        return faces.flat.astype(np.int64, copy=False), faces.size.astype(np.int64, copy=False)
-    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    flat = np.fromiter(itertools.chain.from_iterable(faces), dtype=np.int64, count=int(size.sum()))
-    return flat, size
-
-
 def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     """Merge translated pieces into one crease pattern, all faces at once.
 
@@ -958,7 +959,7 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     v2 = np.vstack([p2 for p2, _ in points]) if pieces else np.zeros((0, 2))
     v3 = np.vstack([p3 for _, p3 in points]) if pieces else np.zeros((0, 3))
     v2 = v2 + np.repeat(np.asarray(offsets, dtype=float).reshape(-1, 2), n_points, axis=0)
-    flats, sizes = zip(*map(_flat_faces, pieces), strict=True) if pieces else ((), ())
+    flats, sizes = zip(*(flat_faces(p.faces) for p in pieces), strict=True) if pieces else ((), ())
     size = np.concatenate([np.zeros(0, dtype=np.int64), *sizes])
     flat = np.concatenate([np.zeros(0, dtype=np.int64), *flats])
     base = np.concatenate([[0], np.cumsum(n_points)[:-1]])

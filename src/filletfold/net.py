@@ -15,7 +15,7 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 
-from .module import Piece, face_polygons
+from .module import FaceLists, Piece, face_polygons, flat_faces
 
 
 def rigid_fit(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
@@ -59,14 +59,27 @@ def merge_pieces(
     pieces: list[Piece], placement: list[np.ndarray], eps: float, vertex: int = -1
 ) -> Piece:
     """One piece from placed pieces, with coincident points (2D and 3D) merged."""
-    out = Piece(vertex=vertex)
+    p2s, p3s, flats, sizes, patches = [], [], [], [], []
+    base = 0
     for piece, m in zip(pieces, placement, strict=True):
         p2, p3 = piece.arrays()
-        base = len(out.points_2d)
-        out.points_2d.extend(p2 @ m[:2, :2].T + m[:2, 2])
-        out.points_3d.extend(p3)
-        out.faces.extend([[i + base for i in f] for f in piece.faces])
-        out.patches.extend(piece.patches)
+        flat, size = flat_faces(piece.faces)
+        p2s.append(p2 @ m[:2, :2].T + m[:2, 2])
+        p3s.append(p3)
+        flats.append(flat + base)
+        sizes.append(size)
+        patches.extend(piece.patches)
+        base += len(p2)
+    out = Piece(
+        vertex=vertex,
+        points_2d=np.concatenate([np.zeros((0, 2)), *p2s]),
+        points_3d=np.concatenate([np.zeros((0, 3)), *p3s]),
+        faces=FaceLists(
+            np.concatenate([np.zeros(0, np.int64), *flats]),
+            np.concatenate([np.zeros(0, np.int64), *sizes]),
+        ),
+        patches=patches,
+    )
     out.merge_coincident(eps)
     return out
 
