@@ -262,7 +262,9 @@ def solve_material_loss(
         "b_eq": np.zeros(A_eq.shape[0]) if has_eq else None,
         "method": "highs",
     }
-    res = linprog(c, bounds=bounds, **lp)
+    # stage 1 by HiGHS' interior-point method (with crossover to a vertex): on large
+    # tessellations about twice as fast as its simplex on this max-min programme
+    res = linprog(c, bounds=bounds, **{**lp, "method": "highs-ipm"})
     if res.status == 0 and res.x[-1] > 0:
         # stage 2: among the solutions with every width >= b*, the smallest total loss; the
         # optimum of stage 1 leaves all widths but the smallest free, often at their caps
