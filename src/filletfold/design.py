@@ -190,7 +190,8 @@ def _stage_key(pm: PolyMesh, *params) -> tuple:
             return (a.shape, a.tobytes())
         return repr(x)
 
-    faces = tuple(tuple(int(i) for i in f) for f in pm.faces)
+    # the faces: each face's first corner and the corners' vertices, in order
+    faces = (pm.face_start.astype(np.int64).tobytes(), pm.halfedge_from.astype(np.int64).tobytes())
     return (pm.vertices.tobytes(), faces, *(plain(p) for p in params))
 
 
@@ -330,11 +331,13 @@ def use_cone_axes(mesh: PolyMesh, frames: list, res: VertexResult) -> None:
 
 def shelf_offsets(pieces: list[Piece], gap: float) -> np.ndarray:
     """(n_pieces, 2) translations laying pieces side by side in rows."""
-    boxes = []
-    for piece in pieces:
-        p2, _ = piece.arrays()
-        boxes.append([*p2.min(axis=0), *p2.max(axis=0)])
-    return shelf_layout(np.array(boxes), gap)
+    points = [np.asarray(piece.points_2d, dtype=float).reshape(-1, 2) for piece in pieces]
+    if not points:
+        return shelf_layout(np.zeros((0, 4)), gap)
+    p2 = np.concatenate(points)
+    first = np.cumsum([len(p) for p in points]) - [len(p) for p in points]
+    boxes = np.hstack([np.minimum.reduceat(p2, first), np.maximum.reduceat(p2, first)])
+    return shelf_layout(boxes, gap)
 
 
 def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
