@@ -153,18 +153,19 @@ def pack_problems(problems: Sequence[ApexConstraints], targets: np.ndarray, n: i
         return np.concatenate([getattr(p, name) for p in problems])
 
     Q, c, s = cat("quad_Q"), cat("quad_c"), cat("quad_s")
-    sign, coef = cat("quad_sign"), cat("quad_coef")
+    sign, coef, R_q = cat("quad_sign"), cat("quad_coef"), cat("quad_R")
     lin_a = cat("lin_a")
     V = T[:, :3]
     v = T[:, 3:5] if n == 5 else np.array([p.v_fixed for p in problems])
+    Lq, Vq = L[qb], V[qb]
     # ApexConstraints.values and .jacobian, row by row
     vi = np.einsum("qij,qj->qi", Q, v[qb]) + cat("quad_t")
-    d = V[qb] - c
+    d = Vq - c
     num = (vi[:, 0] - s) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", d, d)
-    dn = vi[:, 1] - np.einsum("ij,ij->i", V[qb] - cat("quad_M"), cat("quad_R"))
-    quad = (sign * num - coef * dn) / L[qb] + cat("quad_const")
+    dn = vi[:, 1] - np.einsum("ij,ij->i", Vq - cat("quad_M"), R_q)
+    quad = (sign * num - coef * dn) / Lq + cat("quad_const")
     lin = np.einsum("ij,ij->i", lin_a, V[lb]) + cat("lin_b")
-    g_quad = -2 * sign[:, None] * d + coef[:, None] * cat("quad_R")
+    g_quad = -2 * sign[:, None] * d + coef[:, None] * R_q
     if n == 5:
         r = vi - np.stack([s, np.zeros_like(s)], axis=1)
         g_v = 2 * sign[:, None] * np.einsum("qji,qj->qi", Q, r) - coef[:, None] * Q[:, 1, :]
@@ -177,13 +178,16 @@ def pack_problems(problems: Sequence[ApexConstraints], targets: np.ndarray, n: i
         np.array([-1.0, -1.0, -1.0, 1.0, 1.0][:n]),
         np.zeros((B, R), dtype=bool),
     )
-    q_at = np.arange(len(qb)) - (np.cumsum(nq) - nq)[qb]  # place of each row in its problem
-    l_at = np.arange(len(lb)) - (np.cumsum(nl) - nl)[lb] + nq[lb]
-    out.a[qb, q_at], out.a[lb, l_at] = quad / L[qb], lin / L[lb]
-    out.A[qb, q_at] = g_quad / L[qb, None]
-    out.A[lb, l_at, :3] = lin_a
-    out.alpha[qb, q_at] = sign / L[qb] * L[qb]
-    out.mask[qb, q_at] = out.mask[lb, l_at] = True
+    # each row's place in the padded block, as a flat index (b * R + place in its problem)
+    q_at = np.arange(len(qb)) + (qb * R - (np.cumsum(nq) - nq)[qb])
+    l_at = np.arange(len(lb)) + (lb * R - (np.cumsum(nl) - nl)[lb] + nq[lb])
+    a, alpha, mask = out.a.reshape(-1), out.alpha.reshape(-1), out.mask.reshape(-1)  # views
+    A = out.A.reshape(-1, n)
+    a[q_at], a[l_at] = quad / Lq, lin / L[lb]
+    A[q_at] = g_quad / Lq[:, None]
+    A[l_at, :3] = lin_a
+    alpha[q_at] = sign / Lq * Lq
+    mask[q_at] = mask[l_at] = True
     return out
 
 
