@@ -636,11 +636,12 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
             max_iter=max_iter, tol=PROJECTION_TOL,
         )  # fmt: skip
     result = []
+    X = T + L[:, None] * y  # the solved points (rows of feasible problems)
     for b, p in enumerate(problems):
         if at_target[b]:
             result.append(ApexSolution(True, T[b].copy(), [], True, "target"))
         elif feasible[b]:
-            x, how = T[b] + L[b] * y[b], "ipm"
+            x, how = X[b], "ipm"
             if not converged[b] and not kkt_point(p, T[b], x):
                 # rare: finish with SLSQP from the feasible point
                 x_s = project_slsqp(p, T[b], x)
