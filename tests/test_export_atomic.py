@@ -196,3 +196,17 @@ def test_contents_built_when_written_and_a_failing_build_writes_nothing(tmp_path
     assert calls == ["a", "b"] and not out.exists()
     write_outputs(out, {"a.txt": first, "b.bin": lambda: b"B"})
     assert (out / "a.txt").read_text() == "A" and (out / "b.bin").read_bytes() == b"B"
+
+
+def test_text_is_encoded_a_chunk_at_a_time(tmp_path, monkeypatch):
+    """Text is written as UTF-8 in chunks of characters (no encoded copy of the whole text):
+    the file holds exactly the text's encoding, multi-byte characters across chunk ends too."""
+    from filletfold.export import atomic
+
+    monkeypatch.setattr(atomic, "ENCODE_CHUNK", 3)
+    text = "aé€\U0001d11eb" * 7 + "\n"
+    write_outputs(tmp_path / "out", {"t.txt": text, "b.bin": b"\x00\xff"})
+    assert (tmp_path / "out" / "t.txt").read_bytes() == text.encode("utf-8")
+    assert (tmp_path / "out" / "b.bin").read_bytes() == b"\x00\xff"
+    write_file_atomic(tmp_path / "one.txt", text)
+    assert (tmp_path / "one.txt").read_bytes() == text.encode("utf-8")

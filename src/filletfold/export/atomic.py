@@ -24,15 +24,30 @@ from ..errors import ExportError
 __all__ = ["write_file_atomic", "write_outputs"]
 
 
-def _encode(name: str, data) -> bytes:
-    """Return ``data`` as bytes: ``str`` is encoded as UTF-8, bytes-like values are copied."""
+def _encode(name: str, data) -> str | bytes:
+    """``data`` ready for :func:`_write_all`: ``str`` as it is (encoded as UTF-8 while it is
+    written), bytes-like values as bytes."""
     if isinstance(data, str):
-        return data.encode("utf-8")
+        return data
     if isinstance(data, bytes | bytearray | memoryview):
         return bytes(data)
     raise ExportError(
         f"cannot write {name!r}: contents must be str or bytes, not {type(data).__name__}"
     )
+
+
+#: Characters of a text encoded at a time while it is written (the encoded copy of a whole
+#: large text would double the export's peak memory).
+ENCODE_CHUNK = 1 << 24
+
+
+def _write_all(fh, data: str | bytes) -> None:
+    """Write ``data`` to the binary file ``fh``, a ``str`` as UTF-8 a chunk at a time."""
+    if isinstance(data, bytes):
+        fh.write(data)
+        return
+    for i in range(0, len(data), ENCODE_CHUNK):
+        fh.write(data[i : i + ENCODE_CHUNK].encode("utf-8"))
 
 
 def _os_message(exc: OSError, what: str) -> str:
@@ -92,10 +107,10 @@ def _remove_dirs(created: list[Path]) -> None:
             break
 
 
-def _write_synced(path: Path, data: bytes) -> None:
+def _write_synced(path: Path, data: str | bytes) -> None:
     """Write ``data`` to a new file ``path`` and fsync it."""
     with open(path, "xb") as fh:
-        fh.write(data)
+        _write_all(fh, data)
         fh.flush()
         os.fsync(fh.fileno())
 
@@ -251,7 +266,7 @@ def write_file_atomic(path, data: str | bytes) -> Path:
         fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         tmp = Path(tmp_name)
         with os.fdopen(fd, "wb") as fh:
-            fh.write(payload)
+            _write_all(fh, payload)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
