@@ -373,3 +373,23 @@ def test_face_lists_read_as_lists_of_int():
     )
     piece.face([1, 4, 3], "face 2")
     assert piece.faces == [[0, 1, 2], [2, 1, 3, 4], [1, 4, 3]]
+
+
+def test_face_rows_read_as_the_list_of_face_arrays():
+    """An assembled pattern's faces (FaceRows: one flat array) index, slice and iterate as the
+    list of (k,) int64 arrays they replace; face_arrays gives their arrays back as they are."""
+    from filletfold.pattern import FaceRows, face_arrays
+
+    faces = [np.array([0, 1, 2]), np.array([2, 1, 3, 4]), np.array([4, 3, 5])]
+    flat, start = face_arrays(faces)
+    rows = FaceRows(flat, start)
+    assert len(rows) == 3 and bool(rows) and not bool(FaceRows(flat[:0], start[:1]))
+    for got in (list(rows), rows[:], [rows[i] for i in range(3)], [rows[-3], rows[-2], rows[-1]]):
+        assert [g.tolist() for g in got] == [f.tolist() for f in faces]
+        assert all(g.dtype == np.int64 for g in got)
+    assert rows[np.int64(1)].tolist() == [2, 1, 3, 4]
+    with pytest.raises(IndexError):
+        rows[3]
+    got_flat, got_start = face_arrays(rows)
+    assert got_flat is flat and got_start is start
+    assert list(FaceRows(flat[:0], start[:1])) == []

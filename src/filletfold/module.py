@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 
 from .errors import MeshError
 from .mesh.polymesh import PolyMesh
-from .pattern import CreasePattern
+from .pattern import CreasePattern, FaceRows
 from .rounding import EdgeRounding
 from .tolerances import tol
 from .vertex.apex import crease_length
@@ -951,7 +951,8 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     -------
     CreasePattern
         Vertices piece after piece (each piece's points in order, translated), faces as
-        ``(k,) int64`` arrays piece after piece, with their patches and pieces.
+        ``(k,) int64`` arrays piece after piece (:class:`~filletfold.pattern.FaceRows`), with
+        their patches and pieces.
     """
     points = [piece.arrays() for piece in pieces]
     n_points = np.array([len(p2) for p2, _ in points], dtype=np.int64)
@@ -965,15 +966,7 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     base = np.concatenate([[0], np.cumsum(n_points)[:-1]])
     flat += np.repeat(np.repeat(base, n_faces), size)
     start = np.concatenate([[0], np.cumsum(size)])
-    # faces of k corners as rows of one (n_k, k) block, put back in order
-    groups = [np.flatnonzero(size == k) for k in np.unique(size).tolist()]
-    rows = list(
-        itertools.chain.from_iterable(
-            flat[start[idx][:, None] + np.arange(size[idx[0]])] for idx in groups
-        )
-    )
-    order = np.argsort(np.concatenate([np.zeros(0, dtype=np.int64), *groups]), kind="stable")
-    faces = list(map(rows.__getitem__, order.tolist()))
+    faces = FaceRows(flat, start)  # (k,) int64 rows made when asked for
     return CreasePattern(
         vertices_2d=v2,
         vertices_3d=v3,

@@ -7,6 +7,7 @@ the flat layout) and a 3D position (in the folded form); faces are polygons coun
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -15,6 +16,68 @@ from .tolerances import tol
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
 NORMAL_CHUNK = 100_000
+
+
+class FaceRows(Sequence):
+    """Polygons held as one flat index array and their offsets, read as (k,) int arrays.
+
+    What :func:`~filletfold.module.assemble_pattern` gives a pattern: no array object per
+    face until one is asked for.
+
+    Parameters
+    ----------
+    flat : (h,) int64
+        The faces' vertex indices, one face after the other.
+    start : (n_faces + 1,) int64
+        Face ``i`` is ``flat[start[i]:start[i + 1]]``.
+    """
+
+    __slots__ = ("flat", "start")
+
+    def __init__(self, flat: np.ndarray, start: np.ndarray):
+        self.flat, self.start = flat, start
+
+    def __len__(self) -> int:
+        return len(self.start) - 1
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"face {i} out of range ({n} faces)")
+        i = int(i) % n
+        return self.flat[self.start[i] : self.start[i + 1]]
+
+    def __iter__(self):
+        return iter(np.split(self.flat, self.start[1:-1]) if len(self) else [])
+
+
+def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
+    """Faces as one flat index array and their offsets.
+
+    Parameters
+    ----------
+    faces : FaceRows, or list of (k,) int
+
+    Returns
+    -------
+    flat : (h,) int
+        The faces' vertex indices, one face after the other.
+    start : (n_faces + 1,) int
+        Face ``i`` is ``flat[start[i]:start[i + 1]]``.
+    """
+    if isinstance(faces, FaceRows):
+        return faces.flat, faces.start
+    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    start = np.zeros(len(faces) + 1, dtype=np.int64)
+    np.cumsum(sizes, out=start[1:])
+    if len(faces) == 0:
+        return np.zeros(0, dtype=np.int64), start
+    flat = np.concatenate(faces)
+    if np.issubdtype(flat.dtype, np.integer):
+        flat = flat.astype(np.int64, copy=False)
+    return flat, start
 
 
 @dataclass
@@ -74,7 +137,7 @@ class CreasePattern:
         Positions in the flat layout (same length unit as the mesh).
     vertices_3d : (n, 3) float
         Positions in the folded form.
-    faces : list of (k,) int
+    faces : list of (k,) int, or FaceRows
         Polygons, counter-clockwise in 2D.
     face_patch : list of str
         The surface patch of each face: ``"cone <vertex>"``, ``"cylinder <edge>"`` or
@@ -169,10 +232,8 @@ class CreasePattern:
     def _halfedges(self):
         """(from (h,), to (h,), face_start (n_faces + 1,), next (h,)) of the faces'
         half-edges; ``next`` is the following half-edge of the same face."""
-        sizes = np.fromiter(map(len, self.faces), dtype=np.int64, count=len(self.faces))
-        start = np.zeros(len(sizes) + 1, dtype=np.int64)
-        np.cumsum(sizes, out=start[1:])
-        a = np.concatenate(self.faces).astype(np.int64)
+        a, start = face_arrays(self.faces)
+        a = a.astype(np.int64, copy=False)
         nxt = np.arange(len(a)) + 1
         nxt[start[1:] - 1] = start[:-1]
         return a, a[nxt], start, nxt

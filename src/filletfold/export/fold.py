@@ -19,7 +19,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ExportError, ParameterError
-from ..pattern import Annotations, CreasePattern
+from ..pattern import Annotations, CreasePattern, FaceRows, face_arrays
 from ..tolerances import tol
 
 __all__ = [
@@ -84,36 +84,11 @@ def _signed_area(vertices_2d: np.ndarray, a: np.ndarray, start: np.ndarray) -> n
     return 0.5 * np.add.reduceat(cross, start[:-1])
 
 
-def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
-    """Faces as one flat index array and their offsets.
-
-    Parameters
-    ----------
-    faces : list of (k,) int
-
-    Returns
-    -------
-    flat : (h,) int
-        The faces' vertex indices, one face after the other.
-    start : (n_faces + 1,) int
-        Face ``i`` is ``flat[start[i]:start[i + 1]]``.
-    """
-    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    start = np.zeros(len(faces) + 1, dtype=np.int64)
-    np.cumsum(sizes, out=start[1:])
-    if len(faces) == 0:
-        return np.zeros(0, dtype=np.int64), start
-    flat = np.concatenate(faces)
-    if np.issubdtype(flat.dtype, np.integer):
-        flat = flat.astype(np.int64, copy=False)
-    return flat, start
-
-
 def _face_arrays_if_valid(faces, n: int) -> tuple[np.ndarray, np.ndarray] | None:
     """:func:`face_arrays` when every face is a 1-D list of at least 3 integer indices in
     ``0..n-1``, checked all at once; None otherwise (or when the faces cannot be read that
     way): :func:`validate_pattern` then finds the first bad face."""
-    if not _integer_faces(faces):
+    if not isinstance(faces, FaceRows) and not _integer_faces(faces):  # (FaceRows: integers)
         return None
     try:
         flat, start = face_arrays(faces)
