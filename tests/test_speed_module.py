@@ -360,7 +360,7 @@ def test_face_lists_read_as_lists_of_int():
     and a face added afterwards turns them into a plain list."""
     from filletfold.module import FaceLists, Piece
 
-    faces = FaceLists(np.array([0, 1, 2, 2, 1, 3, 4]), np.array([3, 4]))
+    faces = FaceLists.of_sizes(np.array([0, 1, 2, 2, 1, 3, 4]), np.array([3, 4]))
     assert len(faces) == 2 and faces[1] == [2, 1, 3, 4] and faces[-1] == [2, 1, 3, 4]
     assert list(faces) == [[0, 1, 2], [2, 1, 3, 4]] == faces
     assert all(type(i) is int for f in faces for i in f)

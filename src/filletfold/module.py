@@ -18,7 +18,6 @@ into runs of consecutive sectors, each its own piece.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,39 +28,28 @@ from scipy.spatial import cKDTree
 
 from .errors import MeshError
 from .mesh.polymesh import PolyMesh
-from .pattern import CreasePattern, FaceRows
+from .pattern import CreasePattern, FaceRows, FlatFaces
 from .rounding import EdgeRounding
 from .tolerances import tol
 from .vertex.apex import crease_length
 from .vertex.frame import VertexFrame, apply, stack_sides, to_chart
 
 
-class FaceLists(Sequence):
-    """A piece's faces held as one flat array of corner indices (with each face's corner
-    count), read as a list of lists of int; the lists are made on first use.
+class FaceLists(FlatFaces):
+    """A piece's faces as :class:`~filletfold.pattern.FlatFaces`, read as a list of lists of
+    int (made on first use, as :func:`build_module` makes them)."""
 
-    Parameters
-    ----------
-    flat : (m,) int
-        The corners of every face, face after face.
-    size : (n_faces,) int
-        Corners per face.
-    """
+    __slots__ = ("_lists",)
 
-    __slots__ = ("_lists", "flat", "size")
-
-    def __init__(self, flat: np.ndarray, size: np.ndarray):
-        self.flat, self.size, self._lists = flat, size, None
-
-    def __len__(self) -> int:
-        return len(self.size)
+    def __init__(self, flat: np.ndarray, start: np.ndarray):
+        super().__init__(flat, start)
+        self._lists = None
 
     def lists(self) -> list[list[int]]:
         """The faces as lists of int (made once)."""
         if self._lists is None:
             values = self.flat.tolist()
-            bounds = np.concatenate([[0], np.cumsum(self.size)]).tolist()
-            self._lists = [values[a:b] for a, b in itertools.pairwise(bounds)]
+            self._lists = [values[a:b] for a, b in itertools.pairwise(self.start.tolist())]
         return self._lists
 
     def __getitem__(self, i):
@@ -75,10 +63,11 @@ class FaceLists(Sequence):
 
 
 def flat_faces(faces) -> tuple[np.ndarray, np.ndarray]:
-    """(m,) int corners of ``faces`` (index lists, or :class:`FaceLists`), face after face,
-    and (n_faces,) int their counts."""
-    if isinstance(faces, FaceLists):
-        return faces.flat.astype(np.int64, copy=False), faces.size.astype(np.int64, copy=False)
+    """(m,) int64 corners of ``faces`` (:class:`~filletfold.pattern.FlatFaces`, or index
+    lists: read in one pass over their values), face after face, and (n_faces,) int64 their
+    counts."""
+    if isinstance(faces, FlatFaces):
+        return faces.flat, np.diff(faces.start)
     size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
     flat = np.fromiter(itertools.chain.from_iterable(faces), dtype=np.int64, count=int(size.sum()))
     return flat, size
@@ -204,7 +193,7 @@ class Piece:
         new = np.full(n, -1)
         new[used] = np.arange(len(used))
         self.points_2d, self.points_3d = p2[used], p3[used]  # arrays, as compact() keeps them
-        self.faces = FaceLists(new[flat], size)
+        self.faces = FaceLists.of_sizes(new[flat], size)
         self.patches = [p for p, k in zip(self.patches, kept.tolist(), strict=True) if k]
         self._keys = {k: int(new[root[i]]) for k, i in self._keys.items() if new[root[i]] >= 0}
         if self.apex_index is not None:

@@ -474,7 +474,7 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
                 vertex=chunk.frames[v].vertex,
                 points_2d=P2[a:b].copy(),
                 points_3d=P3[a:b].copy(),
-                faces=FaceLists(local[cb[r] : cb[r + 1]], size[fa:fz]),
+                faces=FaceLists.of_sizes(local[cb[r] : cb[r + 1]], size[fa:fz]),
                 patches=patches[fa:fz],
                 apex_index=0 if chunk.cone[v] else None,
             )

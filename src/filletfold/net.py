@@ -74,7 +74,7 @@ def merge_pieces(
         vertex=vertex,
         points_2d=np.concatenate([np.zeros((0, 2)), *p2s]),
         points_3d=np.concatenate([np.zeros((0, 3)), *p3s]),
-        faces=FaceLists(
+        faces=FaceLists.of_sizes(
             np.concatenate([np.zeros(0, np.int64), *flats]),
             np.concatenate([np.zeros(0, np.int64), *sizes]),
         ),

@@ -18,27 +18,40 @@ from .tolerances import tol
 NORMAL_CHUNK = 100_000
 
 
-class FaceRows(Sequence):
-    """Polygons held as one flat index array and their offsets, read as (k,) int arrays.
-
-    What :func:`~filletfold.module.assemble_pattern` gives a pattern: no array object per
-    face until one is asked for.
+class FlatFaces(Sequence):
+    """Polygons held as one flat index array and their offsets: no object per face until one
+    is asked for. The base of :class:`FaceRows` (faces read as (k,) int64 arrays) and
+    :class:`~filletfold.module.FaceLists` (faces read as lists of int); :func:`face_arrays`
+    hands their arrays out as they are.
 
     Parameters
     ----------
-    flat : (h,) int64
+    flat : (h,) int
         The faces' vertex indices, one face after the other.
-    start : (n_faces + 1,) int64
+    start : (n_faces + 1,) int
         Face ``i`` is ``flat[start[i]:start[i + 1]]``.
     """
 
     __slots__ = ("flat", "start")
 
     def __init__(self, flat: np.ndarray, start: np.ndarray):
-        self.flat, self.start = flat, start
+        self.flat = np.asarray(flat, dtype=np.int64)
+        self.start = np.asarray(start, dtype=np.int64)
+
+    @classmethod
+    def of_sizes(cls, flat: np.ndarray, size: np.ndarray):
+        """The faces of ``size`` (n_faces,) corners each, their corners ``flat``."""
+        return cls(flat, np.concatenate([[0], np.cumsum(size, dtype=np.int64)]))
 
     def __len__(self) -> int:
         return len(self.start) - 1
+
+
+class FaceRows(FlatFaces):
+    """:class:`FlatFaces` read as (k,) int64 arrays (views of ``flat``): what
+    :func:`~filletfold.module.assemble_pattern` gives a pattern."""
+
+    __slots__ = ()
 
     def __getitem__(self, i):
         if isinstance(i, slice):
@@ -58,7 +71,7 @@ def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    faces : FaceRows, or list of (k,) int
+    faces : FlatFaces, or list of (k,) int
 
     Returns
     -------
@@ -67,7 +80,7 @@ def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
     start : (n_faces + 1,) int
         Face ``i`` is ``flat[start[i]:start[i + 1]]``.
     """
-    if isinstance(faces, FaceRows):
+    if isinstance(faces, FlatFaces):
         return faces.flat, faces.start
     sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
     start = np.zeros(len(faces) + 1, dtype=np.int64)

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ExportError, ParameterError
-from ..pattern import Annotations, CreasePattern, FaceRows, face_arrays
+from ..pattern import Annotations, CreasePattern, FlatFaces, face_arrays
 from ..tolerances import tol
 
 __all__ = [
@@ -88,7 +88,7 @@ def _face_arrays_if_valid(faces, n: int) -> tuple[np.ndarray, np.ndarray] | None
     """:func:`face_arrays` when every face is a 1-D list of at least 3 integer indices in
     ``0..n-1``, checked all at once; None otherwise (or when the faces cannot be read that
     way): :func:`validate_pattern` then finds the first bad face."""
-    if not isinstance(faces, FaceRows) and not _integer_faces(faces):  # (FaceRows: integers)
+    if not isinstance(faces, FlatFaces) and not _integer_faces(faces):  # (integers as made)
         return None
     try:
         flat, start = face_arrays(faces)
