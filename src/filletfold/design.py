@@ -335,7 +335,8 @@ def shelf_offsets(pieces: list[Piece], gap: float) -> np.ndarray:
     if not points:
         return shelf_layout(np.zeros((0, 4)), gap)
     p2 = np.concatenate(points)
-    first = np.cumsum([len(p) for p in points]) - [len(p) for p in points]
+    count = np.array([len(p) for p in points])
+    first = np.cumsum(count) - count
     boxes = np.hstack([np.minimum.reduceat(p2, first), np.maximum.reduceat(p2, first)])
     return shelf_layout(boxes, gap)
 

@@ -216,7 +216,8 @@ def build_constraints_many(
         side, s = np.concatenate([side, x_side])[order], np.concatenate([s, x_s])[order]
         C, N = np.vstack([C, x_C])[order], np.vstack([N, x_N])[order]
         n_x = np.bincount(x_vert, minlength=n)
-        first, last = first + (np.cumsum(n_x) - n_x)[sv], last + (np.cumsum(n_x) - n_x)[sv]
+        shift = (np.cumsum(n_x) - n_x)[sv]  # extra samples of the vertices before
+        first, last = first + shift, last + shift
     m = np.bincount(sv[side], minlength=n)  # samples per vertex
     mo, mv = np.cumsum(m) - m, np.repeat(np.arange(n), m)  # first sample, vertex of each
     margin = np.asarray(margins, dtype=float).reshape(n)

@@ -172,7 +172,7 @@ def classify_vertices(
             frame = frames[k]
             res.kind[u] = "developable"
             gap = float(np.linalg.norm(frame.rho[:2, 2]))
-            scale = float(np.mean([s.length for s in frame.sides]))
+            scale = float(frame.arrays.length.mean())
             if gap > tol.closure * scale or b <= tol.normal_bound:
                 res.status[u] = "developable"
                 res.reason[u] = (
@@ -206,10 +206,10 @@ def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
     vertex's common frame, or None when every consecutive pair is parallel.
     """
     lines = []
-    for i, side in enumerate(frame.sides):
-        if side.arc > 0:
+    for i, arc in enumerate(frame.arrays.arc.tolist()):
+        if arc > 0:
             m = frame.cyl_map[i]
-            lines.append((m[:2, :2] @ [0.5 * side.arc, 0.0] + m[:2, 2], m[:2, :2] @ [0.0, 1.0]))
+            lines.append((m[:2, :2] @ [0.5 * arc, 0.0] + m[:2, 2], m[:2, :2] @ [0.0, 1.0]))
     for (p1, d1), (p2, d2) in zip(lines, lines[1:] + lines[:1], strict=True):
         a = np.stack([d1, -d2], axis=1)
         if abs(np.linalg.det(a)) > 1e-6:
