@@ -55,3 +55,11 @@ def test_designs_in_threads_are_those_of_one_thread(name, kwargs, monkeypatch):
     for field in ("vertices_2d", "vertices_3d", "edges", "edge_assignment", "edge_fold_angle"):
         np.testing.assert_array_equal(getattr(one.pattern, field), getattr(two.pattern, field))
     assert [f.tolist() for f in one.pattern.faces] == [f.tolist() for f in two.pattern.faces]
+
+
+def test_threads_reject_a_value_that_is_not_a_number(monkeypatch):
+    from filletfold.errors import ParameterError
+
+    monkeypatch.setenv("FILLETFOLD_THREADS", "two")
+    with pytest.raises(ParameterError, match="FILLETFOLD_THREADS must be a whole number"):
+        parallel.threads()

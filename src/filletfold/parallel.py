@@ -13,6 +13,8 @@ import os
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 
+from .errors import ParameterError
+
 __all__ = ["thread_map", "threads"]
 
 
@@ -21,7 +23,13 @@ def threads() -> int:
     (1 runs everything in the calling thread)."""
     env = os.environ.get("FILLETFOLD_THREADS", "").strip()
     if env:
-        return max(1, int(env))
+        try:
+            return max(1, int(env))
+        except ValueError:
+            raise ParameterError(
+                f"FILLETFOLD_THREADS must be a whole number of threads, got {env!r}",
+                name="FILLETFOLD_THREADS",
+            ) from None
     try:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # pragma: no cover - not on Linux
