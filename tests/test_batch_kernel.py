@@ -359,3 +359,23 @@ def test_threads_give_the_results_of_one_thread(monkeypatch):
         got = interior_point_numba(rows, q, c, y, **kw)
         np.testing.assert_array_equal(got[1], want[1])
         np.testing.assert_array_equal(got[0][want[1]], want[0][want[1]])
+
+
+def test_a_bad_thread_count_is_reported_not_taken_for_a_broken_kernel(monkeypatch):
+    """FILLETFOLD_THREADS that is not a number stops the design with its own error; the
+    kernel is not turned off as if numba had failed."""
+    import warnings
+
+    from filletfold.errors import ParameterError
+
+    calls = recorded_calls(first_attempts("geodesic-sphere:level=3", 0.1, 0.3, 1.0))
+    rows, q, c, y, kw = max(calls, key=lambda call: len(call[3]))
+    monkeypatch.setattr(batch, "USE_KERNEL", True)
+    monkeypatch.setattr(batch, "_kernel_loaded", False)
+    monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", 0)
+    monkeypatch.setenv("FILLETFOLD_THREADS", "two")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ParameterError, match="FILLETFOLD_THREADS"):
+            batch.interior_point(rows, q, c, y, **kw)
+    assert batch.USE_KERNEL

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import nnls
 
+from ..errors import FilletfoldError
 from .apex import ApexConstraints, ApexSolution
 from .reference import project_slsqp, solve_apex_slsqp
 
@@ -233,6 +234,8 @@ def _kernel(rows: RowBlock, q, c, y, **kwargs):
         if not batch_kernel.AVAILABLE:
             raise ImportError("numba cannot be imported")
         out = batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
+    except FilletfoldError:  # the user's error (e.g. FILLETFOLD_THREADS), not numba's
+        raise
     except Exception as exc:  # only the first call (import and compile) is guarded
         _turn_kernel_off(f"{type(exc).__name__}: {exc}")
         return interior_point_numpy(rows, q, c, y, **kwargs)
