@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from filletfold.errors import MeshError
 from filletfold.mesh import CleanLog, PolyMesh, clean_mesh, example_mesh
 from filletfold.tolerances import tol
 
-from .conftest import signed_volume
+from .conftest import random_convex, signed_volume
 
 
 def cube():
@@ -154,24 +156,54 @@ def test_unreferenced_vertices_are_removed():
     assert_allclose(log.vertex_map[1:], np.arange(8))
 
 
-def test_non_convex_polygons_are_kept_and_triangles_merged_into_them():
+def boundary_loops(mesh: PolyMesh) -> int:
+    """Number of boundary loops of a mesh."""
+    b = mesh.edges[mesh.is_boundary_edge]
+    if not len(b):
+        return 0
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    graph = coo_matrix((np.ones(len(b)), (b[:, 0], b[:, 1])), shape=(mesh.n_vertices,) * 2)
+    _, label = connected_components(graph, directed=False)
+    return len(np.unique(label[b[:, 0]]))
+
+
+def assert_convex_planar(mesh: PolyMesh):
+    assert mesh.corner_angles().max() <= np.pi + tol.angle
+    for f, n in zip(mesh.faces, mesh.face_normal, strict=True):
+        p = mesh.vertices[f]
+        assert np.abs((p - p[0]) @ n).max() <= tol.planar * np.ptp(p, axis=0).max()
+
+
+@pytest.mark.parametrize("as_triangles", [False, True])
+def test_non_convex_polygons_become_convex_parts(as_triangles):
+    """An L-shaped face (given as a hexagon, or as a fan of triangles) is split into convex
+    parts: a reflex corner would leave its vertex without a cone."""
     v, faces = example_mesh("l-prism")
-    tris = []
-    for f in faces:
-        if len(f) == 6:  # fan from the corner opposite the reflex corner
-            j = int(np.argmax([np.abs(v[i, :2] - v[f, :2].min(axis=0)).sum() == 0 for i in f]))
-            g = np.roll(f, -j)
-            tris += [g[[0, i, i + 1]] for i in range(1, 5)]
-        else:
-            tris += [f[[0, 1, 2]], f[[0, 2, 3]]]
-    assert len(tris) == 20
-    mesh, log = clean_mesh(v, tris)
-    assert mesh.n_faces == 8 and log.merged_faces == 12
-    assert sorted(len(f) for f in mesh.faces) == [4] * 6 + [6, 6]
-    assert_allclose(mesh.corner_angles().max(), 1.5 * np.pi, atol=1e-12)
+    if as_triangles:
+        tris = []
+        for f in faces:
+            if len(f) == 6:  # fan from the corner opposite the reflex corner
+                j = int(np.argmax([np.abs(v[i, :2] - v[f, :2].min(axis=0)).sum() == 0 for i in f]))
+                g = np.roll(f, -j)
+                tris += [g[[0, i, i + 1]] for i in range(1, 5)]
+            else:
+                tris += [f[[0, 1, 2]], f[[0, 2, 3]]]
+        faces = tris
+    mesh, log = clean_mesh(v, faces)
+    assert 10 <= mesh.n_faces <= 12 and mesh.n_vertices == 12  # each L in 2 or 3 parts
+    assert_convex_planar(mesh)
+    assert_allclose(mesh.face_area.sum(), PolyMesh(v, example_mesh("l-prism")[1]).face_area.sum())
+    split = [r for r in log.repairs if r.what == "split-face"]
+    assert len(split) == (0 if as_triangles else 2)
+    assert all("not convex" in r.why for r in split)
+    if not as_triangles:
+        with pytest.raises(AssertionError):  # strict keeps the reflex corners (no repair)
+            assert_convex_planar(clean_mesh(v, faces, strict=True)[0])
 
 
-def test_coplanar_region_with_hole_is_not_merged():
+def test_coplanar_region_with_hole_is_merged_into_convex_parts():
     # a flat 3 x 3 grid of unit squares without the centre one: boundary is two loops
     g = np.array([[x, y, 0.0] for y in range(4) for x in range(4)])
     quads = [
@@ -181,7 +213,10 @@ def test_coplanar_region_with_hole_is_not_merged():
         if (i, j) != (1, 1)
     ]
     mesh, log = clean_mesh(g, quads)
-    assert mesh.n_faces == 8 and log.merged_faces == 0
+    assert mesh.n_faces == 4 and log.merged_faces == 4
+    assert_convex_planar(mesh)
+    assert_allclose(mesh.face_area.sum(), 8.0, atol=1e-12)
+    assert boundary_loops(mesh) == 2
 
 
 def test_nearly_coplanar_faces_merge_within_tolerance_only():
@@ -213,12 +248,12 @@ def test_faces_as_2d_array_and_float_indices():
     assert_is_unit_cube(mesh)
 
 
-# ---------------------------------------------------------------------------- rejections
+# --------------------------------------------------- refusals (strict=True: repair nothing)
 def test_nan_vertex_rejected_naming_the_vertex():
     v, faces = cube()
     v[3, 1] = np.nan
     with pytest.raises(MeshError, match=r"vertex 3 has a non-finite coordinate") as info:
-        clean_mesh(v, faces)
+        clean_mesh(v, faces, strict=True)
     assert info.value.vertex == 3
 
 
@@ -257,26 +292,26 @@ def test_face_collapsed_by_merging_is_degenerate():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 1e-14], [1, 1, 0]], dtype=float)
     faces = [[0, 1, 2], [1, 4, 3]]  # vertices 1 and 3 coincide
     with pytest.raises(MeshError, match=r"degenerate face 1: it has 2 distinct vertices") as info:
-        clean_mesh(v, faces)
+        clean_mesh(v, faces, strict=True)
     assert info.value.face == 1
 
 
 def test_short_face_is_degenerate():
     with pytest.raises(MeshError, match=r"degenerate face 0: it has 2 distinct"):
-        clean_mesh(np.eye(3), [[0, 1]])
+        clean_mesh(np.eye(3), [[0, 1]], strict=True)
 
 
 def test_zero_area_face_is_degenerate():
     v = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]], dtype=float)
-    with pytest.raises(MeshError, match=r"degenerate face 1: its area 0 is below") as info:
-        clean_mesh(v, [[0, 1, 3], [0, 1, 2]])
+    with pytest.raises(MeshError, match=r"degenerate face 1: its area is \(almost\) zero") as info:
+        clean_mesh(v, [[0, 1, 3], [0, 1, 2]], strict=True)
     assert info.value.face == 1
 
 
 def test_face_visiting_a_vertex_twice_is_degenerate():
     v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 2, 0]], dtype=float)
     with pytest.raises(MeshError, match=r"degenerate face 0: it visits a vertex twice"):
-        clean_mesh(v, [[0, 1, 2, 4, 2, 3]])
+        clean_mesh(v, [[0, 1, 2, 4, 2, 3]], strict=True)
 
 
 def test_duplicate_face_rejected():
@@ -284,7 +319,7 @@ def test_duplicate_face_rejected():
     with pytest.raises(
         MeshError, match=r"degenerate face 4: it uses the same vertices as face 0"
     ) as info:
-        clean_mesh(v, [*faces, faces[0][::-1]])
+        clean_mesh(v, [*faces, faces[0][::-1]], strict=True)
     assert info.value.face == 4
 
 
@@ -292,7 +327,7 @@ def test_non_manifold_edge_rejected_naming_the_edge():
     v = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, -1, 0]], dtype=float)
     fins = [[0, 1, 2], [0, 1, 3], [0, 1, 4]]  # three triangles on edge (0, 1)
     with pytest.raises(MeshError, match=r"non-manifold edge \(0, 1\): shared by 3 faces") as info:
-        clean_mesh(v, fins)
+        clean_mesh(v, fins, strict=True)
     assert info.value.edge == (0, 1)
 
 
@@ -302,7 +337,7 @@ def test_non_manifold_edge_named_by_input_indices_after_merging():
     )
     fins = [[1, 2, 3], [1, 2, 4], [1, 6, 5]]  # 6 duplicates 2
     with pytest.raises(MeshError, match=r"non-manifold edge \(1, 2\)") as info:
-        clean_mesh(v, fins)
+        clean_mesh(v, fins, strict=True)
     assert info.value.edge == (1, 2)
 
 
@@ -311,7 +346,7 @@ def test_bowtie_rejected_naming_the_vertex():
     with pytest.raises(
         MeshError, match=r"non-manifold vertex 2: its faces form 2 separate fans"
     ) as info:
-        clean_mesh(v, [[0, 1, 2], [2, 4, 3]])
+        clean_mesh(v, [[0, 1, 2], [2, 4, 3]], strict=True)
     assert info.value.vertex == 2
 
 
@@ -321,7 +356,7 @@ def test_two_cubes_touching_at_a_corner_rejected():
     v2 = v + 1.0  # its (-0.5, -0.5, -0.5) corner lands on the first cube's corner
     faces2 = list(faces) + [f + 8 for f in faces]
     with pytest.raises(MeshError, match=rf"non-manifold vertex {corner}:") as info:
-        clean_mesh(np.vstack([v, v2]), faces2)
+        clean_mesh(np.vstack([v, v2]), faces2, strict=True)
     assert info.value.vertex == corner
 
 
@@ -339,7 +374,7 @@ def test_moebius_strip_rejected():
         quads.append([a, c, d, b])
     tris = [t for q in quads for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]])]
     with pytest.raises(MeshError, match=r"non-orientable surface: the component containing face"):
-        clean_mesh(np.array(verts), tris)
+        clean_mesh(np.array(verts), tris, strict=True)
 
 
 def test_non_planar_face_rejected():
@@ -347,19 +382,26 @@ def test_non_planar_face_rejected():
     v = v.copy()
     v[int(np.argmax(v.sum(axis=1)))] += [0, 0, 0.01]
     with pytest.raises(MeshError, match=r"face \d+ is not planar: a vertex is") as info:
-        clean_mesh(v, faces)
+        clean_mesh(v, faces, strict=True)
     assert info.value.face in range(6)
 
 
 def test_tolerances_are_used():
-    # a duplicate closer than tol.merge * diagonal merges, one further away does not
+    # a duplicate closer than tol.merge * diagonal is the same point (no repair reported); one
+    # closer than tol.weld * diagonal is welded (reported); one further away is not
     v, faces = cube()
     diag = np.sqrt(3.0)
-    extra = np.vstack([v, v[0] + [0.1 * tol.merge * diag, 0, 0]])
     faces2 = [np.where(f == 0, 8, f) if i == 0 else f for i, f in enumerate(faces)]
+    extra = np.vstack([v, v[0] + [0.1 * tol.merge * diag, 0, 0]])
     mesh, log = clean_mesh(extra, faces2)
+    assert log.merged_vertices == 1 and mesh.n_vertices == 8 and log.repairs == []
+    near = np.vstack([v, v[0] + [0.1 * tol.weld * diag, 0, 0]])
+    mesh, log = clean_mesh(near, faces2)
     assert log.merged_vertices == 1 and mesh.n_vertices == 8
-    far = np.vstack([v, v[0] + [10 * tol.merge * diag, 0, 0]])
+    assert [r.what for r in log.repairs] == ["weld"] and log.repairs[0].where == "vertices 0, 8"
+    mesh, log = clean_mesh(near, faces2, strict=True)  # strict: a crack, as without welding
+    assert log.merged_vertices == 0 and mesh.n_vertices == 9 and not mesh.is_closed
+    far = np.vstack([v, v[0] + [10 * tol.weld * diag, 0, 0]])
     mesh, log = clean_mesh(far, faces2)  # now a crack: face 0 no longer shares vertex 0
     assert log.merged_vertices == 0 and mesh.n_vertices == 9
     assert not mesh.is_closed
@@ -376,7 +418,7 @@ def test_tolerances_are_used():
 def test_duplicate_faces_are_named_in_face_order(faces, message):
     v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.2], [0.5, -1, 0.3]], dtype=float)
     with pytest.raises(MeshError, match=message + r" \(duplicate face\)"):
-        clean_mesh(v, [np.array(f) for f in faces])
+        clean_mesh(v, [np.array(f) for f in faces], strict=True)
 
 
 @pytest.mark.parametrize("bad", [[0, 1, 9], [0, -1, 2], [0.0, 1.5, 2.0], [0.0, np.nan, 2.0]])
@@ -398,3 +440,180 @@ def test_face_array_and_face_lists_give_one_mesh():
     b, _ = clean_mesh(v, [*[list(map(int, x)) for x in f][:-1], np.asarray(f[-1], dtype=float)])
     np.testing.assert_array_equal(a.vertices, b.vertices)
     assert [x.tolist() for x in a.faces] == [x.tolist() for x in b.faces]
+
+
+# ------------------------------------------------------------- repairs of defects (default)
+def whats(log: CleanLog) -> list[str]:
+    return [r.what for r in log.repairs]
+
+
+def test_faces_on_a_non_finite_vertex_are_dropped_and_reported():
+    v, faces = cube()
+    v = np.vstack([v, [np.nan, 0, 0], [7.0, np.inf, 0]])
+    faces = [*faces, np.array([0, 1, 8]), np.array([2, 3, 9])]
+    mesh, log = clean_mesh(v, faces)
+    assert_is_unit_cube(mesh)
+    assert whats(log) == ["drop-face", "drop-face"]
+    assert [r.where for r in log.repairs] == ["face 6", "face 7"]
+    assert "vertex 8 has a non-finite coordinate" in log.repairs[0].why
+    with pytest.raises(MeshError, match="every face uses a vertex with a non-finite"):
+        clean_mesh(np.full((3, 3), np.nan), [[0, 1, 2]])
+
+
+def test_degenerate_faces_are_dropped_and_reported():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 1e-14], [1, 1, 0]], dtype=float)
+    mesh, log = clean_mesh(v, [[0, 1, 2], [1, 4, 3]])  # vertices 1 and 3 coincide
+    assert mesh.n_faces == 1 and whats(log) == ["drop-face"] and log.repairs[0].where == "face 1"
+    assert "2 distinct vertices" in log.repairs[0].why
+
+
+def test_zero_area_cap_is_removed_without_opening_the_surface():
+    """A triangle whose middle vertex lies on its longest edge (a T-junction filler): it is
+    removed and the face across that edge is split at the vertex, so a closed mesh stays
+    closed."""
+    v, faces = example_mesh("tetrahedron")
+    a, b = faces[0][0], faces[0][1]
+    m = 0.5 * (v[a] + v[b])
+    v = np.vstack([v, m])
+    c = len(v) - 1
+    # face 0 (a, b, x) becomes (a, c, x), (c, b, x); the cap (a, b, c) has zero area and the
+    # other face on (a, b) keeps its edge
+    x = faces[0][2]
+    faces = [np.array([a, c, x]), np.array([c, b, x]), *faces[1:], np.array([b, a, c])]
+    mesh, log = clean_mesh(v, faces)
+    assert mesh.is_closed and mesh.n_vertices == 4  # c is a straight corner again: removed
+    assert "drop-face" in whats(log)
+    assert "inserted into the face beside it" in log.repairs[0].why
+    assert_allclose(signed_volume(mesh), signed_volume(PolyMesh(*example_mesh("tetrahedron"))))
+
+
+def test_face_visiting_a_vertex_twice_is_split_into_simple_loops():
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 2, 0], [2, 1, 0]], dtype=float)
+    mesh, log = clean_mesh(v, [[0, 1, 2, 5, 4, 2, 3]], merge_coplanar=False)
+    assert sorted(len(f) for f in mesh.faces) == [3, 4]
+    assert whats(log) == ["split-face", "split-vertex"]  # the two loops touch at vertex 2
+    assert "visits vertex 2 twice" in log.repairs[0].why
+
+
+def test_duplicate_faces_are_dropped_keeping_the_first():
+    v, faces = example_mesh("tetrahedron")
+    mesh, log = clean_mesh(v, [*faces, faces[0][::-1], faces[2]])
+    assert mesh.n_faces == 4 and mesh.is_closed
+    assert [r.where for r in log.repairs] == ["face 4", "face 5"]
+    assert "same vertices as face 0" in log.repairs[0].why
+
+
+def two_cubes(offset):
+    v, faces = cube()
+    return np.vstack([v, v + offset]), list(faces) + [f + 8 for f in faces]
+
+
+@pytest.mark.parametrize(
+    "offset, what, count",
+    [((1.0, 1.0, 1.0), "split-vertex", 1), ((1.0, 1.0, 0.0), "cut-edge", 1)],
+)
+def test_solids_touching_at_a_vertex_or_an_edge_come_apart(offset, what, count):
+    v, faces = two_cubes(np.array(offset))
+    mesh, log = clean_mesh(v, faces)
+    assert whats(log).count(what) == count
+    assert mesh.n_faces == 12 and mesh.is_closed
+    assert mesh.n_vertices == 16  # every vertex of each cube its own again
+    assert_allclose(signed_volume(mesh), 2.0, atol=1e-12)  # both outward
+    for u in range(mesh.n_vertices):
+        assert mesh.vertex_ring(u).closed  # manifold everywhere
+
+
+def test_fin_on_an_edge_is_cut_off_as_a_border():
+    v = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, -1, 0]], dtype=float)
+    mesh, log = clean_mesh(v, [[0, 1, 2], [0, 1, 3], [0, 1, 4]], merge_coplanar=False)
+    assert mesh.n_faces == 3 and whats(log).count("cut-edge") == 1
+    assert "shared by 3 faces" in log.repairs[0].why
+    for u in range(mesh.n_vertices):
+        mesh.vertex_ring(u)  # manifold: no error
+
+
+def test_moebius_strip_is_cut_open_and_oriented():
+    n = 8
+    t = 2 * np.pi * np.arange(n) / n
+    verts, quads = [], []
+    for i, ti in enumerate(t):
+        for s in (-0.3, 0.3):
+            r = 1 + s * np.cos(ti / 2)
+            verts.append([r * np.cos(ti), r * np.sin(ti), s * np.sin(ti / 2)])
+        j = (i + 1) % n
+        a, b = 2 * i, 2 * i + 1
+        c, d = (2 * j, 2 * j + 1) if j else (2 * j + 1, 2 * j)
+        quads.append([a, c, d, b])
+    tris = [t for q in quads for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]])]
+    mesh, log = clean_mesh(np.array(verts), tris)
+    assert "cut-edge" in whats(log)
+    area = sum(PolyMesh(np.array(verts), [t]).face_area[0] for t in tris)
+    assert_allclose(mesh.face_area.sum(), area, rtol=1e-12)
+    assert "cannot be oriented" in next(r.why for r in log.repairs if r.what == "cut-edge")
+
+
+def test_non_planar_quad_is_split_into_triangles():
+    v, faces = cube()
+    v = v.copy()
+    v[int(np.argmax(v.sum(axis=1)))] += [0, 0, 0.01]
+    mesh, log = clean_mesh(v, faces)
+    assert mesh.n_faces == 7 and sorted(map(len, mesh.faces)) == [3] * 2 + [4] * 5
+    assert whats(log) == ["split-face"] and "not planar" in log.repairs[0].why
+    assert_convex_planar(mesh)
+
+
+def test_near_straight_corner_next_to_a_rounded_edge_is_split():
+    """A pentagon whose corner is 0.5 degrees from straight, on a prism: the tangent lines at
+    that corner would cross far away, so the face is split there."""
+    t = np.radians(0.5)
+    base = np.array([[0, 0], [1, 0], [2, np.tan(t)], [2, 1], [0, 1]], dtype=float)
+    v = np.vstack([np.c_[base, np.zeros(5)], np.c_[base, np.ones(5)]])
+    top = np.arange(5, 10)
+    sides = [np.array([i, (i + 1) % 5, (i + 1) % 5 + 5, i + 5]) for i in range(5)]
+    mesh, log = clean_mesh(v, [np.arange(5)[::-1], top, *sides])
+    split = [r for r in log.repairs if r.what == "split-face"]
+    assert len(split) == 2 and all("of straight" in r.why for r in split)
+    assert mesh.n_faces == 9
+    angles = mesh.corner_angles()
+    assert np.abs(angles - np.pi).min() > tol.straight
+
+
+def test_triangle_soup_that_welding_cannot_join_is_refused():
+    rng = np.random.default_rng(1)
+    v = rng.uniform(size=(30, 3))
+    with pytest.raises(MeshError, match=r"no two of the 10 faces share an edge"):
+        clean_mesh(v, np.arange(30).reshape(10, 3))
+
+
+def test_triangle_soup_of_a_real_surface_is_welded():
+    v, faces = example_mesh("icosahedron")
+    soup = np.concatenate([v[f] for f in faces])
+    mesh, log = clean_mesh(soup, np.arange(len(soup)).reshape(-1, 3))
+    assert mesh.n_vertices == 12 and mesh.is_closed and log.repairs == []
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), kind=st.sampled_from(["flip", "dup", "soup", "nm"]))
+def test_repaired_mesh_is_manifold_oriented_planar_convex(seed, kind):
+    """Whatever the defect, the repaired mesh is manifold everywhere, consistently oriented,
+    and its faces are planar and convex."""
+    rng = np.random.default_rng(seed)
+    v, faces = random_convex(seed)
+    faces = [np.asarray(f) for f in faces]
+    if kind == "flip":
+        faces = [f[::-1] if rng.random() < 0.4 else f for f in faces]
+    elif kind == "dup":
+        faces += [faces[i][::-1] for i in rng.choice(len(faces), 3, replace=False)]
+    elif kind == "soup":
+        v = np.concatenate([v[f] for f in faces])
+        faces = list(np.arange(len(v)).reshape(-1, 3))
+    else:  # a second copy touching the first at a vertex
+        k = len(v)
+        shift = v[0] - (v[0] * -1.0)
+        v = np.vstack([v, -v + shift])
+        faces += [f[::-1] + k for f in faces]
+    mesh, _ = clean_mesh(v, faces)
+    for u in range(mesh.n_vertices):
+        mesh.vertex_ring(u)
+    assert_convex_planar(mesh)
+    assert signed_volume(mesh) > 0

@@ -16,7 +16,16 @@ class Tolerances:
     Attributes
     ----------
     merge : float
-        Vertices closer than ``merge * bbox_diagonal`` are merged on input.
+        Vertices closer than ``merge * bbox_diagonal`` are the same point (merged on input).
+    weld : float
+        Vertices closer than ``weld * bbox_diagonal`` are welded on input (a reported repair).
+    degenerate : float
+        A face whose height over its longest edge is below ``degenerate`` times that edge has
+        (almost) zero area: it is removed on input.
+    straight : float
+        A polygon corner within this angle (radians) of straight is split on input (no
+        tangent-line crossing could be placed there), unless straight within ``angle`` and
+        removable.
     planar : float
         A polygon face is planar when every vertex is within ``planar * face_size`` of its plane.
     area : float
@@ -37,9 +46,15 @@ class Tolerances:
         ``closure * mean incident edge length``.
     validate : float
         Slack allowed when the solved apex is validated densely, relative to the local edge length.
+    fillet_floor : float
+        An edge whose fillet would be narrower than this share of the edge's length is left
+        sharp (not rounded): a narrower strip only makes slivers.
     """
 
     merge: float = 1e-9
+    weld: float = 1e-6
+    degenerate: float = 1e-9
+    straight: float = 0.0175  # 1 degree
     planar: float = 1e-6
     area: float = 1e-12
     coplanar_deg: float = 1e-3
@@ -49,6 +64,7 @@ class Tolerances:
     margin: float = 5e-3
     closure: float = 1e-9
     validate: float = 1e-9
+    fillet_floor: float = 1e-3
 
 
 tol = Tolerances()

@@ -18,6 +18,7 @@ from .examples import EXAMPLES, Example, example_mesh, example_names, find_examp
 from .examples import unknown_example_message as _unknown_example_message
 from .io import SUPPORTED_EXTENSIONS, read_mesh, write_obj, write_off
 from .polymesh import PolyMesh, VertexRing
+from .repair import Repair
 
 __all__ = [
     "EXAMPLES",
@@ -25,6 +26,7 @@ __all__ = [
     "CleanLog",
     "Example",
     "PolyMesh",
+    "Repair",
     "VertexRing",
     "clean_mesh",
     "example_mesh",
@@ -41,6 +43,7 @@ def load_mesh(
     *,
     coplanar_deg: float = tol.coplanar_deg,
     merge_coplanar: bool = True,
+    strict: bool = False,
 ) -> tuple[PolyMesh, CleanLog]:
     """Load and clean a mesh from a file, a built-in example, arrays, or a PolyMesh.
 
@@ -53,8 +56,8 @@ def load_mesh(
         * a pair ``(vertices, faces)``: vertices ``(n, 3)`` float, faces an ``(m, k)`` int array
           or a list of index lists;
         * a :class:`PolyMesh`, cleaned again.
-    coplanar_deg, merge_coplanar
-        Passed to :func:`clean_mesh`.
+    coplanar_deg, merge_coplanar, strict
+        Passed to :func:`clean_mesh` (``strict``: refuse defects instead of repairing them).
 
     Returns
     -------
@@ -91,4 +94,6 @@ def load_mesh(
             f"cannot load a mesh from a {type(source).__name__}: expected a file path, a "
             f"built-in example name, a (vertices, faces) pair or a PolyMesh"
         )
-    return clean_mesh(vertices, faces, coplanar_deg=coplanar_deg, merge_coplanar=merge_coplanar)
+    return clean_mesh(
+        vertices, faces, coplanar_deg=coplanar_deg, merge_coplanar=merge_coplanar, strict=strict
+    )

@@ -2,15 +2,18 @@
 
 :func:`clean_mesh` turns raw ``(vertices, faces)`` into a :class:`~filletfold.mesh.PolyMesh`
 that the rest of filletfold can trust: finite, no duplicate vertices, no degenerate faces,
-edge- and vertex-manifold, consistently oriented (outward for closed shells), neighbouring
-coplanar faces merged into single polygons, and every polygon planar.
+edge- and vertex-manifold, consistently oriented (outward for closed shells), every polygon
+planar and convex, neighbouring coplanar faces merged into convex polygons. What can be
+repaired is repaired (:mod:`filletfold.mesh.repair`) and reported in ``CleanLog.repairs``;
+``strict=True`` refuses instead.
 
-Errors name the offending element by its index in the *input* (vertex, edge as a pair of input
-vertex indices, or face).
+Errors and repairs name the element by its index in the *input* (vertex, edge as a pair of
+input vertex indices, or face).
 """
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections import deque
 from dataclasses import dataclass, field
@@ -23,6 +26,18 @@ from scipy.spatial import cKDTree
 from ..errors import MeshError
 from ..tolerances import tol
 from .polymesh import PolyMesh
+from .repair import (
+    RepairLog,
+    corner_turns,
+    drop_duplicate_faces,
+    fix_degenerate_faces,
+    plane_axes,
+    polygon_normal,
+    split_face_loops,
+    split_non_manifold,
+    triangulate_faces,
+    triangulate_polygon,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -43,9 +58,12 @@ class CleanLog:
         Vertices dropped: unreferenced ones, interior vertices of merged coplanar regions, and
         straight (angle pi) corners removed after merging.
     vertex_map : (n_input_vertices,) int
-        Index in the cleaned mesh of each input vertex, ``-1`` where it was dropped.
+        Index in the cleaned mesh of each input vertex, ``-1`` where it was dropped (the first
+        copy of a vertex split into several).
     face_origin : (n_faces,) int
         For each cleaned face, the smallest input face index it was made from.
+    repairs : list of Repair
+        Every repair of a defect (:mod:`filletfold.mesh.repair`): what, where, why.
     """
 
     merged_vertices: int
@@ -54,6 +72,7 @@ class CleanLog:
     removed_vertices: int
     vertex_map: np.ndarray = field(repr=False)
     face_origin: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64), repr=False)
+    repairs: list = field(default_factory=list)
 
 
 def clean_mesh(
@@ -62,13 +81,20 @@ def clean_mesh(
     *,
     coplanar_deg: float = tol.coplanar_deg,
     merge_coplanar: bool = True,
+    strict: bool = False,
 ) -> tuple[PolyMesh, CleanLog]:
     """Validate and repair a polygon mesh.
 
-    Steps, in order: validate; merge duplicate vertices and reject degenerate faces; drop
-    unreferenced vertices; reject non-manifold edges and vertices; orient faces consistently
-    per connected component (outward on closed components); merge neighbouring coplanar faces
-    and remove straight corners left by the merge; check every polygon is planar.
+    Steps, in order: validate; drop faces on non-finite vertices; weld vertices closer than
+    ``tol.weld`` of the bounding-box diagonal; split faces that visit a vertex twice and drop
+    faces of fewer than three vertices; remove faces of (almost) zero area (inserting their
+    middle vertex into the face beside their longest edge); drop duplicate faces and unused
+    vertices; split non-manifold vertices and cut non-manifold edges open; orient faces
+    consistently per connected component (outward on closed components; a component that
+    cannot be oriented is cut open where it conflicts); triangulate non-planar and non-convex
+    polygons; merge neighbouring coplanar faces into convex polygons; remove straight corners
+    and split polygons at corners within ``tol.straight`` of straight; check every polygon is
+    planar. Every repair is listed in ``log.repairs``.
 
     Parameters
     ----------
@@ -80,6 +106,9 @@ def clean_mesh(
         angle (degrees).
     merge_coplanar : bool
         Set False to keep every input face.
+    strict : bool
+        Repair nothing: the first defect raises the :class:`MeshError` that names it (vertices
+        are then welded only within ``tol.merge``, as exact duplicates).
 
     Returns
     -------
@@ -90,26 +119,44 @@ def clean_mesh(
     ------
     MeshError
         With ``vertex``, ``edge`` (pair of input vertex indices) or ``face`` (input index) set:
-        non-finite coordinate, index out of range, no faces, degenerate or duplicate face,
-        non-manifold edge or vertex, non-orientable component, non-planar face.
+        index out of range, no faces, a triangle soup (no two faces share an edge, even after
+        welding), a mesh with nothing left after repairs; with ``strict``: non-finite
+        coordinate, degenerate or duplicate face, non-manifold edge or vertex, non-orientable
+        component, non-planar face.
 
     Notes
     -----
-    A merged coplanar region is kept as separate faces when its boundary is not one simple
-    loop (a region with a hole, or one touching itself at a vertex) or when the merged polygon
-    would not pass the planarity check. A straight corner is removed when it has exactly two
-    edges (two faces inside the surface, or one face on the boundary) and its angle is pi
-    within ``tol.angle`` in each of its faces.
+    A coplanar region is merged face by face (breadth first from its lowest face) while the
+    merged polygon stays one simple, convex, planar loop without a corner within
+    ``tol.straight`` of straight (exactly straight corners excepted: they are removed where
+    the vertex has no other edge). A straight corner is removed when it has exactly two edges
+    (two faces inside the surface, or one face on the boundary) and its angle is pi within
+    ``tol.angle`` in each of its faces.
     """
     v, face_list = _validate(vertices, faces)
     n_input = len(v)
+    log = RepairLog(strict=strict)
+    face_origin = np.arange(len(face_list), dtype=np.int64)
 
-    # 2. merge duplicate vertices, drop repeated indices, reject degenerate faces
-    rep = _close_vertex_representatives(v)
+    # 2. faces on vertices with a non-finite coordinate
+    face_list, face_origin = _drop_non_finite(v, face_list, face_origin, log)
+
+    # 3. weld close vertices, then fix face loops and zero-area faces
+    rep = _close_vertex_representatives(v, face_list, log)
     merged_vertices = n_input - len(np.unique(rep))
-    face_list = _remap_faces(face_list, rep, v)
+    face_list = [rep[f] for f in face_list]
+    vorig = np.arange(n_input, dtype=np.int64)
+    face_list, face_origin = split_face_loops(face_list, face_origin, vorig, log)
+    if face_list:
+        face_list, face_origin = fix_degenerate_faces(
+            face_list, face_origin, v, vorig, log, tol.degenerate
+        )
+    if face_list:
+        face_list, face_origin = drop_duplicate_faces(face_list, face_origin, log)
+    if not face_list:
+        raise MeshError("the mesh has no face left once its degenerate faces are removed")
 
-    # 3. drop unreferenced vertices
+    # 4. drop unreferenced vertices
     used = np.unique(np.concatenate(face_list))
     new_of_rep = -np.ones(n_input, dtype=np.int64)
     new_of_rep[used] = np.arange(len(used))
@@ -118,33 +165,60 @@ def clean_mesh(
     vert_orig = used.copy()  # input index of each current vertex
     v = v[used]
     face_list = [new_of_rep[f] for f in face_list]
-    face_origin = np.arange(len(face_list), dtype=np.int64)
 
-    # 4. manifold checks
+    # 5. non-manifold vertices and edges
+    face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
     he = _HalfEdges(face_list, len(v))
     _check_manifold(he, vert_orig)
 
-    # 5. orientation
-    face_list, flipped = _orient(he, face_list, v, face_origin)
+    # 6. orientation (a component that cannot be oriented is cut where it conflicts)
+    face_list, flipped, conflicts = _orient(he, face_list, v, face_origin, strict)
+    if conflicts:
+        face_list, v, vert_orig = split_non_manifold(
+            face_list, face_origin, v, vert_orig, log, unpaired=conflicts
+        )
+        he = _HalfEdges(face_list, len(v))
+        face_list, flipped2, conflicts = _orient(he, face_list, v, face_origin, True)
+        flipped += flipped2
+    _check_not_soup(he, face_list, face_origin)
 
-    # 6. coplanar merge, straight corners, unreferenced vertices
+    # 7. non-planar and non-convex polygons are triangulated (and regrouped by the merge)
+    face_list, face_origin = _split_non_planar(face_list, face_origin, v, log)
+    if not strict:
+        face_list, face_origin = _split_non_convex(face_list, face_origin, v, log)
+
+    # 8. coplanar merge, straight corners, unreferenced vertices
     merged_faces = 0
     if merge_coplanar and coplanar_deg > 0 and len(face_list) > 1:
-        face_list, face_origin, merged_faces = _merge_coplanar(
-            face_list, face_origin, v, coplanar_deg
+        n_before = len(face_list)
+        for _ in range(8):  # interior vertices of flat regions are removed, then merged again
+            while True:  # regions merged into regions too, until nothing merges
+                n_pass = len(face_list)
+                face_list, face_origin = _merge_coplanar(face_list, face_origin, v, coplanar_deg)
+                if len(face_list) == n_pass:
+                    break
+            face_list, face_origin, removed = _remove_flat_vertices(
+                face_list, face_origin, v, coplanar_deg
+            )
+            if not removed:
+                break
+        merged_faces = n_before - len(face_list)
+    face_list = _remove_straight_corners(face_list, v)
+    if not strict:
+        face_list, face_origin = _split_straight_corners(
+            face_list, face_origin, v, vert_orig, coplanar_deg, log
         )
-        face_list = _remove_straight_corners(face_list, v)
-        used = np.unique(np.concatenate(face_list))
-        if len(used) < len(v):
-            compact = -np.ones(len(v), dtype=np.int64)
-            compact[used] = np.arange(len(used))
-            removed_vertices += int(len(v) - len(used))
-            vertex_map = np.where(vertex_map >= 0, compact[np.maximum(vertex_map, 0)], -1)
-            vert_orig = vert_orig[used]
-            v = v[used]
-            face_list = [compact[f] for f in face_list]
+    used = np.unique(np.concatenate(face_list))
+    if len(used) < len(v):
+        compact = -np.ones(len(v), dtype=np.int64)
+        compact[used] = np.arange(len(used))
+        removed_vertices += int(len(v) - len(used))
+        vertex_map = np.where(vertex_map >= 0, compact[np.maximum(vertex_map, 0)], -1)
+        vert_orig = vert_orig[used]
+        v = v[used]
+        face_list = [compact[f] for f in face_list]
 
-    # 7. planarity
+    # 9. planarity
     _check_planar(face_list, v, face_origin)
 
     mesh = PolyMesh(v, face_list)
@@ -155,6 +229,7 @@ def clean_mesh(
         removed_vertices=int(removed_vertices),
         vertex_map=vertex_map,
         face_origin=face_origin,
+        repairs=list(log.repairs),
     )
     logger.debug("clean_mesh: %s", log)
     return mesh, log
@@ -168,10 +243,6 @@ def _validate(vertices, faces) -> tuple[np.ndarray, list[np.ndarray]]:
         raise MeshError(f"vertices cannot be read as a float array: {exc}") from exc
     if v.ndim != 2 or v.shape[1] != 3:
         raise MeshError(f"vertices must have shape (n, 3), got {v.shape}")
-    bad = np.nonzero(~np.isfinite(v).all(axis=1))[0]
-    if len(bad):
-        i = int(bad[0])
-        raise MeshError(f"vertex {i} has a non-finite coordinate {v[i].tolist()}", vertex=i)
     if faces is None or len(faces) == 0:
         raise MeshError("the mesh is empty: it has no faces")
     n = len(v)
@@ -219,21 +290,76 @@ def _valid_block(block: np.ndarray, n: int) -> bool:
     return block.size == 0 or (block.min() >= 0 and block.max() < n)
 
 
-# ------------------------------------------------------------------ 2. duplicates, degenerate
-def _close_vertex_representatives(v: np.ndarray) -> np.ndarray:
-    """(n,) int: for each vertex, the smallest index of the cluster of vertices it is close to."""
+# ------------------------------------------------------------------ 2. non-finite, welding
+def _drop_non_finite(v: np.ndarray, face_list, face_origin, log: RepairLog):
+    """Drop the faces that use a vertex with a non-finite coordinate (reported)."""
+    bad = ~np.isfinite(v).all(axis=1)
+    if not bad.any():
+        return face_list, face_origin
+    i = int(np.flatnonzero(bad)[0])
+    if log.strict:
+        raise MeshError(f"vertex {i} has a non-finite coordinate {v[i].tolist()}", vertex=i)
+    keep = [not bad[f].any() for f in face_list]
+    for k, f in enumerate(face_list):
+        if not keep[k]:
+            u = int(f[bad[f]][0])
+            log.add(
+                "drop-face",
+                f"face {int(face_origin[k])}",
+                f"its vertex {u} has a non-finite coordinate {v[u].tolist()}",
+                error="",
+            )
+    if not any(keep):
+        raise MeshError(
+            f"every face uses a vertex with a non-finite coordinate (vertex {i}: {v[i].tolist()})",
+            vertex=i,
+        )
+    face_list = [f for f, k in zip(face_list, keep, strict=True) if k]
+    return face_list, face_origin[np.asarray(keep)]
+
+
+def _close_vertex_representatives(v: np.ndarray, face_list, log: RepairLog) -> np.ndarray:
+    """(n,) int: for each vertex, the smallest index of the cluster of vertices it is close to.
+
+    Vertices closer than ``tol.merge`` of the bounding-box diagonal of the used vertices are
+    the same point (as in every STL file); vertices closer than ``tol.weld`` of it are welded
+    too (reported, one repair per cluster), except with ``log.strict``.
+    """
     n = len(v)
     if n < 2:
         return np.arange(n, dtype=np.int64)
-    diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
-    pairs = cKDTree(v).query_pairs(tol.merge * diag, output_type="ndarray")
+    used = np.unique(np.concatenate(face_list))
+    box = v[used]
+    diag = float(np.linalg.norm(box.max(axis=0) - box.min(axis=0)))
+    radius = (tol.merge if log.strict else tol.weld) * diag
+    finite = np.flatnonzero(np.isfinite(v).all(axis=1))
+    pairs = cKDTree(v[finite]).query_pairs(radius, output_type="ndarray")
     if len(pairs) == 0:
         return np.arange(n, dtype=np.int64)
+    pairs = finite[pairs]
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
     first = np.full(labels.max() + 1, n, dtype=np.int64)
     np.minimum.at(first, labels, np.arange(n))
-    return first[labels]
+    rep = first[labels]
+    gap = np.linalg.norm(v[pairs[:, 0]] - v[pairs[:, 1]], axis=1)
+    far = pairs[gap > tol.merge * diag]
+    if len(far):
+        cluster = np.unique(rep[far[:, 0]])
+        for c in cluster.tolist():
+            members = np.flatnonzero(rep == c)
+            spread = float(np.linalg.norm(v[members] - v[c], axis=1).max())
+            shown = ", ".join(map(str, members[:6].tolist())) + (
+                ", ..." if len(members) > 6 else ""
+            )
+            log.add(
+                "weld",
+                f"vertices {shown}",
+                f"{len(members)} vertices within {spread:.3g} of each other "
+                f"({spread / diag:.2g} of the mesh size, below {tol.weld:g}) welded into one",
+                error="",
+            )
+    return rep
 
 
 @dataclass(frozen=True)
@@ -302,70 +428,6 @@ def _face_planarity(fl: _Flat, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         d = np.linalg.norm(v[fl.index[other]] - p, axis=1)
         diameter = np.maximum(diameter, np.maximum.reduceat(d, fl.start[:-1]))
     return distance, diameter
-
-
-def _remap_faces(face_list, rep, v) -> list[np.ndarray]:
-    fl = _Flat.of(face_list)
-    g = rep[fl.index]
-    n = len(v)
-    # distinct vertices per face, and the face with consecutive repeats dropped
-    pairs = np.unique(fl.face * n + g)
-    distinct = np.bincount(pairs // n, minlength=len(fl.size))
-    keep = g != g[fl.prev]
-    kept = np.bincount(fl.face[keep], minlength=len(fl.size))
-    few = np.nonzero(distinct < 3)[0]
-    if len(few):
-        i = int(few[0])
-        raise MeshError(
-            f"degenerate face {i}: it has {int(distinct[i])} distinct vertices after merging "
-            f"duplicates (at least 3 needed)",
-            face=i,
-        )
-    twice = np.nonzero(distinct < kept)[0]
-    if len(twice):
-        i = int(twice[0])
-        face = g[keep][fl.face[keep] == i]
-        raise MeshError(f"degenerate face {i}: it visits a vertex twice ({face.tolist()})", face=i)
-    out = np.split(g[keep], np.cumsum(kept)[:-1])
-    fl = _Flat.of(out)
-    mean_edge = float(np.linalg.norm(v[fl.index[fl.next]] - v[fl.index], axis=1).mean())
-    min_area = tol.area * mean_edge**2
-    area = 0.5 * np.linalg.norm(_face_newell(fl, v), axis=1)
-    small = np.nonzero(area <= min_area)[0]
-    if len(small):
-        i = int(small[0])
-        raise MeshError(
-            f"degenerate face {i}: its area {area[i]:.3g} is below {min_area:.3g} "
-            f"(tol.area * mean_edge**2)",
-            face=i,
-        )
-    twin = _first_duplicate(fl)
-    if twin is not None:
-        i, first = twin
-        raise MeshError(
-            f"degenerate face {i}: it uses the same vertices as face {first} (duplicate face)",
-            face=i,
-        )
-    return out
-
-
-def _first_duplicate(fl: _Flat) -> tuple[int, int] | None:
-    """The first face (in order) with the same set of vertices as an earlier face, and that
-    earlier face's index; None when every face has its own set."""
-    best = None
-    for k in np.unique(fl.size).tolist():
-        rows = np.flatnonzero(fl.size == k)
-        keys = np.sort(fl.index[fl.start[rows][:, None] + np.arange(k)], axis=1)
-        _, first, inverse, count = np.unique(
-            keys, axis=0, return_index=True, return_inverse=True, return_counts=True
-        )
-        inverse = inverse.reshape(-1)
-        later = np.flatnonzero((count[inverse] > 1) & (np.arange(len(rows)) != first[inverse]))
-        if len(later):
-            j = int(later[0])  # rows are in face order: the first repeat of its size
-            hit = (int(rows[j]), int(rows[first[inverse[j]]]))
-            best = hit if best is None or hit[0] < best[0] else best
-    return best
 
 
 # --------------------------------------------------------------------------- half-edges
@@ -439,7 +501,25 @@ def _flip(f: np.ndarray) -> np.ndarray:
     return np.concatenate([f[:1], f[:0:-1]])
 
 
-def _orient(he: _HalfEdges, face_list, v, face_origin) -> tuple[list[np.ndarray], int]:
+def _orient(he: _HalfEdges, face_list, v, face_origin, strict: bool):
+    """Orient every connected component consistently: outward where it is closed, as most of
+    its faces where it is open.
+
+    Returns
+    -------
+    faces : list of (k,) int
+    flipped : int
+        Faces reversed.
+    conflicts : list of (int, int)
+        When a component cannot be oriented (and not ``strict``): the edges (a, b), a < b,
+        across which the breadth-first orientation conflicts, to be cut open; the faces are
+        then returned unchanged.
+
+    Raises
+    ------
+    MeshError
+        With ``strict``, for a component that cannot be oriented.
+    """
     n_faces = len(face_list)
     inner = np.nonzero(he.edge_count == 2)[0]
     h1 = he.edge_he0[inner]
@@ -469,6 +549,9 @@ def _orient(he: _HalfEdges, face_list, v, face_origin) -> tuple[list[np.ndarray]
                     queue.append(g)
         n_comp += 1
     conflict = np.nonzero((parity[fa] ^ parity[fb]) != same)[0]
+    if len(conflict) and not strict:
+        edges = he.edge_ends[inner[conflict]]
+        return face_list, 0, [(int(a), int(b)) for a, b in edges]
     if len(conflict):
         c = int(conflict[0])
         f = int(face_origin[fa[c]])
@@ -493,11 +576,78 @@ def _orient(he: _HalfEdges, face_list, v, face_origin) -> tuple[list[np.ndarray]
     invert = np.where(is_open, comp_flips * 2 > comp_size, comp_vol < 0)
     parity = parity ^ invert[component].astype(np.int64)
     out = [_flip(f) if parity[i] else f for i, f in enumerate(face_list)]
-    return out, int(parity.sum())
+    return out, int(parity.sum()), []
 
 
-# ------------------------------------------------------------------------ 6. coplanar merge
+def _check_not_soup(he: _HalfEdges, face_list, face_origin) -> None:
+    """Raise when no two of three or more faces share an edge (a triangle soup that welding
+    did not join)."""
+    if len(face_list) > 2 and not (he.edge_count == 2).any():
+        raise MeshError(
+            f"no two of the {len(face_list)} faces share an edge, even after welding vertices "
+            f"closer than {tol.weld:g} of the mesh size: a triangle soup, not a surface",
+            face=int(face_origin[0]),
+        )
+
+
+# ------------------------------------------------------------- 7. non-planar, non-convex faces
+def _split_non_planar(face_list, face_origin, v, log: RepairLog):
+    """Triangulate every polygon not planar within ``tol.planar`` of its diameter."""
+    fl = _Flat.of(face_list)
+    dist, diam = _face_planarity(fl, v)
+    bad = np.flatnonzero((dist > tol.planar * diam) & (fl.size > 3))
+    return triangulate_faces(
+        face_list,
+        face_origin,
+        v,
+        bad,
+        log,
+        lambda i: (
+            f"not planar (a vertex is {dist[i] / diam[i]:.2g} of its diameter from its plane)"
+        ),
+        lambda o, i: (
+            f"face {o} is not planar: a vertex is {dist[i]:.3g} from its best plane, "
+            f"more than {tol.planar:g} x its diameter {diam[i]:.3g}"
+        ),
+    )
+
+
+def _split_non_convex(face_list, face_origin, v, log: RepairLog):
+    """Triangulate every polygon with a reflex corner (a reflex corner would leave its vertex
+    without a cone); the coplanar merge regroups the triangles into convex parts."""
+    fl = _Flat.of(face_list)
+    reflex = _corner_angles(fl, v) > np.pi + tol.angle
+    bad = np.flatnonzero(np.bincount(fl.face[reflex], minlength=len(fl.size)) > 0)
+    return triangulate_faces(
+        face_list,
+        face_origin,
+        v,
+        bad,
+        log,
+        lambda i: (
+            "not convex (a reflex corner leaves no room for the straight crease of its "
+            "vertex's cone)"
+        ),
+        lambda o, i: "",
+    )
+
+
+# ------------------------------------------------------------------------ 8. coplanar merge
 def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
+    """Merge neighbouring coplanar faces into convex polygons, region by region.
+
+    Each region grows breadth first from its lowest face through edges whose faces' normals
+    differ by less than ``coplanar_deg``; a face joins when the merged polygon stays one
+    simple loop (it shares one chain of edges with the region), convex, planar within
+    ``tol.planar`` and without a corner within ``tol.straight`` of straight that is not
+    straight within ``tol.angle``. A face that cannot join starts a region of its own.
+
+    Returns
+    -------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+        Smallest input face of each merged polygon.
+    """
     he = _HalfEdges(face_list, len(v))
     normal = _face_newell(_Flat.of(face_list), v)
     normal /= np.linalg.norm(normal, axis=1)[:, None]
@@ -506,75 +656,161 @@ def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
     fb = he.face[he.edge_he1[inner]]
     cos_lim = np.cos(np.radians(coplanar_deg))
     flat = np.einsum("ij,ij->i", normal[fa], normal[fb]) > cos_lim
-    n_faces = len(face_list)
     if not flat.any():
-        return face_list, face_origin, 0
-    graph = coo_matrix((np.ones(int(flat.sum())), (fa[flat], fb[flat])), shape=(n_faces, n_faces))
-    _, group = connected_components(graph, directed=False)
-    twin_face = -np.ones(len(he.frm), dtype=np.int64)
-    h0, h1 = he.edge_he0[inner], he.edge_he1[inner]
-    twin_face[h0] = he.face[h1]
-    twin_face[h1] = he.face[h0]
-    members: dict[int, list[int]] = {}
-    for f, g in enumerate(group.tolist()):
-        members.setdefault(g, []).append(f)
-    loops: dict[int, np.ndarray] = {}  # group -> merged polygon
-    for g, fs in members.items():
-        if len(fs) < 2:
-            continue
-        loop = _group_boundary(fs, he, group, twin_face, g)
-        if loop is None:
-            logger.debug("coplanar faces %s kept: boundary is not one simple loop", fs)
-            continue
-        loops[g] = loop
-    if loops:
-        dist, diam = _face_planarity(_Flat.of(list(loops.values())), v)
-        for g, d, size in zip(list(loops), dist, diam, strict=True):
-            if d > tol.planar * size:
-                logger.debug("coplanar faces %s kept: merged polygon not planar", members[g])
-                del loops[g]
-    replaced: dict[int, np.ndarray] = {}  # first face of a merged group -> merged polygon
-    dropped: set[int] = set()
-    removed = 0
-    for g, loop in loops.items():
-        fs = members[g]
-        replaced[fs[0]] = loop
-        dropped.update(fs[1:])
-        removed += len(fs) - 1
+        return face_list, face_origin
+    n_faces = len(face_list)
+    neighbours: list[list[int]] = [[] for _ in range(n_faces)]
+    for a, b in zip(fa[flat].tolist(), fb[flat].tolist(), strict=True):
+        neighbours[a].append(b)
+        neighbours[b].append(a)
+    region = -np.ones(n_faces, dtype=np.int64)
     out, origin = [], []
-    for f in range(n_faces):
+    for seed in range(n_faces):
+        if region[seed] >= 0:
+            continue
+        region[seed] = len(out)
+        loop = face_list[seed].tolist()
+        members = [seed]
+        if neighbours[seed]:
+            axes = plane_axes(normal[seed])
+            queue = deque(neighbours[seed])
+            while queue:
+                g = queue.popleft()
+                if region[g] >= 0:
+                    continue
+                merged = _splice(loop, face_list[g].tolist())
+                if merged is None or not _convex_planar(v[merged], axes):
+                    continue
+                loop = merged
+                members.append(g)
+                region[g] = len(out)
+                queue.extend(x for x in neighbours[g] if region[x] < 0)
+        out.append(np.asarray(loop, dtype=np.int64) if len(members) > 1 else face_list[seed])
+        origin.append(int(face_origin[members].min()))
+    return out, np.asarray(origin, dtype=np.int64)
+
+
+def _remove_flat_vertices(face_list, face_origin, v, coplanar_deg):
+    """Remove the interior vertices of flat regions: a vertex whose faces around it are all
+    coplanar (within ``coplanar_deg``) has nothing to round; its fan is replaced by the
+    triangles of the polygon around it, for the merge to regroup into convex parts.
+
+    Returns
+    -------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+    removed : int
+        Vertices removed.
+    """
+    he = _HalfEdges(face_list, len(v))
+    normal = _face_newell(_Flat.of(face_list), v)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    f0 = he.face[he.edge_he0]
+    f1 = he.face[np.maximum(he.edge_he1, 0)]
+    cos_lim = np.cos(np.radians(coplanar_deg))
+    flat = (he.edge_count == 2) & (np.einsum("ij,ij->i", normal[f0], normal[f1]) > cos_lim)
+    ends = he.edge_ends
+    n = len(v)
+    not_flat = np.zeros(n, dtype=bool)
+    not_flat[ends[~flat].ravel()] = True  # a bent or boundary edge
+    candidates = np.flatnonzero(~not_flat & (np.bincount(ends.ravel(), minlength=n) > 0))
+    if not len(candidates):
+        return face_list, face_origin, 0
+    faces_of: dict[int, list[int]] = {}
+    for f, x in zip(he.face.tolist(), he.frm.tolist(), strict=True):
+        faces_of.setdefault(x, []).append(f)
+    touched: set[int] = set()
+    replace: dict[int, list] = {}  # first face of a fan -> its triangles; others dropped
+    dropped: set[int] = set()
+    for u in candidates.tolist():
+        fan = faces_of[u]
+        if touched.intersection(fan):
+            continue
+        loop = _fan_boundary(u, [face_list[f].tolist() for f in fan])
+        if loop is None:
+            continue
+        tris = triangulate_polygon(v[loop])
+        touched.update(fan)
+        first = min(fan)
+        tris = [np.asarray([loop[i] for i in t], dtype=np.int64) for t in tris]
+        replace[first] = (tris, int(face_origin[fan].min()))
+        dropped.update(f for f in fan if f != first)
+    if not replace:
+        return face_list, face_origin, 0
+    out, origin = [], []
+    for f, (face, o) in enumerate(zip(face_list, face_origin.tolist(), strict=True)):
         if f in dropped:
             continue
-        if f in replaced:
-            out.append(replaced[f])
-            origin.append(min(int(face_origin[x]) for x in members[group[f]]))
+        if f in replace:
+            tris, o = replace[f]
+            out.extend(tris)
+            origin.extend([o] * len(tris))
         else:
-            out.append(face_list[f])
-            origin.append(int(face_origin[f]))
-    return out, np.array(origin, dtype=np.int64), removed
+            out.append(face)
+            origin.append(o)
+    return out, np.asarray(origin, dtype=np.int64), len(replace)
 
 
-def _group_boundary(fs, he, group, twin_face, g) -> np.ndarray | None:
-    """The boundary of a group of faces as one CCW vertex loop, or None if not one simple loop."""
-    hs = np.concatenate([np.arange(he.start[f], he.start[f + 1]) for f in fs])
-    tw = twin_face[hs]
-    outside = (tw < 0) | (group[np.maximum(tw, 0)] != g)
-    hs = hs[outside]
-    frm = he.frm[hs]
-    if len(np.unique(frm)) != len(frm):
-        return None
-    nxt = dict(zip(frm.tolist(), he.to[hs].tolist(), strict=True))
-    start = int(frm.min())
-    loop = [start]
-    u = nxt[start]
-    while u != start:
-        if u not in nxt or len(loop) > len(frm):
+def _fan_boundary(u: int, fan: list) -> list | None:
+    """The loop around vertex ``u`` of its faces ``fan`` (counter-clockwise lists, a closed
+    fan), or None when it is not one simple loop."""
+    nxt = {}
+    for face in fan:
+        k = face.index(u)
+        path = face[k + 1 :] + face[:k]  # from the vertex after u round to the one before
+        if path[0] in nxt:
             return None
-        loop.append(u)
-        u = nxt[u]
-    if len(loop) != len(frm) or len(loop) < 3:
+        for a, b in itertools.pairwise(path):
+            if a in nxt:
+                return None
+            nxt[a] = b
+    start = next(iter(nxt))
+    loop, x = [start], nxt.get(start)
+    while x is not None and x != start and len(loop) <= len(nxt):
+        loop.append(x)
+        x = nxt.get(x)
+    if x != start or len(loop) != len(nxt) or len(loop) < 3:
         return None
-    return np.array(loop, dtype=np.int64)
+    return loop
+
+
+def _splice(loop: list, face: list) -> list | None:
+    """The loop of a region and a face merged along the one chain of edges they share
+    (counter-clockwise, both), or None when they share no edge, several chains, or the
+    merged loop would visit a vertex twice."""
+    n, k = len(loop), len(face)
+    f_edges = {(face[j], face[(j + 1) % k]) for j in range(k)}
+    shared = [(loop[(i + 1) % n], loop[i]) in f_edges for i in range(n)]
+    m = sum(shared)
+    if m == 0 or m >= n or m >= k:
+        return None
+    starts = [i for i in range(n) if shared[i] and not shared[i - 1]]
+    if len(starts) != 1:
+        return None
+    s = starts[0]
+    a, b = loop[s], loop[(s + m) % n]
+    part = [loop[(s + m + t) % n] for t in range(n - m + 1)]  # b ... a along the region
+    j, jb = (face.index(a) + 1) % k, face.index(b)
+    while j != jb:  # the face from a on to b, ends excluded
+        part.append(face[j])
+        j = (j + 1) % k
+    if len(part) != n + k - 2 * m or len(set(part)) != len(part):
+        return None
+    return part
+
+
+def _convex_planar(p: np.ndarray, axes: np.ndarray) -> bool:
+    """Whether the polygon ``p`` (k, 3) is convex seen along ``e1 x e2`` of ``axes`` (corners
+    straight within ``tol.angle`` allowed, none nearer straight than ``tol.straight`` else),
+    and planar within ``tol.planar`` of its diameter."""
+    xy = (p - p[0]) @ axes.T
+    turn = corner_turns(xy)
+    if (turn < -tol.angle).any() or ((turn > tol.angle) & (turn < tol.straight)).any():
+        return False
+    n = polygon_normal(p)
+    dist = np.abs((p - p.mean(axis=0)) @ (n / np.linalg.norm(n))).max()
+    diam = np.linalg.norm(xy.max(axis=0) - xy.min(axis=0))
+    return bool(dist <= tol.planar * diam)
 
 
 def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
@@ -614,6 +850,56 @@ def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
         edges.discard((min(u, b), max(u, b)))
         edges.add((min(a, b), max(a, b)))
     return [np.array(f, dtype=np.int64) for f in faces]
+
+
+def _split_straight_corners(face_list, face_origin, v, vert_orig, coplanar_deg, log: RepairLog):
+    """Split every polygon at each corner within ``tol.straight`` of straight where one of the
+    corner's two edges is bent (its faces differ by ``coplanar_deg`` or more, so it is
+    rounded): a diagonal from that corner to the opposite one, since the two tangent lines
+    there would cross far away or not at all."""
+    he = _HalfEdges(face_list, len(v))
+    normal = _face_newell(_Flat.of(face_list), v)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    two = he.edge_count == 2
+    f0 = he.face[he.edge_he0]
+    f1 = he.face[np.maximum(he.edge_he1, 0)]
+    bent = two & (np.einsum("ij,ij->i", normal[f0], normal[f1]) < np.cos(np.radians(coplanar_deg)))
+    edge_bent = {
+        tuple(e): bool(b) for e, b in zip(he.edge_ends.tolist(), bent.tolist(), strict=True)
+    }
+    out, origin = [], []
+    pending = list(zip(face_list, face_origin.tolist(), strict=True))
+    while pending:
+        f, o = pending.pop(0)
+        if len(f) >= 4:
+            axes = plane_axes(polygon_normal(v[f]))
+            turn = corner_turns((v[f] - v[f[0]]) @ axes.T)
+            k = len(f)
+            fl = f.tolist()
+            sides = [
+                edge_bent.get((min(a, b), max(a, b)), True)
+                for a, b in zip(fl, fl[1:] + fl[:1], strict=True)
+            ]
+            bad = [
+                i for i in range(k) if abs(turn[i]) < tol.straight and (sides[i] or sides[i - 1])
+            ]
+            if bad:
+                i = bad[0]
+                j = (i + k // 2) % k
+                lo, hi = min(i, j), max(i, j)
+                log.add(
+                    "split-face",
+                    f"face {o}",
+                    f"its corner at vertex {int(vert_orig[f[i]])} is within "
+                    f"{np.degrees(abs(turn[i])):.2g} deg of straight next to a rounded edge: "
+                    "split there",
+                    error="",
+                )
+                pending[:0] = [(f[lo : hi + 1], o), (np.concatenate([f[hi:], f[: lo + 1]]), o)]
+                continue
+        out.append(f)
+        origin.append(o)
+    return out, np.asarray(origin, dtype=np.int64)
 
 
 # ----------------------------------------------------------------------------- 7. planarity

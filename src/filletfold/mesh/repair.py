@@ -1,0 +1,556 @@
+"""Repairs of a raw polygon mesh, each one reported.
+
+:func:`~filletfold.mesh.clean.clean_mesh` runs these steps in order; every change they make is
+a :class:`Repair` (what, where, why) in a :class:`RepairLog`. With ``strict=True`` the log
+raises the :class:`~filletfold.errors.MeshError` that names the element instead of repairing.
+
+Faces are lists of vertex-index arrays with ``origin`` (the input face each one comes from);
+vertices carry ``vorig`` (their input index), so that every message names input elements.
+
+* :func:`split_face_loops` -- faces that visit a vertex twice split into simple loops, faces of
+  fewer than three distinct vertices dropped;
+* :func:`fix_degenerate_faces` -- faces of (almost) zero area: a triangle whose middle vertex lies
+  on its longest edge is removed and that vertex inserted into the face across the edge (what
+  CGAL's ``remove_degenerate_faces`` does by edge flips), anything else is dropped;
+* :func:`drop_duplicate_faces` -- a face on the same vertices as an earlier one;
+* :func:`split_non_manifold` -- a vertex where separate fans of faces touch becomes one copy
+  per fan, and an edge shared by more than two faces is cut open so that each sheet keeps a
+  manifold neighbourhood: the faces around the edge are paired by their angular order (CGAL's
+  ``duplicate_non_manifold_vertices`` does the first, trimesh's and MeshLab's cleaning the
+  second only by deleting faces);
+* :func:`triangulate_faces` -- a polygon that is not planar, or not convex, is triangulated in
+  its plane (the coplanar merge then regroups coplanar triangles into convex parts).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from ..errors import MeshError
+
+
+@dataclass(frozen=True)
+class Repair:
+    """One change made to the input mesh.
+
+    Attributes
+    ----------
+    what : str
+        The kind of repair: ``"weld"``, ``"drop-face"``, ``"split-face"``, ``"split-vertex"``,
+        ``"cut-edge"``, ``"insert-vertex"``, ...
+    where : str
+        The element, by its index in the input (``"face 7"``, ``"vertex 12"``,
+        ``"edge (3, 9)"``, ``"vertices 4, 17"``).
+    why : str
+        What was wrong with it.
+    """
+
+    what: str
+    where: str
+    why: str
+
+    def as_dict(self) -> dict:
+        return {"what": self.what, "where": self.where, "why": self.why}
+
+    def __str__(self) -> str:
+        return f"{self.what} {self.where}: {self.why}"
+
+
+@dataclass
+class RepairLog:
+    """The repairs made so far; with ``strict`` the first one raises instead.
+
+    Attributes
+    ----------
+    strict : bool
+    repairs : list of Repair
+    """
+
+    strict: bool = False
+    repairs: list = field(default_factory=list)
+
+    def add(self, what: str, where: str, why: str, *, error: str, **element) -> None:
+        """Record a repair, or (``strict``) raise ``MeshError(error, **element)``."""
+        if self.strict:
+            raise MeshError(error, **element)
+        self.repairs.append(Repair(what, where, why))
+
+
+# ------------------------------------------------------------------------------ geometry
+def polygon_normal(p: np.ndarray) -> np.ndarray:
+    """(3,) Newell vector of a polygon ``p`` (k, 3) (twice its vector area), about its centroid."""
+    q = p - p.mean(axis=0)
+    return np.cross(q, np.roll(q, -1, axis=0)).sum(axis=0)
+
+
+def plane_axes(normal: np.ndarray) -> np.ndarray:
+    """(2, 3) orthonormal in-plane axes ``e1, e2`` with ``e1 x e2`` along ``normal``."""
+    n = normal / np.linalg.norm(normal)
+    e1 = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
+    e1 /= np.linalg.norm(e1)
+    return np.stack([e1, np.cross(n, e1)])
+
+
+def corner_turns(xy: np.ndarray) -> np.ndarray:
+    """(k,) signed turn at each corner of a 2D polygon ``xy`` (k, 2), radians in (-pi, pi]:
+    positive at a convex corner of a counter-clockwise polygon, 0 where it is straight."""
+    d_in = xy - np.roll(xy, 1, axis=0)
+    d_out = np.roll(xy, -1, axis=0) - xy
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    dot = np.einsum("ij,ij->i", d_in, d_out)
+    return np.arctan2(cross, dot)
+
+
+# ------------------------------------------------------------------------- face loops
+def split_face_loops(faces, origin, vorig, log: RepairLog):
+    """Drop consecutive repeats, split faces that visit a vertex twice, drop faces with fewer
+    than three distinct vertices.
+
+    Parameters
+    ----------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+        Input face of each face.
+    vorig : (n_vertices,) int
+        Input index of each vertex.
+    log : RepairLog
+
+    Returns
+    -------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+    """
+    out, out_origin = [], []
+    for f, o in zip(faces, origin.tolist(), strict=True):
+        g = f[f != np.roll(f, 1)] if len(f) > 1 else f
+        if len(g) == len(f) and len(np.unique(f)) == len(f) and len(f) >= 3:
+            out.append(f)
+            out_origin.append(o)
+            continue
+        distinct = len(np.unique(g))
+        if distinct < 3:
+            log.add(
+                "drop-face",
+                f"face {o}",
+                f"it has {distinct} distinct vertices once coincident vertices are welded",
+                error=f"degenerate face {o}: it has {distinct} distinct vertices after merging "
+                "duplicates (at least 3 needed)",
+                face=o,
+            )
+            continue
+        loops = _simple_loops(g.tolist())
+        if len(loops) == 1 and len(loops[0]) == len(g):
+            out.append(np.asarray(loops[0], dtype=np.int64))
+            out_origin.append(o)
+            continue
+        log.add(
+            "split-face",
+            f"face {o}",
+            f"it visits vertex {int(vorig[_repeated(g)])} twice: split into "
+            f"{len(loops)} simple polygon(s)",
+            error=f"degenerate face {o}: it visits a vertex twice ({g.tolist()})",
+            face=o,
+        )
+        for loop in loops:
+            out.append(np.asarray(loop, dtype=np.int64))
+            out_origin.append(o)
+    return out, np.asarray(out_origin, dtype=np.int64)
+
+
+def _repeated(g: np.ndarray) -> int:
+    values, counts = np.unique(g, return_counts=True)
+    return int(values[counts > 1][0])
+
+
+def _simple_loops(loop: list) -> list[list]:
+    """A closed vertex loop cut at its repeated vertices into simple loops of >= 3 vertices."""
+    done, stack = [], [loop]
+    while stack:
+        cur = stack.pop()
+        seen = {}
+        for i, x in enumerate(cur):
+            if x in seen:
+                j = seen[x]
+                stack += [cur[j:i], cur[:j] + cur[i:]]
+                break
+            seen[x] = i
+        else:
+            if len(cur) >= 3:
+                done.append(cur)
+    return done
+
+
+# ------------------------------------------------------------------------- zero-area faces
+def fix_degenerate_faces(faces, origin, v, vorig, log: RepairLog, rel_height: float):
+    """Remove faces of (almost) zero area without opening the surface.
+
+    A face is degenerate when its area is at most ``rel_height / 2`` times its longest edge
+    squared (its height over that edge below ``rel_height`` of it). A degenerate triangle
+    ``(a, b, c)`` with longest edge ``ab`` is removed and ``c`` is inserted into every other
+    face on ``ab`` (a triangle there is split in two), so the surface stays closed; other
+    degenerate faces are dropped. Repeated until none is left (at most 8 rounds).
+
+    Returns
+    -------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+    """
+    for _ in range(8):
+        bad = _degenerate(faces, v, rel_height)
+        if not len(bad):
+            break
+        faces = [np.asarray(f, dtype=np.int64) for f in faces]
+        on_edge = _faces_on_edges(faces)
+        drop, insert = set(), {}  # face -> list of (a, b, c): put c between a and b
+        for i in bad.tolist():
+            if i in drop:
+                continue
+            f = faces[i]
+            o = int(origin[i])
+            p = v[f]
+            length = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+            drop.add(i)
+            why = "its area is (almost) zero"
+            if len(f) == 3:
+                k = int(np.argmax(length))
+                a, b, c = int(f[k]), int(f[(k + 1) % 3]), int(f[(k + 2) % 3])
+                others = [j for j in on_edge.get((min(a, b), max(a, b)), []) if j != i]
+                others = [j for j in others if j not in drop]
+                for j in others:
+                    insert.setdefault(j, []).append((a, b, c))
+                if others:
+                    why += (
+                        f": vertex {int(vorig[c])} lies on its edge ({int(vorig[a])}, "
+                        f"{int(vorig[b])}) and was inserted into the face beside it"
+                    )
+            log.add(
+                "drop-face",
+                f"face {o}",
+                why,
+                error=f"degenerate face {o}: its area is (almost) zero (its height is below "
+                f"{rel_height:g} of its longest edge)",
+                face=o,
+            )
+        new_faces, new_origin = [], []
+        for j, (f, o) in enumerate(zip(faces, origin.tolist(), strict=True)):
+            if j in drop:
+                continue
+            for part in _insert_vertices(f, insert.get(j, ())):
+                new_faces.append(part)
+                new_origin.append(o)
+        faces, origin = new_faces, np.asarray(new_origin, dtype=np.int64)
+    bad = _degenerate(faces, v, rel_height)
+    if len(bad):
+        keep = np.ones(len(faces), dtype=bool)
+        keep[bad] = False
+        for i in bad.tolist():
+            o = int(origin[i])
+            log.add(
+                "drop-face",
+                f"face {o}",
+                "its area is (almost) zero",
+                error=f"degenerate face {o}: its area is (almost) zero",
+                face=o,
+            )
+        faces = [f for f, k in zip(faces, keep, strict=True) if k]
+        origin = origin[keep]
+    return faces, origin
+
+
+def _degenerate(faces, v, rel_height: float) -> np.ndarray:
+    """Indices of the faces whose area is at most ``rel_height / 2`` x longest edge squared."""
+    if not faces:
+        return np.zeros(0, dtype=np.int64)
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    start = np.concatenate([[0], np.cumsum(size)])
+    idx = np.concatenate(faces)
+    face = np.repeat(np.arange(len(faces)), size)
+    nxt = np.arange(len(idx)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    p = v[idx]
+    centroid = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
+    q = p - centroid[face]
+    area = 0.5 * np.linalg.norm(np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0), axis=1)
+    longest = np.maximum.reduceat(np.linalg.norm(p[nxt] - p, axis=1), start[:-1])
+    return np.flatnonzero(area <= 0.5 * rel_height * longest**2)
+
+
+def _faces_on_edges(faces) -> dict:
+    """(a, b) with a < b -> faces using that edge."""
+    out: dict = {}
+    for i, f in enumerate(faces):
+        fl = f.tolist()
+        for a, b in zip(fl, fl[1:] + fl[:1], strict=True):
+            out.setdefault((min(a, b), max(a, b)), []).append(i)
+    return out
+
+
+def _insert_vertices(f: np.ndarray, inserts) -> list[np.ndarray]:
+    """Face ``f`` with each ``c`` of ``inserts`` (a, b, c) put between ``a`` and ``b``; a
+    triangle that gets one vertex is split into two triangles at it."""
+    if not inserts:
+        return [f]
+    loop = f.tolist()
+    for a, b, c in inserts:
+        if c in loop:
+            continue
+        n = len(loop)
+        for k in range(n):
+            x, y = loop[k], loop[(k + 1) % n]
+            if {x, y} == {a, b}:
+                loop.insert(k + 1, c)
+                break
+    if len(f) == 3 and len(loop) == 4:  # split the triangle at the new vertex
+        k = next(i for i, x in enumerate(loop) if x not in f.tolist())
+        c, b, d, a = (loop[(k + j) % 4] for j in range(4))
+        return [np.array([c, b, d], dtype=np.int64), np.array([c, d, a], dtype=np.int64)]
+    return [np.asarray(loop, dtype=np.int64)]
+
+
+# ------------------------------------------------------------------------- duplicate faces
+def drop_duplicate_faces(faces, origin, log: RepairLog):
+    """Drop every face on the same set of vertices as an earlier face (either orientation).
+
+    Returns
+    -------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+    """
+    keep = np.ones(len(faces), dtype=bool)
+    twin = {}  # dropped face -> the earlier face it repeats
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    for k in np.unique(size).tolist():
+        rows = np.flatnonzero(size == k)
+        keys = np.sort(np.array([faces[i] for i in rows.tolist()]), axis=1)
+        _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        for j in np.flatnonzero(np.arange(len(rows)) != first[inverse]).tolist():
+            twin[int(rows[j])] = int(rows[first[inverse[j]]])
+    for i in sorted(twin):
+        keep[i] = False
+        o, o0 = int(origin[i]), int(origin[twin[i]])
+        log.add(
+            "drop-face",
+            f"face {o}",
+            f"it uses the same vertices as face {o0} (duplicate face)",
+            error=f"degenerate face {o}: it uses the same vertices as face {o0} (duplicate face)",
+            face=o,
+        )
+    return [f for f, k in zip(faces, keep, strict=True) if k], origin[keep]
+
+
+# ------------------------------------------------------------------------- non-manifold
+def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=()):
+    """Make every edge and vertex manifold by giving vertices one copy per fan.
+
+    The corners of a vertex (one per face using it) are joined across each edge whose faces
+    are paired: the two faces of an ordinary edge; around an edge shared by more than two
+    faces, neighbours in the angular order around the edge, paired so that each pair's
+    normals point out of the wedge between them (the two faces of one solid, where solids
+    touch along an edge); an odd face out keeps the edge as a border. Each connected set of
+    corners of a vertex is a fan; a vertex with several fans gets one copy per fan (the first
+    keeps its index). Edges listed in ``unpaired`` (as (a, b), a < b, current indices) are
+    cut open the same way.
+
+    Returns
+    -------
+    faces : list of (k,) int
+    v : (n_vertices', 3) float
+    vorig : (n_vertices',) int
+        Input index of each vertex (copies keep their original's).
+    """
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    start = np.concatenate([[0], np.cumsum(size)])
+    frm = np.concatenate(faces).astype(np.int64)
+    face = np.repeat(np.arange(len(faces)), size)
+    nxt = np.arange(len(frm)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    to = frm[nxt]
+    n = len(v)
+    lo, hi = np.minimum(frm, to), np.maximum(frm, to)
+    key = lo * n + hi
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    bounds = np.flatnonzero(np.r_[True, ks[1:] != ks[:-1], True])
+    count = np.diff(bounds)
+    cut = {int(a) * n + int(b) for a, b in unpaired}
+    pairs = []  # (half-edge, half-edge) joined across their edge
+    two = np.flatnonzero(count == 2)
+    h1, h2 = order[bounds[two]], order[bounds[two] + 1]
+    keep2 = np.array([int(k) not in cut for k in ks[bounds[two]]], dtype=bool)
+    pairs.append(np.stack([h1[keep2], h2[keep2]], axis=1))
+    for g in np.flatnonzero(count > 2).tolist():
+        hs = order[bounds[g] : bounds[g + 1]]
+        a, b = int(lo[hs[0]]), int(hi[hs[0]])
+        if a * n + b in cut:
+            continue
+        chosen, single = _pair_around_edge(hs, a, b, frm, face, start, size, v)
+        pairs.append(np.asarray(chosen, dtype=np.int64).reshape(-1, 2))
+        why = (
+            f"shared by {len(hs)} faces: cut open so that each sheet keeps two faces "
+            f"({len(chosen)} pair(s)" + (", one face left with a border there)" if single else ")")
+        )
+        log.add(
+            "cut-edge",
+            f"edge ({int(vorig[a])}, {int(vorig[b])})",
+            why,
+            error=f"non-manifold edge ({int(vorig[a])}, {int(vorig[b])}): shared by {len(hs)} "
+            "faces (at most 2 allowed)",
+            edge=(int(vorig[a]), int(vorig[b])),
+        )
+    for a, b in unpaired:
+        log.add(
+            "cut-edge",
+            f"edge ({int(vorig[a])}, {int(vorig[b])})",
+            "the surface cannot be oriented consistently across it (a Moebius-like band): cut open",
+            error="non-orientable surface",
+            edge=(int(vorig[a]), int(vorig[b])),
+        )
+    pairs = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
+    # corner of vertex x in the face of half-edge h (h on edge (x, y)): h if h leaves x
+    ha, hb = pairs[:, 0], pairs[:, 1]
+    x = frm[ha]
+    corner_a_x, corner_a_y = ha, nxt[ha]
+    corner_b_x = np.where(frm[hb] == x, hb, nxt[hb])
+    corner_b_y = np.where(frm[hb] == x, nxt[hb], hb)
+    rows = np.concatenate([corner_a_x, corner_a_y])
+    cols = np.concatenate([corner_b_x, corner_b_y])
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(frm), len(frm)))
+    _, label = connected_components(graph, directed=False)
+    # fans: distinct (vertex, label); the fan with the lowest corner keeps the vertex
+    fan_key = frm * (int(label.max()) + 1) + label
+    uniq, first_corner, fan_of = np.unique(fan_key, return_index=True, return_inverse=True)
+    fan_of = fan_of.reshape(-1)
+    fan_vertex = frm[first_corner]
+    # order fans of a vertex by their lowest corner; the first keeps the index
+    by = np.lexsort((first_corner, fan_vertex))
+    rank = np.zeros(len(uniq), dtype=np.int64)
+    sv = fan_vertex[by]
+    first_of_v = np.r_[True, sv[1:] != sv[:-1]]
+    group_start = np.maximum.accumulate(np.where(first_of_v, np.arange(len(sv)), 0))
+    rank[by] = np.arange(len(sv)) - group_start
+    extra = np.flatnonzero(rank > 0)
+    new_index = fan_vertex.copy()
+    new_index[extra] = n + np.arange(len(extra))
+    if len(extra):
+        counts = np.bincount(fan_vertex, minlength=n)
+        for u in np.flatnonzero(counts > 1).tolist():
+            log.add(
+                "split-vertex",
+                f"vertex {int(vorig[u])}",
+                f"its faces form {int(counts[u])} separate fans: one copy per fan",
+                error=f"non-manifold vertex {int(vorig[u])}: its faces form {int(counts[u])} "
+                "separate fans (faces touching only at this vertex)",
+                vertex=int(vorig[u]),
+            )
+    corner_vertex = new_index[fan_of]
+    v2 = np.concatenate([v, v[fan_vertex[extra]]])
+    vorig2 = np.concatenate([vorig, vorig[fan_vertex[extra]]])
+    out = np.split(corner_vertex, start[1:-1])
+    return out, v2, vorig2
+
+
+def _pair_around_edge(hs, a, b, frm, face, start, size, v):
+    """Pair the half-edges ``hs`` of the faces around edge (a, b) by angular order.
+
+    Returns the chosen pairs (list of (h, h)) and whether one face was left unpaired.
+    """
+    d = v[b] - v[a]
+    d /= np.linalg.norm(d)
+    axes = plane_axes(d)
+    theta, side = [], []
+    for h in hs.tolist():
+        f = int(face[h])
+        p = v[frm[start[f] : start[f] + size[f]]]
+        w = p.mean(axis=0) - v[a]
+        w -= (w @ d) * d
+        theta.append(float(np.arctan2(w @ axes[1], w @ axes[0])))
+        nrm = polygon_normal(p)
+        side.append(float(np.sign(nrm @ np.cross(d, w))))  # +1: normal toward larger angle
+    order = np.argsort(theta, kind="stable")
+    hs_sorted = hs[order]
+    side = np.asarray(side)[order]
+    k = len(hs)
+
+    def score(i, j):  # normals out of the wedge from i to j (i before j in angle)
+        return -side[i] + side[j]
+
+    best, best_score, single = None, -np.inf, False
+    starts = range(k) if k % 2 else range(2)
+    for s in starts:
+        idx = [(s + t) % k for t in range(k)]
+        chosen = [(idx[t], idx[t + 1]) for t in range(0, k - 1, 2)]
+        total = sum(score(i, j) for i, j in chosen)
+        if total > best_score:
+            best, best_score, single = chosen, total, k % 2 == 1
+    return [(int(hs_sorted[i]), int(hs_sorted[j])) for i, j in best], single
+
+
+# ------------------------------------------------------------------------- triangulation
+def triangulate_polygon(p: np.ndarray) -> list[tuple[int, int, int]]:
+    """Triangles (local corner indices) of a polygon ``p`` (k, 3), counter-clockwise about its
+    Newell normal: a constrained Delaunay triangulation of its projection (shapely), or a fan
+    from the first corner when the projection is not a simple polygon."""
+    k = len(p)
+    if k == 3:
+        return [(0, 1, 2)]
+    axes = plane_axes(polygon_normal(p))
+    xy = (p - p.mean(axis=0)) @ axes.T
+    poly = shapely.Polygon(xy)
+    if poly.is_valid and len({tuple(q) for q in xy.tolist()}) == k:
+        where = {tuple(q): i for i, q in enumerate(xy.tolist())}
+        tris = []
+        for t in shapely.get_parts(shapely.constrained_delaunay_triangles(poly)):
+            ring = np.asarray(t.exterior.coords)[:3]
+            ids = [where.get(tuple(q)) for q in ring.tolist()]
+            if None in ids:
+                break
+            i, j, m = ids
+            a, b, c = xy[i], xy[j], xy[m]
+            if (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) < 0:
+                j, m = m, j
+            tris.append((i, j, m))
+        else:
+            if len(tris) == k - 2:
+                return sorted(tris)
+    return [(0, i, i + 1) for i in range(1, k - 1)]
+
+
+def triangulate_faces(faces, origin, v, which, log: RepairLog, why, error):
+    """Replace the faces ``which`` (indices) by their triangles (:func:`triangulate_polygon`).
+
+    ``why(i)`` says what is wrong with face ``i``; ``error(o, i)`` gives the strict-mode
+    message for it (``o`` its input face).
+
+    Returns
+    -------
+    faces : list of (k,) int
+    origin : (n_faces,) int
+    """
+    which = set(int(i) for i in which)
+    if not which:
+        return faces, origin
+    out, out_origin = [], []
+    for i, (f, o) in enumerate(zip(faces, origin.tolist(), strict=True)):
+        if i not in which:
+            out.append(f)
+            out_origin.append(o)
+            continue
+        tris = triangulate_polygon(v[f])
+        log.add(
+            "split-face",
+            f"face {o}",
+            f"{why(i)}: split into {len(tris)} triangles (coplanar ones are merged again into "
+            "convex parts)",
+            error=error(o, i),
+            face=o,
+        )
+        for t in tris:
+            out.append(f[list(t)])
+            out_origin.append(o)
+    return out, np.asarray(out_origin, dtype=np.int64)
