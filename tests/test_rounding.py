@@ -119,11 +119,25 @@ def test_flat_edges_are_not_rounded():
 
 @pytest.mark.parametrize(
     ("radius", "match"),
-    [(np.nan, "finite"), (-0.1, "positive"), (0.0, "positive"), (np.ones(3), "shape")],
+    [(np.nan, "finite"), (-0.1, "positive"), (np.ones(3), "shape")],
 )
 def test_bad_radius(radius, match):
     with pytest.raises(ParameterError, match=match):
         round_edges(mesh("cube"), radius)
+
+
+def test_zero_radius_and_slivers_leave_edges_sharp():
+    """Radius 0 on a bent edge, or a fillet narrower than ``floor`` of its edge, leaves the edge
+    sharp: radius 0 but its half angle and mountain/valley sign kept."""
+    m = mesh("cube")
+    r = np.full(m.n_edges, 0.1)
+    r[0] = 0.0
+    r[1] = 1e-5
+    rd = round_edges(m, r, floor=1e-3)
+    assert rd.sharp.tolist() == [True, True] + [False] * (m.n_edges - 2)
+    assert np.all(rd.radius[:2] == 0) and np.all(rd.arc_length[:2] == 0)
+    assert_allclose(rd.half_angle, np.pi / 4) and np.all(rd.kappa == 1)
+    assert round_edges(m, r).sharp.tolist() == [True] + [False] * (m.n_edges - 1)
 
 
 @pytest.mark.parametrize("name", ["cube", "dimpled-cube", "random-convex"])

@@ -596,7 +596,13 @@ def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
 
 
 def hole_heights(frame: VertexFrame) -> np.ndarray:
-    """(n_sides,) height of the hole border above the midpoint cross-section on each side."""
+    """(n_sides,) height of the hole border above the midpoint cross-section on each side.
+
+    At a closed ring whose edges are all unrounded (a sharp vertex) the border runs through
+    the vertex itself: no hole, the faces meet at it.
+    """
+    if frame.ring.closed and not (frame.arrays.radius > 0).any():
+        return 0.5 * frame.arrays.length
     lm = np.fmin(frame.lmax_start, frame.lmax_end)
     return 0.5 * lm
 

@@ -186,8 +186,28 @@ def clamp_radii(
     r = np.where(inner, np.broadcast_to(np.asarray(edge_radius, float), (mesh.n_edges,)), 0.0)
     limit, *_ = radius_limits(mesh, r, gamma)
     r = np.where(r > share * limit, share * limit, r)
+    return shrink_broken(mesh, r, gamma, share=share)
+
+
+def shrink_broken(mesh: PolyMesh, edge_radius, half_angle, *, share: float = 0.9) -> np.ndarray:
+    """Shrink the radii whose tangent-line crossings pass an edge midpoint by ``share`` until
+    none does (valid radii are kept as they are).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    edge_radius : (n_edges,) float
+    half_angle : (n_edges,) float
+    share : float
+        In (0, 1).
+
+    Returns
+    -------
+    (n_edges,) float
+    """
+    r = np.array(edge_radius, dtype=float)
     for _ in range(200):
-        _, _, broken, _ = radius_limits(mesh, r, gamma)
+        _, _, broken, _ = radius_limits(mesh, r, half_angle)
         if not broken.any():
             break
         r[broken] *= share
@@ -223,6 +243,9 @@ class EdgeRounding:
         :func:`radius_limits`).
     uniform_limit : float
         Largest valid uniform radius.
+    sharp : (n_edges,) bool
+        Interior edges left sharp: bent, but not rounded (radius 0) because their fillet
+        would have been a sliver (see ``floor`` in :func:`round_edges`).
     """
 
     radius: np.ndarray
@@ -235,6 +258,7 @@ class EdgeRounding:
     tangent_point: np.ndarray
     limit: np.ndarray
     uniform_limit: float
+    sharp: np.ndarray | None = None
 
     def arc_points(self, samples: int, step_deg: float = 0.0) -> np.ndarray:
         """Points to sample on each edge's arc (both ends included).
@@ -262,17 +286,24 @@ class EdgeRounding:
         return np.where(self.arc_length > 0, n, 1)
 
 
-def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -> EdgeRounding:
+def round_edges(
+    mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg, floor: float = 0.0
+) -> EdgeRounding:
     """Round every interior edge with a cylinder tangent to both faces.
 
     Parameters
     ----------
     mesh : PolyMesh
     radius : float or (n_edges,) float
-        Absolute radius, uniform or per edge (values at boundary and flat edges are ignored).
+        Absolute radius, uniform or per edge (values at boundary and flat edges are ignored; 0
+        on a bent edge leaves it sharp).
     flat_deg : float
         An interior edge whose faces meet within this angle (degrees) is flat: not rounded
         (radius 0), its two faces join smoothly.
+    floor : float
+        An edge whose fillet would be narrower than ``floor`` times the edge's length
+        (strip width ``A = 2 r tan(gamma)``) is left sharp: radius 0, its faces meet at a
+        straight crease folded by the dihedral angle (half angle and kappa kept). 0: none.
 
     Returns
     -------
@@ -281,7 +312,7 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
     Raises
     ------
     ParameterError
-        If a radius is not finite or not positive, or exceeds its edge's limit (the message
+        If a radius is not finite or negative, or exceeds its edge's limit (the message
         names the edge, its vertices, the limit and the largest uniform radius).
     """
     gamma, kappa = edge_dihedral(mesh)
@@ -296,13 +327,16 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
     rounded = inner & ~flat
     if not np.all(np.isfinite(r[rounded])):
         raise ParameterError("radius must be finite", name="radius")
-    if np.any(r[rounded] <= 0):
-        e = int(np.nonzero(rounded & (r <= 0))[0][0])
+    if np.any(r[rounded] < 0):
+        e = int(np.nonzero(rounded & (r < 0))[0][0])
         raise ParameterError(
             f"radius must be positive (edge {e} has {r[e]:g})", name="radius", edge=e
         )
     r[~inner | flat] = 0.0
     kappa[flat] = 0
+    sharp = rounded & ((r == 0) | (2 * r * np.tan(gamma) < floor * mesh.edge_length))
+    r[sharp] = 0.0
+    rounded &= ~sharp
     limit, given, broken, uniform = radius_limits(mesh, r, gamma)
     if broken.any():
         ratio = np.where(broken, r / limit, 0.0)
@@ -329,7 +363,7 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
         n = mesh.face_normal[ef[rounded, k]]
         tangent[rounded, k] = axis[rounded] + (kappa[rounded] * r[rounded])[:, None] * n
     gamma = np.where(flat, 0.0, gamma)
-    arc = 2 * r * gamma
+    arc = 2 * r * gamma  # 0 at flat and sharp edges
     strip = 2 * r * np.tan(gamma)
     return EdgeRounding(
         radius=r,
@@ -342,4 +376,5 @@ def round_edges(mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg) -
         tangent_point=tangent,
         limit=limit,
         uniform_limit=uniform,
+        sharp=sharp,
     )

@@ -423,9 +423,15 @@ class VertexFrame:
         return self._gluing(side, frame, 0.0)
 
     def gluing_end(self, i: int) -> np.ndarray:
-        """Map from cylinder ``i``'s chart into the chart of face ``f_i``."""
+        """Map from cylinder ``i``'s chart into the chart of face ``f_i`` (a side of radius 0
+        meets it along its own line: the chart's ``s`` axis turns into ``R x N`` of ``f_i``)."""
         side = self.sides[i]
-        return self._gluing(side, self.face_frames[i], side.arc)
+        frame = self.face_frames[i]
+        if side.radius == 0:
+            s = np.zeros(1)
+            t = np.cross(side.R, np.cross(frame[1], frame[2]))[None]
+            return _gluing_maps(t, side.R[None], frame[None], side.base(s), s)[0]
+        return self._gluing(side, frame, side.arc)
 
     @staticmethod
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
@@ -693,10 +699,11 @@ def vertex_frames(
     g_start = np.full((len(sv), 3, 3), np.nan)
     g_end_inv = np.full((len(sv), 3, 3), np.nan)
     g_start[rs] = _gluing_maps(sa.tangent(rs, s0), R[rs], frames[f_prev[rs]], sa.base(rs, s0), s0)
+    t_end = sa.tangent(rs, arc[rs])
+    unbent = ~curved[rs]  # a side of radius 0 (flat or sharp) meets f_i along its own line
+    t_end[unbent] = np.cross(R[rs[unbent]], normals[f_next[rs[unbent]]])
     g_end_inv[rs] = invert(
-        _gluing_maps(
-            sa.tangent(rs, arc[rs]), R[rs], frames[f_next[rs]], sa.base(rs, arc[rs]), arc[rs]
-        )
+        _gluing_maps(t_end, R[rs], frames[f_next[rs]], sa.base(rs, arc[rs]), arc[rs])
     )
     current = np.repeat(np.eye(3)[None], n, axis=0)  # tau = f_{n-1}; f_0 for an open ring
     cyl_map = np.full((len(sv), 3, 3), np.nan)

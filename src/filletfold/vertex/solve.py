@@ -26,7 +26,7 @@ from .frame import VertexFrame, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
 
-STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable")
+STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable", "sharp")
 
 
 @dataclass
@@ -36,9 +36,11 @@ class VertexResult:
     Attributes
     ----------
     kind : list of str
-        ``"cone"``, ``"saddle"``, ``"developable"`` or ``"boundary"``.
+        ``"cone"``, ``"saddle"``, ``"developable"``, ``"boundary"`` or ``"sharp"`` (no edge at
+        the vertex is rounded: its faces meet at the vertex itself).
     status : list of str
-        ``"ok"``, ``"saddle"``, ``"infeasible"``, ``"boundary"`` or ``"developable"``.
+        ``"ok"``, ``"saddle"``, ``"infeasible"``, ``"boundary"``, ``"developable"`` or
+        ``"sharp"``.
     reason : list of str or None
     angle_sum, defect, solid_angle : (n,) float
     normal : (n, 3) float
@@ -167,8 +169,18 @@ def classify_vertices(
         rounding.kappa[edges], rounding.half_angle[edges], count
     )
     developable = is_developable(res.angle_sum[u_closed])
+    unrounded = (
+        np.maximum.reduceat(np.concatenate([a.radius for a in sides]), np.cumsum(count) - count)
+        == 0
+    )
     for j, (k, u, b) in enumerate(zip(closed, u_closed.tolist(), bound.tolist(), strict=True)):
-        if developable[j]:
+        if unrounded[j]:
+            res.kind[u] = res.status[u] = "sharp"
+            res.reason[u] = (
+                "no edge at this vertex is rounded (each is flat, or left sharp because its "
+                "fillet would be a sliver): its faces meet at the vertex itself"
+            )
+        elif developable[j]:
             frame = frames[k]
             res.kind[u] = "developable"
             gap = float(np.linalg.norm(frame.rho[:2, 2]))
