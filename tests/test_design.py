@@ -89,18 +89,27 @@ def check_pieces_lie_on_their_planes_and_cylinders(d):
 
 def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
     example_design = d
-    """A cone whose apex lies behind the surface (sigma = -1) folds every crease as a mountain."""
+    """A cone whose apex lies behind the surface (sigma = -1) folds every crease as a mountain;
+    a crease between two face pieces lies on an edge left sharp and folds by its dihedral
+    angle, a mountain where the edge is convex."""
     d = example_design
-    p = d.pattern
+    p, m, rd = d.pattern, d.mesh, d.rounding
     cone_of = np.array([int(s.split()[1]) if s.startswith("cone") else -1 for s in p.face_patch])
+    face_of = np.array([int(s.split()[1]) if s.startswith("face") else -1 for s in p.face_patch])
     crease = np.isin(p.edge_assignment, ["M", "V"])
     assert np.all(
         np.sign(p.edge_fold_angle[crease]) == np.where(p.edge_assignment[crease] == "M", -1, 1)
     )
+    edge_of = {tuple(sorted(f)): e for e, f in enumerate(m.edge_faces.tolist())}
     for k in np.nonzero(crease)[0]:
         fa, fb = p.edge_faces[k]
         u = max(cone_of[fa], cone_of[fb])
-        assert u >= 0, "every crease borders a cone"
+        if u < 0:  # two face pieces: a sharp edge
+            e = edge_of[tuple(sorted((face_of[fa], face_of[fb])))]
+            assert rd.sharp[e], "every crease borders a cone or lies on a sharp edge"
+            assert p.edge_assignment[k] == ("M" if rd.kappa[e] > 0 else "V")
+            assert_allclose(abs(p.edge_fold_angle[k]), np.degrees(2 * rd.half_angle[e]), atol=1e-6)
+            continue
         assert p.edge_assignment[k] == ("M" if d.vertices.sigma[u] < 0 else "V")
     # cylinder/face joins and facets are F with angle 0; borders are B
     assert np.all(p.edge_fold_angle[~crease] == 0)
@@ -341,7 +350,8 @@ def test_export_writes_the_four_files(tmp_path):
         ({"samples": 2}, ParameterError, "samples must be an integer >= 3"),
         ({"radius": "abc"}, ParameterError, "radius must be a number or a percentage"),
         ({"radius": "-5%"}, ParameterError, "radius must be positive"),
-        ({"radius": 3.0}, ParameterError, r"exceeds its limit 0\.5"),
+        ({"radius": 3.0, "strict": True}, ParameterError, r"exceeds its limit 0\.5"),
+        ({"radius": 3.0, "clamp": False}, ParameterError, r"exceeds its limit 0\.5"),
         ({"depth": -1}, ParameterError, "depth must be positive"),
         ({"depth": float("nan")}, ParameterError, "depth must be finite"),
         ({"depth": np.ones(3)}, ParameterError, r"per-element depth must have shape \(8,\)"),
@@ -395,6 +405,23 @@ def s_prism():
     return v, faces
 
 
+def test_radii_over_their_limits_are_fitted_by_default():
+    d = filletfold.round_mesh("cube", radius=3.0)
+    assert np.all(d.rounding.radius <= 0.9 * 0.5 + 1e-12)
+    assert len(d.fitting["reduced"]) == d.mesh.n_edges
+    assert_allclose(d.fitting["radius_requested"], 3.0)
+    assert "fitted" in d.summary()
+
+
 def test_face_that_is_not_star_shaped_is_split_into_convex_parts():
     d = filletfold.round_mesh(s_prism(), radius=0.05)
+    assert any(r.what == "split-face" for r in d.repairs)
     assert d.mesh.corner_angles().max() <= np.pi + 1e-9
+    assert "repair" in d.summary()
+
+
+def test_face_that_is_not_star_shaped_is_named():
+    from filletfold.errors import MeshError
+
+    with pytest.raises(MeshError, match=r"face \d+ is not star-shaped"):
+        filletfold.round_mesh(s_prism(), radius=0.05, strict=True)

@@ -15,7 +15,17 @@ from pathlib import Path
 import numpy as np
 
 from .conical import conical_material_loss, is_conical, vertex_cone_axes
-from .errors import ParameterError, SolverError
+from .errors import (
+    FilletfoldError,
+    InternalError,
+    ParameterError,
+    SolverError,
+    callers_progress,
+    is_callers,
+    named_stages,
+    one_line,
+)
+from .errors import stage as _stage
 from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
 from .layout import shelf_layout
 from .material_loss import MaterialLoss, solve_material_loss
@@ -28,6 +38,7 @@ from .rounding import EdgeRounding, clamp_radii, round_edges
 from .sheet import glue_pieces
 from .tabs import add_tabs_and_labels
 from .tolerances import tol
+from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
 
 DEFAULT_RADIUS = "10%"
@@ -95,7 +106,12 @@ class Parameters:
     arc_step : float
         Largest turn between two samples of an arc (degrees; 0: every arc gets ``samples``).
     clamp : bool
-        Whether radii over their limit were reduced to fit.
+        Whether radii over their limit were reduced to fit (the default; off with ``strict``).
+    fit_vertices : bool
+        Whether infeasible vertices got smaller radii on their edges when that makes their
+        cone feasible (the default; off with ``strict``).
+    strict : bool
+        Whether defects of the mesh were refused instead of repaired.
     material_loss : bool
         Whether radii came from the consistent-material-loss programme.
     max_loss : float, str or None
@@ -110,11 +126,13 @@ class Parameters:
     depth: object = DEFAULT_DEPTH
     samples: int = DEFAULT_SAMPLES
     arc_step: float = DEFAULT_ARC_STEP
-    clamp: bool = False
+    clamp: bool = True
     material_loss: bool = False
     max_loss: object = None
     layout: str = "auto"
     coplanar_deg: float = tol.coplanar_deg
+    fit_vertices: bool = True
+    strict: bool = False
 
     def as_dict(self) -> dict:
         def plain(x):
@@ -130,6 +148,8 @@ class Parameters:
             "max_loss": plain(self.max_loss) if self.max_loss is not None else None,
             "layout": self.layout,
             "coplanar_deg": self.coplanar_deg,
+            "fit_vertices": self.fit_vertices,
+            "strict": self.strict,
         }
 
 
@@ -150,7 +170,10 @@ class Stages:
     loss : MaterialLoss or None
     conical : bool
         Whether the radii came from the conical-mesh offset (cone axes as normals).
+    requested : (n_edges,) float
+        The radii asked for.
     rounding : EdgeRounding
+        The radii used (fitted to their limits, smaller where vertices were rescued).
     centres : (n_faces, 3) float
     frames : list of VertexFrame
     classified : VertexResult
@@ -168,6 +191,7 @@ class Stages:
     key: tuple
     loss: MaterialLoss | None
     conical: bool
+    requested: np.ndarray
     rounding: EdgeRounding
     centres: np.ndarray
     frames: list
@@ -222,6 +246,16 @@ class Design:
         left without a tab.
     stages : Stages or None
         Intermediate results a later ``round_mesh(..., reuse=design)`` takes over.
+    repairs : list of Repair
+        The repairs made to the input mesh (:mod:`filletfold.mesh.repair`).
+    fitting : dict
+        ``radius_requested`` (n_edges,) float, the radii asked for (0 at boundary and flat
+        edges); ``fitted_radius`` (n_edges,) float, the radii after fitting to the limits and
+        before any rescue; ``reduced`` (k,) int, the edges whose radius was reduced to fit its
+        limit; ``sharp`` (k,) int, the edges left sharp (their fillet would be narrower than
+        ``tol.fillet_floor`` of the edge); ``rescued`` (dict vertex -> factor), the vertices
+        whose edges' radii were scaled by ``factor`` to make their cone feasible (applied when
+        ``rescue_applied``, else only reported in their reason).
     """
 
     mesh: PolyMesh
@@ -237,6 +271,8 @@ class Design:
     layout_note: str = ""
     fabrication: dict = field(default_factory=dict)
     stages: Stages | None = field(default=None, repr=False, compare=False)
+    repairs: list = field(default_factory=list)
+    fitting: dict = field(default_factory=dict)
 
     @property
     def vertex_status(self) -> list:
@@ -358,8 +394,9 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
     res.apex_2d[us[near]] = pattern.vertices_2d[k[near]]
 
 
-def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg):
-    """Radii (given, clamped, or from the material-loss programme) and the edge rounding.
+def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg, floor):
+    """Radii (given, fitted to their limits, or from the material-loss programme) and the edge
+    rounding.
 
     Returns
     -------
@@ -367,9 +404,15 @@ def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg):
     rounding : EdgeRounding
     conical : bool
         True when the radii came from a conical mesh's face offset.
+    requested : (n_edges,) float
+        The radius asked for on each edge (the cap with ``material_loss``).
     """
     ref = pm.mean_edge_length
     loss, conical = None, False
+    requested = np.broadcast_to(
+        np.asarray(parse_length(radius, ref, "radius", count=pm.n_edges), dtype=float),
+        (pm.n_edges,),
+    ).copy()
     if material_loss:
         cap = None if max_loss is None else float(parse_length(max_loss, ref, "max loss"))
         developable = np.all(
@@ -390,9 +433,11 @@ def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg):
         r = parse_length(radius, ref, "radius", count=pm.n_edges)
         if clamp:
             r = clamp_radii(pm, r, flat_deg=coplanar_deg)
-    return loss, round_edges(pm, r, flat_deg=coplanar_deg), conical
+    floor = 0.0 if material_loss else floor  # consistent losses need every edge rounded
+    return loss, round_edges(pm, r, flat_deg=coplanar_deg, floor=floor), conical, requested
 
 
+@named_stages("reading the mesh")
 def round_mesh(
     mesh,
     radius=DEFAULT_RADIUS,
@@ -400,7 +445,7 @@ def round_mesh(
     *,
     samples: int = DEFAULT_SAMPLES,
     arc_step: float = DEFAULT_ARC_STEP,
-    clamp: bool = False,
+    clamp: bool | None = None,
     material_loss: bool = False,
     max_loss=None,
     layout: str = "auto",
@@ -412,6 +457,8 @@ def round_mesh(
     progress=None,
     reuse: Design | None = None,
     keep_stages: bool = True,
+    strict: bool = False,
+    fit_vertices: bool | None = None,
 ) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
@@ -434,9 +481,10 @@ def round_mesh(
         turn by a few degrees, is not sampled as densely as a cube's quarter turns. The chord
         then deviates from the cylinder by at most ``r (1 - cos(arc_step / 2))`` (8.6e-5 r at
         1.5 degrees). 0 gives every arc ``samples`` points.
-    clamp : bool
+    clamp : bool, optional
         Reduce radii over their edge's limit to 90% of it (see
-        :func:`filletfold.rounding.clamp_radii`) instead of raising.
+        :func:`filletfold.rounding.clamp_radii`) instead of raising. Default: on, off with
+        ``strict``.
     material_loss : bool
         Choose every edge's radius from the consistent-material-loss linear programme (sec. 4,
         :func:`filletfold.material_loss.solve_material_loss`); ``radius`` is then the largest
@@ -468,6 +516,15 @@ def round_mesh(
         An earlier design of the same mesh: when the rounding parameters are the same, its
         rounding, frames and normals are taken over and only the vertices whose depth changed
         are re-solved and rebuilt (see :class:`Stages`); the result is the same as without.
+    strict : bool
+        Refuse instead of repairing: a defect of the mesh raises the :class:`MeshError` that
+        names it (see :func:`~filletfold.mesh.clean.clean_mesh`), and ``clamp`` and
+        ``fit_vertices`` default to off.
+    fit_vertices : bool, optional
+        When a cone vertex is infeasible, halve the radii of its edges (up to four times) and
+        keep them where that makes its cone feasible (:mod:`filletfold.vertex.rescue`); off,
+        the radius that would work is only given in its reason. Default: on, off with
+        ``strict``.
     keep_stages : bool
         Keep what ``reuse`` needs in ``design.stages`` (the default). False lets the vertex
         frames and modules go as soon as the layout no longer needs them, which lowers the peak
@@ -509,19 +566,26 @@ def round_mesh(
             f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
             name="coplanar_deg",
         )
+    progress = callers_progress(progress)
+    strict = bool(strict)
+    clamp = (not strict) if clamp is None else bool(clamp)
+    fit_vertices = (not strict) if fit_vertices is None else bool(fit_vertices)
+    floor = 0.0 if strict else tol.fillet_floor
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
-    pm, _ = load_mesh(mesh, coplanar_deg=coplanar_deg)
+    pm, clean_log = load_mesh(mesh, coplanar_deg=coplanar_deg, strict=strict)
     timings["read"] = time.perf_counter() - t0
     params = Parameters(
         radius=radius,
         depth=depth,
         samples=int(samples),
         arc_step=float(arc_step),
-        clamp=bool(clamp),
+        clamp=clamp,
         material_loss=bool(material_loss),
         max_loss=max_loss,
         layout=layout,
         coplanar_deg=coplanar_deg,
+        fit_vertices=fit_vertices,
+        strict=strict,
     )
     ref = pm.mean_edge_length
 
@@ -531,15 +595,21 @@ def round_mesh(
         st = None
 
     t = time.perf_counter()
+    _stage("rounding the edges")
     if st is not None:
         loss, rounding, centres, conical = st.loss, st.rounding, st.centres, st.conical
+        requested = st.requested
     else:
-        loss, rounding, conical = _round(pm, radius, clamp, material_loss, max_loss, coplanar_deg)
+        loss, rounding, conical, requested = _round(
+            pm, radius, clamp, material_loss, max_loss, coplanar_deg, floor
+        )
         centres = face_piece_centres(pm, rounding)
+    fitted_radius = rounding.radius.copy()
     timings["rounding"] = time.perf_counter() - t
     depths = _resolve_depth(depth, ref, pm.n_vertices)
 
     t = time.perf_counter()
+    _stage("vertex normals")
     if st is not None:
         frames, classified = st.frames, st.classified  # read-only: res is a copy
     else:
@@ -557,7 +627,28 @@ def round_mesh(
         kept = {u for u in range(pm.n_vertices) if st.depths[u] == depths[u]}
         res.take(st.vertices, sorted(kept))
         pending = [u for u in pending if u not in kept]
-    apices = solve_apices(frames, depths, res, centres, progress, vertices=pending)
+    _stage("apices")
+    apices = _solve_apices(frames, depths, res, centres, progress, pending)
+    rescue = Rescue()
+    if not material_loss and any(res.status[u] == "infeasible" for u in pending):
+        frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
+        classified = copy.deepcopy(classified)
+        rounding, centres, rescue = rescue_vertices(
+            pm,
+            rounding,
+            frames,
+            res,
+            depths,
+            centres,
+            face_piece_centres,
+            apply=fit_vertices,
+            flat_deg=coplanar_deg,
+            floor=floor,
+            apices=apices,
+            classified=classified,
+            vertices=pending,
+        )
+        kept -= rescue.resolved
     solved = [
         st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
         for u, frame in enumerate(frames)
@@ -565,19 +656,12 @@ def round_mesh(
     timings["apices"] = time.perf_counter() - t
 
     t = time.perf_counter()
+    _stage("vertex modules")
     points = rounding.arc_points(int(samples), float(arc_step))
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]
-    built = build_modules(
-        pm,
-        [solved[u][0] for u in todo],
-        centres,
-        points,
-        [solved[u][1] for u in todo],
-        [solved[u][2] for u in todo],
-        progress,
-    )
+    built = _build_modules(pm, [solved[u] for u in todo], centres, points, progress)
     for u, module in zip(todo, built, strict=True):
         modules[u] = module
     stages = (
@@ -587,6 +671,7 @@ def round_mesh(
             key=key,
             loss=loss,
             conical=conical,
+            requested=requested,
             rounding=rounding,
             centres=centres,
             frames=frames,
@@ -604,6 +689,7 @@ def round_mesh(
         # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
         del frames, classified
         solved = modules = built = None
+    _stage("layout")
     layout_used, layout_note = "modules", ""
     eps = 1e-9 * ref
     if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
@@ -668,6 +754,7 @@ def round_mesh(
         pattern = assemble_pattern(pieces, shelf_offsets(pieces, gap))
     fab = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
     if tabs:
+        _stage("glue tabs")
         fab = add_tabs_and_labels(pattern, tab_h)
     if sheet is not None:
         fab.update(sheet_stats)
@@ -688,4 +775,75 @@ def round_mesh(
         layout_note=layout_note,
         fabrication=fab,
         stages=stages,
+        repairs=list(clean_log.repairs),
+        fitting=_fitting(rounding, requested, fitted_radius, rescue),
     )
+
+
+def _solve_apices(frames, depths, res: VertexResult, centres, progress, pending) -> dict:
+    """:func:`solve_apices` of the vertices ``pending``; when it fails unforeseen, the
+    vertices are solved one by one and a vertex whose solve fails is infeasible, with the
+    failure as its reason (a failure is data, not the end of the design)."""
+    try:
+        return solve_apices(frames, depths, res, centres, progress, vertices=pending)
+    except FilletfoldError:
+        raise
+    except Exception as exc:
+        if is_callers(exc):
+            raise
+        out = {}
+        for u in pending:
+            res.status[u] = ""
+            try:
+                out.update(solve_apices(frames, depths, res, centres, vertices=[u]))
+            except FilletfoldError:
+                raise
+            except Exception as exc:
+                res.status[u] = "infeasible"
+                res.reason[u] = f"the apex solver failed: {one_line(exc)}"
+                out[u] = (None, None)
+        return out
+
+
+def _build_modules(pm: PolyMesh, solved: list, centres, points, progress) -> list:
+    """:func:`build_modules` of ``solved`` (frame, apex, developed apex) per vertex; when it
+    fails unforeseen, the modules are built one by one to name the vertex whose module fails."""
+    frames, apices, developed = ([x[k] for x in solved] for k in range(3))
+    try:
+        return build_modules(pm, frames, centres, points, apices, developed, progress)
+    except FilletfoldError:
+        raise
+    except Exception as exc:
+        if is_callers(exc):
+            raise
+        out = []
+        for frame, apex, v in solved:
+            try:
+                out += build_modules(pm, [frame], centres, points, [apex], [v])
+            except FilletfoldError:
+                raise
+            except Exception as exc:
+                raise InternalError(
+                    f"vertex modules failed at vertex {frame.vertex}: {one_line(exc)} "
+                    "(run with --debug for the traceback)",
+                    stage="vertex modules",
+                    element=f"vertex {frame.vertex}",
+                ) from exc
+        raise  # every module built alone: the failure was in the batch (re-raise it)
+
+
+def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue) -> dict:
+    """What :attr:`Design.fitting` holds: the radii asked for, the edges reduced to fit their
+    limits, the edges left sharp, the vertices rescued (:mod:`filletfold.vertex.rescue`)."""
+    bent = rounding.half_angle > 0  # rounded or left sharp (not boundary, not flat)
+    asked = np.where(bent, requested, 0.0)
+    sharp = rounding.sharp if rounding.sharp is not None else np.zeros(len(bent), dtype=bool)
+    reduced = np.flatnonzero(bent & ~sharp & (fitted < asked * (1 - 1e-12)))
+    return {
+        "radius_requested": asked,
+        "fitted_radius": fitted,
+        "reduced": reduced,
+        "sharp": np.flatnonzero(sharp),
+        "rescued": dict(sorted(rescue.rescued.items())),
+        "rescue_applied": rescue.applied,
+    }

@@ -8,11 +8,13 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
+from .errors import named_stages
 from .export import report_json, write_outputs
 from .export.cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .export.report import Records
 from .rounding import loss_from_radius
 from .tabs import assembly_text
+from .tolerances import tol
 
 #: The files :func:`export_design` writes by default.
 OUTPUT_FILES = output_names(DEFAULT_FORMATS)
@@ -78,7 +80,7 @@ def report_records(design) -> dict:
         "uniform_radius_limit": _num(rd.uniform_limit),
         "status_counts": design.status_counts(),
         "mesh": {"vertices": mesh.vertices, "faces": list(mesh.faces)},
-        "edges": _edge_records(mesh, rd),
+        "edges": _edge_records(mesh, rd, design.fitting.get("radius_requested")),
         "vertices": _vertex_records(design.vertices),
         "pattern": {
             "pieces": int(pat.n_pieces),
@@ -89,10 +91,34 @@ def report_records(design) -> dict:
             "max_edge_mismatch": float(mismatch.max(initial=0.0)),
             "max_relative_edge_mismatch": float(relative.max(initial=0.0)),
         },
+        "repairs": [r.as_dict() for r in design.repairs],
+        "fitting": _fitting_report(design),
         "layout": {"kind": design.layout, "note": design.layout_note or None},
         "fabrication": _fabrication_report(design),
         "material_loss": _loss_report(design.material_loss),
         "timings": {k: float(v) for k, v in design.timings.items()},
+    }
+
+
+def _fitting_report(design) -> dict:
+    """``fitting`` of the report: radii reduced to fit, edges left sharp, vertices rescued."""
+    fit = design.fitting
+    if not fit:
+        return {}
+    asked, fitted = fit["radius_requested"], fit["fitted_radius"]
+    reduced = fit["reduced"]
+    factor = fitted[reduced] / asked[reduced]
+    return {
+        "radii_reduced": len(reduced),
+        "smallest_factor": float(factor.min()) if len(reduced) else None,
+        "reduced": [
+            {"edge": int(e), "requested": float(asked[e]), "radius": float(fitted[e])}
+            for e in reduced.tolist()
+        ],
+        "sharp": fit["sharp"].tolist(),
+        "vertices_rescued": len(fit["rescued"]),
+        "rescue_applied": bool(fit["rescue_applied"]),
+        "rescued": [{"vertex": int(u), "factor": float(f)} for u, f in fit["rescued"].items()],
     }
 
 
@@ -102,7 +128,7 @@ def _not_finite(x: np.ndarray) -> np.ndarray:
     return bad.any(axis=1) if bad.ndim == 2 else bad
 
 
-def _edge_records(mesh, rd) -> Records:
+def _edge_records(mesh, rd, design_requested=None) -> Records:
     """The ``edges`` of the report: one record per mesh edge."""
     boundary = (mesh.edge_faces < 0).any(axis=1)
     bent = rd.half_angle > 0
@@ -115,6 +141,12 @@ def _edge_records(mesh, rd) -> Records:
             "faces": mesh.edge_faces,
             "length": np.asarray(mesh.edge_length, dtype=float),
             "radius": np.asarray(rd.radius, dtype=float),
+            "radius_requested": np.asarray(
+                design_requested if design_requested is not None else rd.radius, dtype=float
+            ),
+            "sharp": (
+                np.zeros(mesh.n_edges, dtype=bool) if rd.sharp is None else rd.sharp
+            ).tolist(),
             "half_angle": np.asarray(rd.half_angle, dtype=float),
             "assignment": np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist(),
             "arc_length": np.asarray(rd.arc_length, dtype=float),
@@ -227,6 +259,8 @@ def design_summary(design, max_listed: int = 8) -> str:
         else "radius: no interior edge",
         f"vertices: {shown}",
     ]
+    lines[1:1] = _repair_lines(design, max_listed)
+    lines[-1:-1] = _fitting_lines(design)
     if design.material_loss is not None:
         ml = design.material_loss
         w = ml.edge_loss[ml.edge_loss > 0]
@@ -268,6 +302,58 @@ def design_summary(design, max_listed: int = 8) -> str:
     return "\n".join(lines)
 
 
+def _repair_lines(design, max_listed: int) -> list[str]:
+    """Summary lines of the mesh repairs: the count per kind, the first few of them."""
+    repairs = design.repairs
+    if not repairs:
+        return []
+    kinds: dict = {}
+    for r in repairs:
+        kinds[r.what] = kinds.get(r.what, 0) + 1
+    out = [
+        f"repairs: {len(repairs)} ("
+        + ", ".join(f"{n} {k}" for k, n in kinds.items())
+        + "; see report.json)"
+    ]
+    for r in repairs[:max_listed]:
+        text = str(r)
+        out.append("  " + (text if len(text) <= 160 else text[:157] + "..."))
+    if len(repairs) > max_listed:
+        out.append(f"  ... and {len(repairs) - max_listed} more")
+    return out
+
+
+def _fitting_lines(design) -> list[str]:
+    """Summary lines of the radius fitting, the sharp edges and the rescued vertices."""
+    fit = design.fitting
+    if not fit:
+        return []
+    out = []
+    reduced = fit["reduced"]
+    if len(reduced):
+        f = fit["fitted_radius"][reduced] / fit["radius_requested"][reduced]
+        out.append(
+            f"radii fitted: {len(reduced)} edges reduced to fit their limits (smallest factor "
+            f"{f.min():.3g})"
+        )
+    if len(fit["sharp"]):
+        out.append(
+            f"sharp edges: {len(fit['sharp'])} left sharp (a fillet narrower than "
+            f"{tol.fillet_floor:g} of the edge would be a sliver)"
+        )
+    rescued = fit["rescued"]
+    if rescued:
+        f = np.array(list(rescued.values()))
+        verb = "rescued" if fit["rescue_applied"] else "would be feasible"
+        out.append(
+            f"vertices {verb}: {len(rescued)} with the radii of their edges scaled by "
+            f"{f.min():g} to {f.max():g}"
+            + ("" if fit["rescue_applied"] else " (--fit-vertices does so)")
+        )
+    return out
+
+
+@named_stages("export")
 def export_design(
     design,
     folder,

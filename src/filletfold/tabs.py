@@ -142,6 +142,12 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         (per label: the two pieces it joins and the piece carrying the tab).
     """
     polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
+    if polys:  # a face that is not a valid polygon is taken as its valid part (tabs only)
+        valid = shapely.is_valid(polys)
+        if not valid.all():
+            fixed = shapely.make_valid(np.asarray(polys, dtype=object)[~valid])
+            for i, g in zip(np.flatnonzero(~valid).tolist(), fixed, strict=True):
+                polys[i] = g
     tree = shapely.STRtree(polys)
     placed_tabs: list = []
     ann = Annotations(sheets=p.annotations.sheets)
@@ -152,6 +158,14 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
     tab_boxes = np.zeros((0, 4))  # bounds of the placed tabs, to test only the nearby ones
 
     def clear(tab: shapely.Polygon) -> bool:
+        """Whether the tab overlaps no face and no placed tab (False too when its geometry
+        fails: a tab is an annotation, its border then keeps its labels)."""
+        try:
+            return _clear(tab)
+        except shapely.errors.GEOSException:
+            return False
+
+    def _clear(tab: shapely.Polygon) -> bool:
         shrunk = tab.buffer(-1e-9 * tab_height)
         for i in tree.query(shrunk):
             if polys[int(i)].intersection(shrunk).area > 1e-12 * tab.area:

@@ -1,0 +1,185 @@
+"""Infeasible vertices: smaller radii on their own edges, found and (optionally) applied.
+
+Every constraint of sec. 3.2 gets easier as the radii shrink (the paper's sec. 2.5 argument:
+the rounding's effect vanishes with the radius), so a cone vertex that is infeasible at the
+requested radii is tried again with the radii of its own rounded edges halved, up to
+:data:`ROUNDS` times. :func:`rescue_vertices` does this for all infeasible vertices at once,
+round after round:
+
+* ``apply=True`` (``--fit-vertices``): the halved radii are kept; every vertex of a face that
+  has a changed edge is classified and solved again (its frame, or the face piece centres its
+  creases must stay short of, changed), so the design stays consistent;
+* ``apply=False``: only the infeasible vertices are solved again, on a copy; a vertex that
+  becomes feasible gets the radius that works in its reason, and the design is unchanged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..mesh.polymesh import PolyMesh
+from ..rounding import EdgeRounding, round_edges, shrink_broken
+from .solve import VertexResult, classify_vertices, solve_apices
+
+#: Halvings of an infeasible vertex's radii tried before it is left infeasible (1/16 at most).
+ROUNDS = 4
+
+
+@dataclass
+class Rescue:
+    """What :func:`rescue_vertices` found.
+
+    Attributes
+    ----------
+    rescued : dict of int to float
+        Vertex -> the factor its edges' radii were multiplied by (applied, or only found).
+    applied : bool
+    edges : (k,) int
+        Edges whose radius changed (applied only).
+    resolved : set of int
+        Vertices classified and solved again on the changed radii (applied only).
+    """
+
+    rescued: dict = field(default_factory=dict)
+    applied: bool = False
+    edges: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    resolved: set = field(default_factory=set)
+
+
+def rescue_vertices(
+    mesh: PolyMesh,
+    rounding: EdgeRounding,
+    frames: list,
+    res: VertexResult,
+    depths: np.ndarray,
+    centres: np.ndarray,
+    face_centres,
+    *,
+    apply: bool,
+    flat_deg: float,
+    floor: float = 0.0,
+    apices: dict,
+    classified: VertexResult | None = None,
+    vertices=None,
+) -> tuple[EdgeRounding, np.ndarray, Rescue]:
+    """Try smaller radii on the edges of every infeasible cone vertex.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+    frames : list of VertexFrame
+        Indexed by vertex; entries of re-solved vertices are replaced (``apply``).
+    res : VertexResult
+        Updated in place: re-solved vertices (``apply``), or the reasons of the vertices a
+        smaller radius would rescue (not ``apply``).
+    depths : (n_vertices,) float
+    centres : (n_faces, 3) float
+        Face piece centres of ``rounding``.
+    face_centres : callable
+        ``face_centres(mesh, rounding) -> (n_faces, 3)`` (:func:`~filletfold.module.
+        face_piece_centres`).
+    apply : bool
+    flat_deg, floor : float
+        Passed to :func:`~filletfold.rounding.round_edges`.
+    apices : dict
+        Vertex -> (apex, developed apex) of :func:`solve_apices`; updated in place
+        (``apply``).
+    classified : VertexResult, optional
+        The classification before any apex (what a later design reuses): updated in place at
+        the re-classified vertices (``apply``).
+    vertices : iterable of int, optional
+        Try only these vertices (default: every infeasible cone vertex).
+
+    Returns
+    -------
+    rounding : EdgeRounding
+    centres : (n_faces, 3) float
+    rescue : Rescue
+    """
+    out = Rescue(applied=apply)
+    bad = _infeasible(res)
+    if vertices is not None:
+        allowed = set(int(u) for u in vertices)
+        bad = [u for u in bad if u in allowed]
+    if not bad:
+        return rounding, centres, out
+    radius = rounding.radius.copy()
+    start = radius.copy()
+    factor = {u: 1.0 for u in bad}
+    trial = VertexResult.empty(mesh.n_vertices) if not apply else None
+    edge_face = mesh.edge_faces
+    for _ in range(ROUNDS):
+        if not bad:
+            break
+        edges = np.unique(np.concatenate([frames[u].ring.edges for u in bad]))
+        edges = edges[radius[edges] > 0]
+        if not len(edges):
+            break
+        radius[edges] *= 0.5
+        radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
+        for u in bad:
+            factor[u] *= 0.5
+        new_rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor)
+        new_centres = face_centres(mesh, new_rounding)
+        if apply:
+            faces = np.unique(edge_face[edges])
+            faces = faces[faces >= 0]
+            affected = np.unique(np.concatenate([mesh.faces[f] for f in faces]))
+            target = res
+        else:
+            affected = np.array(sorted(bad), dtype=np.int64)
+            target = trial
+        fresh = VertexResult.empty(mesh.n_vertices)
+        target.take(fresh, affected)
+        new_frames = classify_vertices(mesh, new_rounding, target, affected)
+        if apply and classified is not None:
+            classified.take(target, affected)
+        todo = [u for u in affected.tolist() if target.status[u] == ""]
+        solved = solve_apices(
+            dict(zip(affected.tolist(), new_frames, strict=True)),
+            depths,
+            target,
+            new_centres,
+            vertices=todo,
+        )
+        if apply:
+            out.resolved.update(affected.tolist())
+            for u, frame in zip(affected.tolist(), new_frames, strict=True):
+                frames[u] = frame
+            apices.update(solved)
+            rounding, centres = new_rounding, new_centres
+        for u in list(bad):
+            if target.status[u] == "ok":
+                out.rescued[u] = factor[u]
+                bad.remove(u)
+        if apply:  # neighbours made infeasible by the change join the next round
+            for u in _infeasible(res):
+                if u not in out.rescued and u not in factor:
+                    factor[u] = 1.0
+                    bad.append(u)
+    factor_of = {u: f for u, f in factor.items() if u not in out.rescued}
+    for u, f in factor_of.items():
+        if res.status[u] == "infeasible":
+            res.reason[u] += f"; still infeasible with the radii of its edges multiplied by {f:g}"
+    if apply:
+        out.edges = np.flatnonzero(radius != start)
+    else:
+        for u, f in out.rescued.items():
+            r = rounding.radius[frames[u].ring.edges]
+            r = r[r > 0]
+            res.reason[u] += (
+                f"; its cone is feasible with the radii of its edges multiplied by {f:g} "
+                f"(at most {r.max() * f:.4g}): --fit-vertices does so"
+            )
+    return rounding, centres, out
+
+
+def _infeasible(res: VertexResult) -> list:
+    """The cone vertices whose status is infeasible."""
+    return [
+        u for u, (k, s) in enumerate(zip(res.kind, res.status, strict=True))
+        if s == "infeasible" and k in ("cone", "developable")
+    ]  # fmt: skip
