@@ -1,0 +1,1027 @@
+"""The validity certificate of a design: its invariants measured again from the pattern.
+
+:func:`certify` takes a crease pattern and the mesh it was made from and measures, with numpy
+arrays over every pattern vertex, edge and face at once:
+
+1. ``ruling isometry`` -- every cone ruling (a side of a ``cone u`` face from the apex) is as
+   long in 2D as in 3D: ``|len2D - len3D| / len <= RULING_TOL`` (every ``cone u`` face must
+   have a corner at ``vertex_apex[u]``, within ``APEX_TOL`` of the design size);
+2. ``contraction`` -- no pattern edge is longer folded than flat:
+   ``(len3D - len2D) / len2D <= CONTRACTION_TOL``;
+3. ``on planes`` -- every corner of a ``face f`` face lies in mesh face ``f``'s plane, within
+   ``PLANE_TOL`` of the design size;
+4. ``on cylinders`` -- every corner of a ``cylinder e`` face lies at the radius ``r`` from the
+   axis of edge ``e`` (through ``O = M - kappa (r / cos gamma) unit(N_a + N_b)``, along the
+   edge), within ``CYLINDER_TOL`` of the design size;
+5. ``M/V`` -- every M/V edge folds the way its assignment and fold angle say: the signed angle
+   between its two faces' folded normals has the written sign (count of disagreements, limit
+   0), and ``fold-angle match``: it is the written angle within ``ANGLE_TOL_DEG``;
+6. ``fold-angle range`` -- no crease folds flat: ``|angle| < MAX_FOLD_DEG``; and ``smallest fold
+   angle`` -- none is so small it is no crease at all: ``|angle| > MIN_FOLD_DEG``;
+7. ``no overlap`` -- no two faces overlap in 2D by more than ``OVERLAP_TOL`` of the smaller one
+   (and every face is a simple polygon); ``face orientation`` -- every face is counter-clockwise
+   (positive signed area) in 2D;
+8. ``smallest edge`` -- the shortest pattern edge (the shorter of its flat and folded lengths)
+   is at least ``MIN_EDGE`` of the design size;
+
+and, for information, the ``smallest face angle`` in 2D (slivers). The *design size* is the
+bounding-box diagonal of the folded form.
+
+A pattern read from a file holds its coordinates rounded (:data:`FOLD_DIGITS` significant
+digits): each is known to ``coord_quantum`` (:func:`file_quantum`: ``5e-12`` times the largest
+coordinate), so the tolerances of 1, 2 (lengths) and 5 (angles) grow by what that rounding can
+do to the figure of each edge (see :data:`LENGTH_QUANTA` and :func:`certify`).
+
+:func:`certify_design` certifies an in-memory :class:`~filletfold.Design`; :func:`check_folder`
+a folder written by ``filletfold round`` (``design.fold`` and ``report.json``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from .errors import MeshReadError, ParameterError
+from .export.fold import FOLD_DIGITS
+from .export.fold_read import _edge_faces, read_fold
+from .pattern import CreasePattern, face_arrays
+
+__all__ = [
+    "ANGLE_TOL_DEG",
+    "APEX_TOL",
+    "CONTRACTION_TOL",
+    "CYLINDER_TOL",
+    "FILE_ROUNDING",
+    "LENGTH_QUANTA",
+    "MAX_FOLD_DEG",
+    "MIN_EDGE",
+    "MIN_FOLD_DEG",
+    "OVERLAP_TOL",
+    "PLANE_TOL",
+    "RULING_TOL",
+    "Certificate",
+    "Check",
+    "certify",
+    "certify_design",
+    "check_folder",
+    "file_quantum",
+]
+
+#: Largest ``|len2D - len3D| / len`` of a cone ruling (plus the file's rounding).
+RULING_TOL = 1e-12
+#: Largest ``(len3D - len2D) / len2D`` of a pattern edge (plus the file's rounding).
+CONTRACTION_TOL = 1e-12
+#: Largest distance of a face-piece corner from its mesh face's plane / design size.
+PLANE_TOL = 1e-9
+#: Largest ``|distance from the axis - r|`` of a cylinder corner / design size.
+CYLINDER_TOL = 1e-9
+#: A cone face's corner is the apex when it is this close to it (/ design size).
+APEX_TOL = 1e-9
+#: Largest difference between a written fold angle and the folded form's (degrees; plus the
+#: file's rounding). A recomputed angle this close to 0 has no sign to disagree with.
+ANGLE_TOL_DEG = 1e-6
+#: Every crease folds by less than this (degrees): 180 would fold the sheet flat onto itself.
+MAX_FOLD_DEG = 179.5
+#: Every crease folds by more than this (degrees): less is no crease at all.
+MIN_FOLD_DEG = 1e-6
+#: Largest area two faces may share in 2D, as a share of the smaller one.
+OVERLAP_TOL = 1e-9
+#: Shortest pattern edge / design size.
+MIN_EDGE = 1e-7
+#: Relative rounding of a float written with :data:`FOLD_DIGITS` significant digits.
+FILE_ROUNDING = 0.5 * 10.0 ** (1 - FOLD_DIGITS)
+#: With every coordinate within ``q`` of its value, a 2D length is within ``2 sqrt(2) q`` and a
+#: 3D length within ``2 sqrt(3) q`` of its own, so the two differ by this many ``q`` more.
+LENGTH_QUANTA = 2.0 * (math.sqrt(2.0) + math.sqrt(3.0))
+
+#: Convex faces of up to this many corners are told apart in numpy (separating axes).
+SAT_CORNERS = 8
+#: Face pairs separated per numpy block.
+PAIR_CHUNK = 1 << 18
+#: Faces whose neighbours are asked of the tree at once (bounds the pairs held).
+QUERY_CHUNK = 1 << 16
+
+_CONE, _CYLINDER, _FACE = 0, 1, 2
+_KINDS = {"cone": _CONE, "cylinder": _CYLINDER, "face": _FACE}
+
+
+@dataclass
+class Check:
+    """One invariant and its figure.
+
+    Attributes
+    ----------
+    name : str
+        ``"ruling isometry"``, ``"contraction"``, ...
+    ok : bool
+        Whether the invariant holds (always true for an informational figure).
+    value : float
+        The measured figure (NaN when there is nothing to measure).
+    limit : float or None
+        The limit the figure is held to (at the worst element when the limit is per element);
+        None for an informational figure.
+    detail : str
+        What was measured, the worst element, and how the limit is made.
+    relation : str
+        How ``value`` must compare with ``limit``: ``"<="``, ``"<"``, ``">="`` or ``">"``
+        (``""`` for an informational figure).
+    worst : dict
+        The worst element, e.g. ``{"pattern_edge": 17, "patch": "cone 3"}`` (empty when there
+        is none).
+    """
+
+    name: str
+    ok: bool
+    value: float
+    limit: float | None
+    detail: str = ""
+    relation: str = "<="
+    worst: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        """``{"ok", "value", "limit", "detail"}``, JSON data (NaN and infinities as None)."""
+        return {
+            "ok": bool(self.ok),
+            "value": _json_float(self.value),
+            "limit": _json_float(self.limit),
+            "detail": str(self.detail),
+        }
+
+    def line(self) -> str:
+        """One printable line: name, figure, relation and limit, ``ok``/``FAIL``, detail."""
+        if self.limit is None:
+            figure, status = f"{_fmt(self.value):>10}", "info"
+        else:
+            figure = f"{_fmt(self.value):>10} {self.relation:>2} {_fmt(self.limit, 4):<9}"
+            status = "ok" if self.ok else "FAIL"
+        return f"{self.name:<19} {figure:<23} {status:<4}  {self.detail}"
+
+
+@dataclass
+class Certificate:
+    """The invariants of a design, measured.
+
+    Attributes
+    ----------
+    checks : list of Check
+        In the order of the module's list (informational figures last).
+    size : float
+        The design size (bounding-box diagonal of the folded form) the tolerances refer to.
+    coord_quantum : float
+        The coordinates' rounding the tolerances allowed for (0 for an in-memory pattern).
+    ok : bool
+        Whether every invariant holds.
+    """
+
+    checks: list[Check]
+    size: float = 0.0
+    coord_quantum: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return all(c.ok for c in self.checks)
+
+    def __getitem__(self, name: str) -> Check:
+        for c in self.checks:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    @property
+    def failed(self) -> list[Check]:
+        """The checks that do not hold."""
+        return [c for c in self.checks if not c.ok]
+
+    def as_dict(self) -> dict:
+        """``{"ok": bool, "checks": {name: {"ok", "value", "limit", "detail"}}}`` in check order."""
+        return {"ok": self.ok, "checks": {c.name: c.as_dict() for c in self.checks}}
+
+    def summary(self) -> list[str]:
+        """Printable lines: one per check, then the verdict."""
+        lines = [c.line() for c in self.checks]
+        if self.ok:
+            lines.append(f"valid: all {sum(c.limit is not None for c in self.checks)} checks hold")
+        else:
+            names = ", ".join(c.name for c in self.failed)
+            lines.append(f"NOT VALID: {len(self.failed)} check(s) fail: {names}")
+        return lines
+
+
+def _json_float(x) -> float | None:
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _fmt(x, digits: int = 3) -> str:
+    """A figure for a summary line: integers as such, others to ``digits`` significant digits
+    (``-`` for NaN: nothing measured)."""
+    if x is None or not math.isfinite(float(x)):
+        return "-" if x is None or math.isnan(float(x)) else f"{x}"
+    x = float(x)
+    if x == int(x) and abs(x) < 1e6:
+        return str(int(x))
+    return f"{x:.{digits}g}"
+
+
+def _ratio_worst(excess_num: np.ndarray, allowed: np.ndarray) -> int:
+    """The element whose figure ``excess_num`` is largest against its own limit ``allowed``
+    (both (k,) non-negative; 0 / 0 counts as 0, x / 0 as infinity)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(allowed > 0, excess_num / allowed, np.where(excess_num > 0, np.inf, 0.0))
+    ratio = np.where(np.isnan(ratio), np.inf, ratio)
+    return int(np.argmax(ratio))
+
+
+def _distinct(x: np.ndarray) -> int:
+    """How many distinct values the non-negative integers ``x`` hold."""
+    return int(np.count_nonzero(np.bincount(x))) if len(x) else 0
+
+
+def _quantum_note(q: float, what: str) -> str:
+    return f"; limit {what}, q = {q:.2g} (coordinates rounded to {FOLD_DIGITS} digits)" if q else ""
+
+
+class _Data:
+    """The pattern and mesh as arrays, checked for consistency, with what several checks use."""
+
+    def __init__(self, pattern, mesh_vertices, mesh_faces, edges, vertex_apex, coord_quantum):
+        if not isinstance(pattern, CreasePattern):
+            raise ParameterError(
+                f"expected a CreasePattern, got {type(pattern).__name__}", name="pattern"
+            )
+        self.v2 = np.asarray(pattern.vertices_2d, dtype=np.float64)
+        self.v3 = np.asarray(pattern.vertices_3d, dtype=np.float64)
+        n = len(self.v2)
+        if self.v2.shape != (n, 2) or self.v3.shape != (n, 3):
+            raise ParameterError("pattern vertices must be (n, 2) in 2D and (n, 3) in 3D")
+        for name, arr in (("vertices_2d", self.v2), ("vertices_3d", self.v3)):
+            bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
+            if len(bad):
+                raise ParameterError(f"pattern {name}[{bad[0]}] is not finite", name=name)
+        flat, start = face_arrays(pattern.faces)
+        self.flat = np.asarray(flat, dtype=np.int64)
+        self.start = np.asarray(start, dtype=np.int64)
+        self.size_of = np.diff(self.start)
+        n_faces = len(self.size_of)
+        if n_faces == 0:
+            raise ParameterError("the pattern has no faces")
+        if self.size_of.min() < 3 or self.flat.min() < 0 or self.flat.max() >= n:
+            raise ParameterError("pattern faces must list at least 3 vertex indices in range")
+        self.face_of = np.repeat(np.arange(n_faces), self.size_of)
+        self.nxt = np.arange(1, len(self.flat) + 1)
+        self.nxt[self.start[1:] - 1] = self.start[:-1]
+        self.prv = np.empty_like(self.nxt)
+        self.prv[self.nxt] = np.arange(len(self.nxt))
+        q = float(coord_quantum)
+        if not (math.isfinite(q) and q >= 0):
+            raise ParameterError(f"coord_quantum must be >= 0, got {coord_quantum}")
+        self.q = q
+        lo, hi = self.v3.min(axis=0), self.v3.max(axis=0)
+        self.size = float(np.linalg.norm(hi - lo)) or 1.0
+        self.patch = list(map(str, pattern.face_patch))
+        if len(self.patch) != n_faces:
+            raise ParameterError(f"pattern has {n_faces} faces but {len(self.patch)} patches")
+        piece = np.asarray(pattern.face_piece, dtype=np.int64).reshape(-1)
+        self.piece = piece if len(piece) == n_faces else np.full(n_faces, -1)
+        self._mesh(mesh_vertices, mesh_faces, edges, vertex_apex)
+        self._patches(n_faces)
+        self._edges(pattern, n)
+
+    def _mesh(self, mesh_vertices, mesh_faces, edges, vertex_apex):
+        self.mv = np.asarray(mesh_vertices, dtype=np.float64).reshape(-1, 3)
+        mflat, mstart = face_arrays(mesh_faces)
+        mflat = np.asarray(mflat, dtype=np.int64)
+        if len(mstart) < 2 or np.diff(mstart).min() < 3:
+            raise ParameterError("mesh faces must list at least 3 vertices each")
+        if mflat.min() < 0 or mflat.max() >= len(self.mv):
+            raise ParameterError(f"mesh faces refer to a vertex outside 0..{len(self.mv) - 1}")
+        self.n_mesh_faces = len(mstart) - 1
+        # planes: centroid and unit Newell normal of every mesh face
+        msize = np.diff(mstart)
+        p = self.mv[mflat]
+        centre = np.add.reduceat(p, mstart[:-1], axis=0) / msize[:, None]
+        qc = p - np.repeat(centre, msize, axis=0)
+        mnxt = np.arange(1, len(mflat) + 1)
+        mnxt[mstart[1:] - 1] = mstart[:-1]
+        normal = np.add.reduceat(np.cross(qc, qc[mnxt]), mstart[:-1], axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            normal /= np.linalg.norm(normal, axis=1)[:, None]
+        self.face_centre, self.face_normal = centre, normal
+        try:
+            ev = np.asarray(edges["vertices"], dtype=np.int64).reshape(-1, 2)
+            n_edges = len(ev)
+            ef = np.asarray(edges["faces"], dtype=np.int64).reshape(n_edges, 2)
+            r = np.asarray(edges["radius"], dtype=np.float64).reshape(n_edges)
+            gamma = np.asarray(edges["half_angle"], dtype=np.float64).reshape(n_edges)
+            kappa = np.asarray(edges["kappa"], dtype=np.float64).reshape(n_edges)
+        except KeyError as exc:
+            raise ParameterError(f"edges needs the key {exc}", name="edges") from None
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"edges arrays are malformed ({exc})", name="edges") from None
+        if n_edges and (ev.min() < 0 or ev.max() >= len(self.mv)):
+            raise ParameterError("edges refer to a mesh vertex out of range", name="edges")
+        if n_edges and ef.max() >= self.n_mesh_faces:
+            raise ParameterError("edges refer to a mesh face out of range", name="edges")
+        self.n_mesh_edges = n_edges
+        # cylinder axes: O = M - kappa (r / cos gamma) unit(N_a + N_b), along the edge
+        rounded = (ef >= 0).all(axis=1) & (r > 0) & (kappa != 0) & np.isfinite(gamma)
+        a, b = self.mv[ev[:, 0]], self.mv[ev[:, 1]]
+        direction = b - a
+        with np.errstate(invalid="ignore", divide="ignore"):
+            direction /= np.linalg.norm(direction, axis=1)[:, None]
+            s = self.face_normal[ef[:, 0]] + self.face_normal[ef[:, 1]]
+            s /= np.linalg.norm(s, axis=1)[:, None]
+            axis = 0.5 * (a + b) - (np.sign(kappa) * r / np.cos(gamma))[:, None] * s
+        rounded &= np.isfinite(axis).all(axis=1) & np.isfinite(direction).all(axis=1)
+        self.axis_point, self.axis_dir, self.radius = axis, direction, r
+        self.rounded = rounded
+        apex = np.asarray(vertex_apex, dtype=np.float64)
+        if apex.shape != (len(self.mv), 3):
+            raise ParameterError(
+                f"vertex_apex must be ({len(self.mv)}, 3), got {apex.shape}", name="vertex_apex"
+            )
+        self.apex = apex
+
+    def _patches(self, n_faces):
+        names = dict.fromkeys(self.patch)
+        limit = {
+            _CONE: len(self.mv),
+            _CYLINDER: self.n_mesh_edges,
+            _FACE: self.n_mesh_faces,
+        }
+        what = {_CONE: "mesh vertex", _CYLINDER: "mesh edge", _FACE: "mesh face"}
+        parsed = {}
+        for name in names:
+            parts = name.split()
+            kind = _KINDS.get(parts[0]) if len(parts) == 2 and parts[0] else None
+            if kind is None or not parts[1].isdigit():
+                face = self.patch.index(name)
+                raise ParameterError(
+                    f"pattern face {face} has patch {name!r}, not 'cone <vertex>', "
+                    "'cylinder <edge>' or 'face <face>'",
+                    name="face_patch",
+                )
+            index = int(parts[1])
+            if index >= limit[kind]:
+                face = self.patch.index(name)
+                raise ParameterError(
+                    f"pattern face {face} is on {name!r} but there is no {what[kind]} {index} "
+                    f"(the mesh has {limit[kind]})",
+                    name="face_patch",
+                )
+            parsed[name] = (kind, index)
+        kinds = np.array([parsed[p][0] for p in names], dtype=np.int64)
+        indices = np.array([parsed[p][1] for p in names], dtype=np.int64)
+        ids = {p: k for k, p in enumerate(names)}
+        pid = np.fromiter(map(ids.__getitem__, self.patch), dtype=np.int64, count=n_faces)
+        self.kind, self.index = kinds[pid], indices[pid]
+
+    def _edges(self, pattern, n):
+        try:
+            e = np.asarray(pattern.edges, dtype=np.int64).reshape(-1, 2)
+            assign = np.asarray(pattern.edge_assignment).astype(str).reshape(len(e))
+            angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64).reshape(len(e))
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"pattern edge arrays are malformed ({exc})") from None
+        if len(e) and (e.min() < 0 or e.max() >= n):
+            raise ParameterError(f"pattern edges refer to a vertex outside 0..{n - 1}")
+        ef = pattern.edge_faces
+        if ef is None:
+            ef = _edge_faces(e, pattern.faces, n)
+        try:
+            self.edge_faces = np.asarray(ef, dtype=np.int64).reshape(len(e), 2)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"pattern edge_faces is malformed ({exc})") from None
+        self.edges, self.assign, self.angle = e, assign, angle
+        self.l2 = np.linalg.norm(self.v2[e[:, 0]] - self.v2[e[:, 1]], axis=1)
+        self.l3 = np.linalg.norm(self.v3[e[:, 0]] - self.v3[e[:, 1]], axis=1)
+        self._keys = None
+
+    def edge_index(self, a: int, b: int) -> int:
+        """The pattern edge between vertices ``a`` and ``b`` (-1 when there is none)."""
+        n = len(self.v2)
+        if self._keys is None:
+            key = self.edges.min(axis=1) * n + self.edges.max(axis=1)
+            order = np.argsort(key)
+            self._keys = key[order], order
+        keys, order = self._keys
+        k = min(a, b) * n + max(a, b)
+        pos = int(np.searchsorted(keys, k))
+        return int(order[pos]) if pos < len(keys) and keys[pos] == k else -1
+
+    def where_face(self, f: int) -> str:
+        return f"face {f} (piece {self.piece[f]}, {self.patch[f]})"
+
+
+def certify(
+    pattern: CreasePattern,
+    mesh_vertices,
+    mesh_faces,
+    edges: dict,
+    vertex_apex,
+    *,
+    coord_quantum: float = 0.0,
+) -> Certificate:
+    """Measure the invariants of a crease pattern against the mesh it rounds.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Its faces' ``face_patch`` name mesh vertices (``cone u``), edges (``cylinder e``) and
+        faces (``face f``) of the arrays below.
+    mesh_vertices : (n_vertices, 3) float
+    mesh_faces : list of (k,) int, counter-clockwise seen from the front
+    edges : dict of arrays
+        ``vertices`` (n_edges, 2) int, ``faces`` (n_edges, 2) int (the face holding ``a -> b``
+        first; -1 at a boundary), ``radius`` (n_edges,), ``half_angle`` (n_edges,) radians,
+        ``kappa`` (n_edges,) +1 mountain, -1 valley, 0 not rounded.
+    vertex_apex : (n_vertices, 3) float
+        The cone apex of every vertex, NaN where there is none.
+    coord_quantum : float
+        How far each coordinate of the pattern may be from its true value (0 in memory;
+        :func:`file_quantum` for a pattern read from a file). The length limits grow by
+        ``LENGTH_QUANTA * coord_quantum`` per edge, the fold-angle limit by what moving every
+        corner of the edge's two faces by ``sqrt(3) coord_quantum`` can turn their normals:
+        ``sqrt(3) q (P_a / A_a + P_b / A_b)`` radians (``P`` perimeter, ``A`` area, in 3D).
+
+    Returns
+    -------
+    Certificate
+
+    Raises
+    ------
+    ParameterError
+        When the data are inconsistent: a face's patch names no element of the mesh, arrays of
+        the wrong shape, coordinates that are not finite.
+    """
+    data = _Data(pattern, mesh_vertices, mesh_faces, edges, vertex_apex, coord_quantum)
+    checks = [
+        _ruling_isometry(data),
+        _contraction(data),
+        _on_planes(data),
+        _on_cylinders(data),
+        *_fold_angles(data),
+        *_overlap(data),
+        _smallest_edge(data),
+        _smallest_face_angle(data),
+    ]
+    return Certificate(checks=checks, size=data.size, coord_quantum=data.q)
+
+
+def _ruling_isometry(g: _Data) -> Check:
+    name = "ruling isometry"
+    cone_faces = np.flatnonzero(g.kind == _CONE)
+    if not len(cone_faces):
+        return Check(name, True, float("nan"), RULING_TOL, "no cone in the design")
+    corner = g.kind[g.face_of] == _CONE
+    c = np.flatnonzero(corner)
+    apex = g.apex[g.index[g.face_of[c]]]
+    with np.errstate(invalid="ignore"):
+        at = np.zeros(len(g.flat), dtype=bool)
+        at[c] = np.linalg.norm(g.v3[g.flat[c]] - apex, axis=1) <= APEX_TOL * g.size
+    has_apex = np.logical_or.reduceat(at, g.start[:-1])
+    missing = cone_faces[~has_apex[cone_faces]]
+    side = c[at[c] | at[g.nxt[c]]]  # the sides a -> b of cone faces from or to the apex
+    a, b = g.flat[side], g.flat[g.nxt[side]]
+    l2 = np.linalg.norm(g.v2[a] - g.v2[b], axis=1)
+    l3 = np.linalg.norm(g.v3[a] - g.v3[b], axis=1)
+    length = np.maximum(l2, l3)
+    diff = np.abs(l2 - l3)
+    allowed = RULING_TOL * length + LENGTH_QUANTA * g.q
+    n_cones = _distinct(g.index[cone_faces])
+    detail = f"{len(side)} ruling sides of {len(cone_faces)} faces on {n_cones} cones"
+    if not len(side):
+        value, limit, ok, worst = float("nan"), RULING_TOL, True, {}
+    else:
+        k = _ratio_worst(diff, allowed)
+        value = float(diff[k] / length[k]) if length[k] > 0 else 0.0
+        limit = float(allowed[k] / length[k]) if length[k] > 0 else RULING_TOL
+        ok = bool((diff <= allowed).all())
+        f = int(g.face_of[side[k]])
+        e = g.edge_index(int(a[k]), int(b[k]))
+        worst = {"pattern_edge": e, "pattern_face": f, "patch": g.patch[f]}
+        detail += f"; worst pattern edge {e} ({g.patch[f]})"
+        if g.q:
+            rel = diff / np.where(length > 0, length, 1.0)
+            detail += f", largest |d|/len {float(rel.max()):.2e}"
+    detail += _quantum_note(g.q, f"{RULING_TOL:g} + {LENGTH_QUANTA:.2f} q / len")
+    if len(missing):
+        f = int(missing[0])
+        u = int(g.index[f])
+        why = "has no apex" if not np.isfinite(g.apex[u]).all() else "has no corner at its apex"
+        detail += f"; {len(missing)} cone face(s) without their apex (first {g.where_face(f)}: "
+        detail += f"vertex {u} {why})"
+        ok = False
+        worst = worst or {"pattern_face": f, "patch": g.patch[f]}
+    return Check(name, ok, value, limit, detail, "<=", worst)
+
+
+def _contraction(g: _Data) -> Check:
+    name = "contraction"
+    longer = g.l3 - g.l2
+    allowed = CONTRACTION_TOL * g.l2 + LENGTH_QUANTA * g.q
+    if not len(g.edges):
+        return Check(name, True, float("nan"), CONTRACTION_TOL, "no pattern edge")
+    k = _ratio_worst(np.maximum(longer, 0.0), allowed)
+    if longer[k] <= 0:  # none longer folded: the largest relative difference
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.where(g.l2 > 0, longer / g.l2, 0.0)
+        k = int(np.argmax(rel))
+    value = float(longer[k] / g.l2[k]) if g.l2[k] > 0 else (math.inf if longer[k] > 0 else 0.0)
+    limit = float(allowed[k] / g.l2[k]) if g.l2[k] > 0 else CONTRACTION_TOL
+    ok = bool((longer <= allowed).all())
+    n_longer = int(np.count_nonzero(longer > allowed))
+    e = int(k)
+    detail = f"{len(g.edges)} pattern edges; worst pattern edge {e} ({g.assign[e]})"
+    if n_longer:
+        detail += f"; {n_longer} longer folded than flat"
+    detail += _quantum_note(g.q, f"{CONTRACTION_TOL:g} + {LENGTH_QUANTA:.2f} q / len")
+    return Check(name, ok, value, limit, detail, "<=", {"pattern_edge": e})
+
+
+def _on_planes(g: _Data) -> Check:
+    name = "on planes"
+    c = np.flatnonzero(g.kind[g.face_of] == _FACE)
+    if not len(c):
+        return Check(name, True, float("nan"), PLANE_TOL, "no face piece in the design")
+    f = g.index[g.face_of[c]]
+    d = np.abs(np.einsum("ij,ij->i", g.v3[g.flat[c]] - g.face_centre[f], g.face_normal[f]))
+    d = np.where(np.isfinite(d), d, np.inf) / g.size
+    k = int(np.argmax(d))
+    v, mf = int(g.flat[c[k]]), int(f[k])
+    detail = (
+        f"{_distinct(g.flat[c])} points of {_distinct(f)} face pieces; "
+        f"worst pattern vertex {v} (face {mf}); distance / size {PLANE_TOL:g}"
+    )
+    worst = {"pattern_vertex": v, "mesh_face": mf}
+    return Check(name, bool(d[k] <= PLANE_TOL), float(d[k]), PLANE_TOL, detail, "<=", worst)
+
+
+def _on_cylinders(g: _Data) -> Check:
+    name = "on cylinders"
+    c = np.flatnonzero(g.kind[g.face_of] == _CYLINDER)
+    if not len(c):
+        return Check(name, True, float("nan"), CYLINDER_TOL, "no cylinder in the design")
+    e = g.index[g.face_of[c]]
+    w = g.v3[g.flat[c]] - g.axis_point[e]
+    t = g.axis_dir[e]
+    with np.errstate(invalid="ignore"):
+        radial = w - np.einsum("ij,ij->i", w, t)[:, None] * t
+        err = np.abs(np.linalg.norm(radial, axis=1) - g.radius[e]) / g.size
+    err = np.where(g.rounded[e] & np.isfinite(err), err, np.inf)
+    k = int(np.argmax(err))
+    v, me = int(g.flat[c[k]]), int(e[k])
+    detail = (
+        f"{_distinct(g.flat[c])} points of {_distinct(e)} cylinders; "
+        f"worst pattern vertex {v} (cylinder {me}); |distance - r| / size {CYLINDER_TOL:g}"
+    )
+    flat = np.unique(e[~g.rounded[e]])
+    if len(flat):
+        detail += f"; {len(flat)} cylinder(s) on edges that are not rounded (first {flat[0]})"
+    worst = {"pattern_vertex": v, "mesh_edge": me}
+    ok = bool(err[k] <= CYLINDER_TOL)
+    return Check(name, ok, float(err[k]), CYLINDER_TOL, detail, "<=", worst)
+
+
+def _face_newell(g: _Data) -> tuple[np.ndarray, np.ndarray]:
+    """(n_faces, 3) Newell vectors (twice the vector area) and (n_faces,) perimeters, in 3D."""
+    p = g.v3[g.flat]
+    centre = np.add.reduceat(p, g.start[:-1], axis=0) / g.size_of[:, None]
+    qc = p - np.repeat(centre, g.size_of, axis=0)
+    newell = np.add.reduceat(np.cross(qc, qc[g.nxt]), g.start[:-1], axis=0)
+    side = np.linalg.norm(p[g.nxt] - p, axis=1)
+    return newell, np.add.reduceat(side, g.start[:-1])
+
+
+def _fold_angles(g: _Data) -> list[Check]:
+    """``M/V``, ``fold-angle match``, ``fold-angle range`` and ``smallest fold angle``."""
+    crease = np.flatnonzero(np.isin(g.assign, ("M", "V")))
+    names = ("M/V", "fold-angle match", "fold-angle range", "smallest fold angle")
+    if not len(crease):
+        why = "no M/V crease in the design"
+        return [
+            Check(names[0], True, 0.0, 0.0, why),
+            Check(names[1], True, float("nan"), ANGLE_TOL_DEG, why),
+            Check(names[2], True, float("nan"), MAX_FOLD_DEG, why, "<"),
+            Check(names[3], True, float("nan"), MIN_FOLD_DEG, why, ">"),
+        ]
+    m = g.assign[crease] == "M"
+    written = g.angle[crease]
+    ef = g.edge_faces[crease]
+    two = (ef >= 0).all(axis=1)
+    newell, perimeter = _face_newell(g)
+    norm = np.linalg.norm(newell, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = newell / norm[:, None]
+        fa, fb = np.where(ef >= 0, ef, 0).T
+        na, nb = unit[fa], unit[fb]
+        d = g.v3[g.edges[crease, 1]] - g.v3[g.edges[crease, 0]]
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
+        cos = np.einsum("ij,ij->i", na, nb)
+        folded = -np.degrees(np.arctan2(sin, cos))  # FOLD's sign: valley positive
+        # what rounding the corners by sqrt(3) q can turn the two normals by
+        slack = math.sqrt(3.0) * g.q * (2 * perimeter / norm)  # P / A, A = |newell| / 2
+        allowed = ANGLE_TOL_DEG + np.degrees(slack[fa] + slack[fb])
+    allowed = np.where(np.isfinite(allowed), allowed, np.inf)
+    folded = np.where(two & np.isfinite(folded), folded, np.nan)
+    # M/V: the written angle has the assignment's sign, and so has the folded form's
+    bad_written = np.where(m, written >= 0, written <= 0)
+    with np.errstate(invalid="ignore"):
+        bad_folded = np.where(m, folded > allowed, folded < -allowed)
+    disagree = ~two | bad_written | bad_folded
+    n_bad = int(np.count_nonzero(disagree))
+    detail = f"{len(crease)} creases ({int(m.sum())} M, {int((~m).sum())} V)"
+    worst = {}
+    if n_bad:
+        k = int(np.flatnonzero(disagree)[0])
+        e = int(crease[k])
+        worst = {"pattern_edge": e}
+        if not two[k]:
+            why = "has only one face"
+        else:
+            why = f"written {written[k]:.6g}, folded form {folded[k]:.6g} deg"
+        detail += f"; {n_bad} disagree: first pattern edge {e} ({g.assign[e]}, {why})"
+    mv = Check(names[0], n_bad == 0, float(n_bad), 0.0, detail, "<=", worst)
+    # fold-angle match: the written angle is the folded form's
+    diff = np.abs((written - folded + 180.0) % 360.0 - 180.0)
+    diff = np.where(np.isnan(diff), np.inf, diff)
+    k = _ratio_worst(diff, allowed)
+    e = int(crease[k])
+    detail = (
+        f"|written - folded form| (deg) of {len(crease)} creases; worst pattern edge {e} "
+        f"(written {written[k]:.6g})"
+        + _quantum_note(g.q, f"{ANGLE_TOL_DEG:g} deg + sqrt(3) q (P_a/A_a + P_b/A_b)")
+    )
+    match = Check(
+        names[1],
+        bool((diff <= allowed).all()),
+        float(diff[k]),
+        float(allowed[k]),
+        detail,
+        "<=",
+        {"pattern_edge": e},
+    )
+    # fold-angle range: no crease folds flat
+    magnitude = np.abs(written)
+    k = int(np.argmax(magnitude))
+    e = int(crease[k])
+    detail = f"largest |fold angle| (deg): pattern edge {e} ({g.assign[e]}, {written[k]:.6g})"
+    n_flat = int(np.count_nonzero(magnitude >= MAX_FOLD_DEG))
+    if n_flat:
+        detail += f"; {n_flat} crease(s) fold flat"
+    span = Check(
+        names[2], n_flat == 0, float(magnitude[k]), MAX_FOLD_DEG, detail, "<", {"pattern_edge": e}
+    )
+    # smallest fold angle: every crease folds
+    k = int(np.argmin(magnitude))
+    e = int(crease[k])
+    n_none = int(np.count_nonzero(magnitude <= MIN_FOLD_DEG))
+    detail = f"smallest |fold angle| (deg): pattern edge {e} ({g.assign[e]}, {written[k]:.6g})"
+    if n_none:
+        detail += f"; {n_none} M/V edge(s) that do not fold"
+    small = Check(
+        names[3], n_none == 0, float(magnitude[k]), MIN_FOLD_DEG, detail, ">", {"pattern_edge": e}
+    )
+    return [mv, match, span, small]
+
+
+def _signed_area_2d(g: _Data) -> np.ndarray:
+    """(n_faces,) signed area in 2D (shoelace about each face's first corner)."""
+    p = g.v2[g.flat] - np.repeat(g.v2[g.flat[g.start[:-1]]], g.size_of, axis=0)
+    pn = p[g.nxt]
+    return 0.5 * np.add.reduceat(p[:, 0] * pn[:, 1] - pn[:, 0] * p[:, 1], g.start[:-1])
+
+
+def _overlap(g: _Data) -> list[Check]:
+    """``no overlap`` (faces' interiors disjoint in 2D, every face a simple polygon) and
+    ``face orientation`` (every face counter-clockwise)."""
+    area = _signed_area_2d(g)
+    n_faces = len(area)
+    # orientation
+    scale = g.size**2
+    k = int(np.argmin(area))
+    n_cw = int(np.count_nonzero(area <= 0))
+    detail = f"smallest signed area / size^2 of {n_faces} faces: {g.where_face(k)}"
+    if n_cw:
+        detail += f"; {n_cw} face(s) clockwise or flat"
+    orient = Check(
+        "face orientation", n_cw == 0, float(area[k] / scale), 0.0, detail, ">", {"pattern_face": k}
+    )
+    # overlap: the pairs of faces whose bounding boxes meet (from the tree, a block of faces at
+    # a time), told apart in numpy when both are convex (:class:`_Separator`), their shared area
+    # measured by shapely otherwise; only the faces measured, and those that are not convex
+    # (checked to be simple polygons), are made shapely polygons
+    p = g.v2[g.flat]
+    lo, hi = np.minimum.reduceat(p, g.start[:-1]), np.maximum.reduceat(p, g.start[:-1])
+    boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+    tree = shapely.STRtree(boxes)
+    convex = _convex_faces(g, area)
+    separator = _Separator(g, convex)
+    polys = np.full(n_faces, None, dtype=object)
+    _make_polygons(g, polys, ~convex)
+    valid = convex.copy()
+    valid[~convex] = shapely.is_valid(polys[~convex])
+    n_pairs = n_measured = n_over = 0
+    value, worst_pair = 0.0, None
+    for first in range(0, n_faces, QUERY_CHUNK):
+        i, j = tree.query(boxes[first : first + QUERY_CHUNK])
+        i += first
+        keep = i < j
+        i, j = i[keep], j[keep]
+        n_pairs += len(i)
+        both = convex[i] & convex[j]
+        separated = np.zeros(len(i), dtype=bool)
+        if both.any():
+            separated[both] = separator.separated(i[both], j[both])
+        near = np.flatnonzero(~separated)
+        near = near[valid[i[near]] & valid[j[near]]]  # a face that is not simple: reported below
+        if not len(near):
+            continue
+        i, j = i[near], j[near]
+        needed = np.zeros(n_faces, dtype=bool)
+        needed[i] = needed[j] = True
+        _make_polygons(g, polys, needed)
+        shared = _intersection_area(polys[i], polys[j])
+        smaller = np.minimum(np.abs(area[i]), np.abs(area[j]))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = np.where(smaller > 0, shared / smaller, np.where(shared > 0, np.inf, 0.0))
+        ratio = np.where(np.isnan(ratio), np.inf, ratio)
+        n_measured += len(ratio)
+        n_over += int(np.count_nonzero(ratio > OVERLAP_TOL))
+        k = int(np.argmax(ratio))
+        if ratio[k] > value:
+            value, worst_pair = float(ratio[k]), (int(i[k]), int(j[k]))
+    detail = f"{n_pairs} touching or close face pairs, {n_measured} measured"
+    worst = {}
+    if worst_pair is not None:
+        a, b = worst_pair
+        worst = {"pattern_faces": [a, b]}
+        detail += f"; worst {g.where_face(a)} and {g.where_face(b)}"
+    if n_over:
+        detail += f"; {n_over} pair(s) overlap"
+    invalid = np.flatnonzero(~valid)
+    if len(invalid):
+        value = max(value, 1.0)  # a face that is not a simple polygon overlaps itself
+        detail += f"; {len(invalid)} face(s) not simple polygons (first {g.where_face(invalid[0])})"
+        worst = worst or {"pattern_faces": [int(invalid[0])]}
+    no_overlap = Check(
+        "no overlap",
+        bool(not n_over and not len(invalid)),
+        value,
+        OVERLAP_TOL,
+        detail + f"; shared area / smaller face {OVERLAP_TOL:g}",
+        "<=",
+        worst,
+    )
+    return [no_overlap, orient]
+
+
+def _convex_faces(g: _Data, area: np.ndarray) -> np.ndarray:
+    """(n_faces,) bool: counter-clockwise convex faces of at most :data:`SAT_CORNERS` corners
+    (every turn to the left up to rounding, one turn in all)."""
+    p = g.v2[g.flat]
+    d = p[g.nxt] - p
+    dn = d[g.nxt]
+    cross = d[:, 0] * dn[:, 1] - d[:, 1] * dn[:, 0]
+    length = np.hypot(d[:, 0], d[:, 1])
+    left = cross >= -1e-12 * length * length[g.nxt]
+    turn = np.arctan2(cross, np.einsum("ij,ij->i", d, dn))
+    one_turn = np.add.reduceat(turn, g.start[:-1]) < 3 * np.pi
+    return (
+        np.logical_and.reduceat(left, g.start[:-1])
+        & one_turn
+        & (area > 0)
+        & (g.size_of <= SAT_CORNERS)
+    )
+
+
+def _make_polygons(g: _Data, polys: np.ndarray, which: np.ndarray) -> None:
+    """Set ``polys[f]`` (n_faces,) to the shapely polygon of face ``f`` where ``which`` (bool)
+    says so and it is not made yet."""
+    which = which & shapely.is_missing(polys)
+    if not which.any():
+        return
+    corner = which[g.face_of]
+    number = np.cumsum(which) - 1
+    rings = shapely.linearrings(g.v2[g.flat[corner]], indices=number[g.face_of[corner]])
+    polys[which] = shapely.polygons(rings)
+
+
+class _Separator:
+    """Separating-axis proofs for pairs of convex faces: every face's corners and outward unit
+    edge normals as (n_faces, K) arrays (``K``: the most corners of a convex face; shorter faces
+    repeat their last corner)."""
+
+    def __init__(self, g: _Data, convex: np.ndarray):
+        size = g.size_of
+        self.size = size
+        self.k = int(size[convex].max(initial=3))
+        ks = np.arange(self.k)
+        first = g.start[:-1, None]
+        corner = g.flat[first + np.minimum(ks, size[:, None] - 1)]
+        nxt = g.flat[first + np.where(ks + 1 < size[:, None], ks + 1, 0)]
+        x, y = g.v2[corner, 0], g.v2[corner, 1]
+        dx, dy = g.v2[nxt, 0] - x, g.v2[nxt, 1] - y
+        length = np.hypot(dx, dy)
+        live = (ks < size[:, None]) & (length > 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nx = np.where(live, dy / length, 0.0)
+            ny = np.where(live, -dx / length, 0.0)
+        eps = 64 * np.finfo(float).eps * max(float(np.abs(g.v2).max()), g.size)
+        self.x, self.y, self.nx, self.ny = x, y, nx, ny
+        # an edge separates when the other face's nearest corner is at least this far along
+        # its normal (the edge's own offset, less the rounding of the products)
+        self.reach = np.where(live, nx * x + ny * y - eps, np.inf)
+
+    def separated(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """(k,) bool: whether the convex faces ``i`` and ``j`` (k,) are proved to have
+        disjoint interiors: an edge of one has the other wholly on its outer side, up to
+        rounding (two convex polygons with disjoint interiors always have such an edge).
+
+        Pairs are taken by their numbers of corners, the other face's corners one at a time
+        (every temporary is a (pairs, corners) array); the edges of ``j`` are tried only on
+        the pairs the edges of ``i`` did not separate.
+        """
+        size, stride = self.size, self.k + 1
+        x, y, nx, ny, reach = self.x, self.y, self.nx, self.ny, self.reach
+        out = np.zeros(len(i), dtype=bool)
+        for u_all, w_all in ((i, j), (j, i)):
+            todo = np.flatnonzero(~out)
+            combo = size[u_all[todo]] * stride + size[w_all[todo]]
+            for key in np.unique(combo).tolist():
+                ku, kw = divmod(key, stride)
+                group = todo[combo == key]
+                for lo in range(0, len(group), PAIR_CHUNK):
+                    sel = group[lo : lo + PAIR_CHUNK]
+                    u, w = u_all[sel], w_all[sel]
+                    nu, mu = nx[u, :ku], ny[u, :ku]
+                    xw, yw = x[w, :kw], y[w, :kw]
+                    near = nu * xw[:, :1] + mu * yw[:, :1]  # (c, ku): nearest corner so far
+                    for k in range(1, kw):
+                        np.minimum(near, nu * xw[:, k : k + 1] + mu * yw[:, k : k + 1], out=near)
+                    out[sel] = (near >= reach[u, :ku]).any(axis=1)
+        return out
+
+
+def _intersection_area(pa: np.ndarray, pb: np.ndarray) -> np.ndarray:
+    """(k,) area shared by valid polygons ``pa`` and ``pb`` (k,) (infinity for a pair GEOS
+    cannot intersect)."""
+    try:
+        return shapely.area(shapely.intersection(pa, pb))
+    except shapely.errors.GEOSException:
+        out = np.empty(len(pa))
+        for k, (a, b) in enumerate(zip(pa, pb, strict=True)):  # only after GEOS failed
+            try:
+                out[k] = shapely.area(shapely.intersection(a, b))
+            except shapely.errors.GEOSException:
+                out[k] = np.inf
+        return out
+
+
+def _smallest_edge(g: _Data) -> Check:
+    name = "smallest edge"
+    if not len(g.edges):
+        return Check(name, True, float("nan"), MIN_EDGE, "no pattern edge", ">=")
+    length = np.minimum(g.l2, g.l3) / g.size
+    k = int(np.argmin(length))
+    detail = f"shortest of {len(g.edges)} pattern edges / size: pattern edge {k} ({g.assign[k]})"
+    n_short = int(np.count_nonzero(length < MIN_EDGE))
+    if n_short:
+        detail += f"; {n_short} shorter than the limit"
+    ok = n_short == 0
+    return Check(name, ok, float(length[k]), MIN_EDGE, detail, ">=", {"pattern_edge": k})
+
+
+def _smallest_face_angle(g: _Data) -> Check:
+    p = g.v2[g.flat]
+    u, w = p[g.prv] - p, p[g.nxt] - p
+    cross = w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0]
+    angle = np.degrees(np.arctan2(cross, np.einsum("ij,ij->i", w, u))) % 360.0
+    k = int(np.argmin(angle))
+    f = int(g.face_of[k])
+    detail = f"degrees, in 2D: corner at pattern vertex {int(g.flat[k])} of {g.where_face(f)}"
+    worst = {"pattern_face": f, "pattern_vertex": int(g.flat[k])}
+    return Check("smallest face angle", True, float(angle[k]), None, detail, "", worst)
+
+
+def certify_design(design) -> Certificate:
+    """:func:`certify` of an in-memory design (its pattern, cleaned mesh, rounding and apices).
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    Certificate
+    """
+    mesh, rd = design.mesh, design.rounding
+    edges = {
+        "vertices": mesh.edges,
+        "faces": mesh.edge_faces,
+        "radius": rd.radius,
+        "half_angle": rd.half_angle,
+        "kappa": rd.kappa,
+    }
+    return certify(design.pattern, mesh.vertices, mesh.faces, edges, design.vertices.apex)
+
+
+def file_quantum(pattern: CreasePattern) -> float:
+    """How far a coordinate of a pattern read from a FOLD file may be from the one computed:
+    :data:`FILE_ROUNDING` (5e-12) times the largest ``|coordinate|`` in 2D or 3D."""
+    largest = max(
+        float(np.abs(pattern.vertices_2d).max(initial=0.0)),
+        float(np.abs(pattern.vertices_3d).max(initial=0.0)),
+    )
+    return FILE_ROUNDING * largest
+
+
+def check_folder(path) -> Certificate:
+    """:func:`certify` the design in a folder written by ``filletfold round``.
+
+    Reads ``design.fold`` (the pattern) and ``report.json`` (the mesh, its edges' radii, half
+    angles and assignments, the vertices' apices); the tolerances allow for the FOLD file's
+    rounding (:func:`file_quantum`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder.
+
+    Returns
+    -------
+    Certificate
+
+    Raises
+    ------
+    MeshReadError
+        When the folder or one of the two files is missing or unreadable, or the two do not
+        belong together; the message is one line naming the file.
+    """
+    folder = Path(os.fspath(path))
+    if not folder.is_dir():
+        what = "not a folder" if folder.exists() else "no such folder"
+        raise MeshReadError(f"{folder}: {what} (write a design with 'filletfold round')")
+    fold, report = folder / "design.fold", folder / "report.json"
+    for f in (fold, report):
+        if not f.is_file():
+            raise MeshReadError(f"{f}: no such file (write the design with 'filletfold round')")
+    pattern = read_fold(fold)
+    mesh_vertices, mesh_faces, edges, apex = _read_report(report)
+    try:
+        return certify(
+            pattern, mesh_vertices, mesh_faces, edges, apex, coord_quantum=file_quantum(pattern)
+        )
+    except ParameterError as exc:
+        raise MeshReadError(f"{fold} does not match {report.name}: {exc}") from None
+
+
+def _read_report(path: Path):
+    """(mesh vertices, mesh faces, edges dict, vertex apices) of a ``report.json``."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MeshReadError(f"{path}: cannot read: {exc}") from None
+    except json.JSONDecodeError as exc:
+        raise MeshReadError(f"{path}: not a report (invalid JSON: {exc.msg})") from None
+    try:
+        mesh = doc["mesh"]
+        vertices = np.asarray(mesh["vertices"], dtype=np.float64).reshape(-1, 3)
+        faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in mesh["faces"]]
+        records = doc["edges"]
+        ev = np.array([r["vertices"] for r in records], dtype=np.int64).reshape(-1, 2)
+        ef = np.array(
+            [[-1, -1] if r["faces"] is None else r["faces"] for r in records], dtype=np.int64
+        ).reshape(-1, 2)
+        radius = np.array([_number(r["radius"]) for r in records], dtype=np.float64)
+        gamma = np.array([_number(r["half_angle"]) for r in records], dtype=np.float64)
+        sign = {"M": 1.0, "V": -1.0}
+        kappa = np.array([sign.get(r["assignment"], 0.0) for r in records], dtype=np.float64)
+        apex = np.array(
+            [[np.nan] * 3 if v["apex"] is None else v["apex"] for v in doc["vertices"]],
+            dtype=np.float64,
+        ).reshape(-1, 3)
+    except KeyError as exc:
+        raise MeshReadError(f"{path}: not a filletfold report (no key {exc})") from None
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise MeshReadError(f"{path}: not a filletfold report (malformed: {exc})") from None
+    if len(apex) != len(vertices):
+        raise MeshReadError(
+            f"{path}: {len(apex)} vertex records for a mesh of {len(vertices)} vertices"
+        )
+    kappa = np.where((radius > 0) & (ef >= 0).all(axis=1), kappa, 0.0)  # flat edges: no cylinder
+    edges = {"vertices": ev, "faces": ef, "radius": radius, "half_angle": gamma, "kappa": kappa}
+    return vertices, faces, edges, apex
+
+
+def _number(x) -> float:
+    return float("nan") if x is None else float(x)
