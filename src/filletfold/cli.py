@@ -15,6 +15,9 @@ Commands
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
     Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
     ``pattern.svg``) and pictures (``pattern.png``, ``preview.png``) into ``DIR``.
+``filletfold check DIR [--json]``
+    Measure the design's invariants from ``DIR/design.fold`` and ``DIR/report.json`` and print
+    them, one line each; exit 0 when all hold, 1 when one fails, 2 when the files cannot be read.
 """
 
 from __future__ import annotations
@@ -348,6 +351,41 @@ def export_cmd(
         f"wrote {len(written)} files to {folder}/: {', '.join(p.name for p in written)}",
         highlight=False,
     )
+
+
+@app.command("check")
+def check_cmd(
+    folder: Annotated[
+        Path,
+        typer.Argument(
+            help="A design folder written by 'filletfold round' (design.fold and report.json)."
+        ),
+    ],
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the certificate as JSON instead of lines.")
+    ] = False,
+):
+    """Check that the design in FOLDER is valid: measure its invariants again from its files.
+
+    One line per invariant (name, measured figure, limit, ok/FAIL, what was measured): ruling
+    isometry, contraction, points on their planes and cylinders, M/V signs and fold angles, no
+    overlap, face orientation, smallest edge (and the smallest face angle, for information).
+    Exit code 0 when every invariant holds, 1 when one fails, 2 when the files cannot be read.
+    """
+    import json
+
+    from .check import check_folder
+
+    try:
+        certificate = check_folder(folder)
+    except FilletfoldError as exc:
+        typer.echo(f"error: {exc}", err=True)  # one line, never wrapped
+        raise typer.Exit(2) from None
+    if as_json:
+        typer.echo(json.dumps(certificate.as_dict(), indent=2))
+    else:
+        typer.echo("\n".join(certificate.summary()))
+    raise typer.Exit(0 if certificate.ok else 1)
 
 
 @app.command("app")
