@@ -1,0 +1,437 @@
+"""The validity certificate: built-in designs pass, in memory and from their files, and every
+invariant fails when the data are corrupted to break it."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import json
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from filletfold.check import (
+    Certificate,
+    certify,
+    certify_design,
+    check_folder,
+    file_quantum,
+)
+from filletfold.cli import main
+from filletfold.errors import MeshReadError
+from filletfold.export.fold_read import read_fold
+from filletfold.pattern import CreasePattern
+
+from .conftest import design_of
+
+NAMES = ("icosahedron", "cube", "miura")
+CHECKS = [
+    "ruling isometry",
+    "contraction",
+    "on planes",
+    "on cylinders",
+    "M/V",
+    "fold-angle match",
+    "fold-angle range",
+    "smallest fold angle",
+    "no overlap",
+    "face orientation",
+    "smallest edge",
+    "smallest face angle",
+]
+
+
+@functools.cache
+def written(name: str, tmp_root: str) -> str:
+    """The folder of ``name``'s design written once (``tmp_root``: the session's tmp folder)."""
+    folder = f"{tmp_root}/{name}"
+    design_of(name).export(folder, formats="fold,json")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def tmp_root(tmp_path_factory) -> str:
+    return str(tmp_path_factory.mktemp("check"))
+
+
+def _edges(design) -> dict:
+    rd = design.rounding
+    return {
+        "vertices": design.mesh.edges,
+        "faces": design.mesh.edge_faces,
+        "radius": rd.radius,
+        "half_angle": rd.half_angle,
+        "kappa": rd.kappa,
+    }
+
+
+def _certify(design, pattern: CreasePattern | None = None, apex=None) -> Certificate:
+    apex = design.vertices.apex if apex is None else apex
+    pattern = design.pattern if pattern is None else pattern
+    return certify(pattern, design.mesh.vertices, design.mesh.faces, _edges(design), apex)
+
+
+def _failed(cert: Certificate) -> set[str]:
+    return {c.name for c in cert.failed}
+
+
+def _patch_faces(pattern, kind: str) -> np.ndarray:
+    return np.array([k for k, p in enumerate(pattern.face_patch) if p.startswith(kind + " ")])
+
+
+def _consistent(cert: Certificate) -> None:
+    """Every check's verdict is what its figure and limit say."""
+    compare = {
+        "<=": lambda v, lim: v <= lim,
+        "<": lambda v, lim: v < lim,
+        ">=": lambda v, lim: v >= lim,
+        ">": lambda v, lim: v > lim,
+    }
+    for c in cert.checks:
+        if c.limit is None:
+            assert c.ok and c.relation == ""
+        elif not math.isnan(c.value) and c.name not in ("ruling isometry", "no overlap"):
+            assert c.ok == compare[c.relation](c.value, c.limit), c.line()
+
+
+# ------------------------------------------------------------------ valid designs
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_designs_pass_in_memory(name):
+    cert = certify_design(design_of(name))
+    assert cert.ok, "\n".join(cert.summary())
+    assert [c.name for c in cert.checks] == CHECKS
+    assert cert.coord_quantum == 0.0
+    _consistent(cert)
+    assert "q =" not in "\n".join(cert.summary())  # no file rounding in memory
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_written_designs_pass(name, tmp_root, capsys):
+    folder = written(name, tmp_root)
+    cert = check_folder(folder)
+    assert cert.ok, "\n".join(cert.summary())
+    assert cert.coord_quantum == file_quantum(read_fold(f"{folder}/design.fold")) > 0
+    _consistent(cert)
+    assert main(["check", folder]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == len(CHECKS) + 1 and lines[-1].startswith("valid")
+    for line, name_ in zip(lines, CHECKS, strict=False):
+        assert line.startswith(name_)
+        assert (" info " if name_ == "smallest face angle" else " ok ") in line
+    contraction = lines[CHECKS.index("contraction")]
+    assert "q =" in contraction and "12 digits" in contraction  # the file's rounding is said
+
+
+def test_certificate_as_json(tmp_root, capsys):
+    cert = check_folder(written("cube", tmp_root))
+    data = cert.as_dict()
+    assert list(data) == ["ok", "checks"] and data["ok"] is True
+    assert list(data["checks"]) == CHECKS
+    for entry in data["checks"].values():
+        assert list(entry) == ["ok", "value", "limit", "detail"]
+        assert type(entry["value"]) is float and type(entry["ok"]) is bool
+        assert entry["limit"] is None or type(entry["limit"]) is float
+    assert json.loads(json.dumps(data, allow_nan=False)) == data
+    assert data["checks"]["smallest face angle"]["limit"] is None
+    assert main(["check", written("cube", tmp_root), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == data
+
+
+def test_nothing_to_measure_is_not_a_failure():
+    """The Miura design has no cone and no M/V crease: those checks hold, with no figure."""
+    cert = certify_design(design_of("miura"))
+    for name in ("ruling isometry", "fold-angle range", "smallest fold angle"):
+        assert cert[name].ok and math.isnan(cert[name].value)
+    assert cert.as_dict()["checks"]["ruling isometry"]["value"] is None
+
+
+# ------------------------------------------------------------------ each invariant fails
+
+
+def test_ruling_isometry_fails_when_an_apex_moves_in_2d():
+    d = design_of("cube")
+    p = d.pattern
+    cone = _patch_faces(p, "cone")[0]
+    u = int(p.face_patch[cone].split()[1])
+    apex = int(np.argmin(np.linalg.norm(p.vertices_3d - d.vertices.apex[u], axis=1)))
+    v2 = p.vertices_2d.copy()
+    v2[apex] += 1e-6
+    cert = _certify(d, dataclasses.replace(p, vertices_2d=v2))
+    assert "ruling isometry" in _failed(cert)
+    assert cert["ruling isometry"].worst["patch"] == f"cone {u}"
+    # without its apex, no cone face is certified
+    no_apex = d.vertices.apex.copy()
+    no_apex[u] = np.nan
+    cert = _certify(d, apex=no_apex)
+    assert _failed(cert) == {"ruling isometry"}
+    assert f"vertex {u} has no apex" in cert["ruling isometry"].detail
+
+
+def test_contraction_fails_when_a_piece_shrinks_in_2d():
+    d = design_of("miura")
+    p = d.pattern
+    points = np.unique(
+        np.concatenate([f for f, k in zip(p.faces, p.face_piece, strict=True) if k == 0])
+    )
+    v2 = p.vertices_2d.copy()
+    centre = v2[points].mean(axis=0)
+    v2[points] = centre + (1 - 1e-7) * (v2[points] - centre)
+    cert = _certify(d, dataclasses.replace(p, vertices_2d=v2))
+    assert _failed(cert) == {"contraction"}
+    assert cert["contraction"].value == pytest.approx(1e-7, rel=1e-3)
+
+
+def test_on_planes_fails_when_a_point_leaves_its_face():
+    d = design_of("cube")
+    p = d.pattern
+    face = _patch_faces(p, "face")[0]
+    f = int(p.face_patch[face].split()[1])
+    v = int(p.faces[face][2])
+    v3 = p.vertices_3d.copy()
+    v3[v] += 1e-6 * d.mesh.face_normal[f]
+    cert = _certify(d, dataclasses.replace(p, vertices_3d=v3))
+    assert "on planes" in _failed(cert)
+    assert cert["on planes"].worst == {"pattern_vertex": v, "mesh_face": f}
+
+
+def test_on_cylinders_fails_when_a_point_leaves_its_cylinder():
+    d = design_of("icosahedron")
+    p = d.pattern
+    face = _patch_faces(p, "cylinder")[5]
+    e = int(p.face_patch[face].split()[1])
+    v = int(p.faces[face][0])
+    v3 = p.vertices_3d.copy()
+    a, b = d.mesh.vertices[d.mesh.edges[e]]
+    t = (b - a) / np.linalg.norm(b - a)
+    radial = v3[v] - d.rounding.axis_point[e]
+    radial -= (radial @ t) * t
+    v3[v] += 1e-6 * radial / np.linalg.norm(radial)
+    cert = _certify(d, dataclasses.replace(p, vertices_3d=v3))
+    assert "on cylinders" in _failed(cert)
+    assert cert["on cylinders"].worst == {"pattern_vertex": v, "mesh_edge": e}
+    assert cert["on cylinders"].value == pytest.approx(1e-6 / cert.size, rel=1e-3)
+
+
+def test_mv_fails_when_an_assignment_flips():
+    d = design_of("icosahedron")
+    p = d.pattern
+    e = int(np.flatnonzero(p.edge_assignment == "M")[3])
+    assign = p.edge_assignment.copy()
+    assign[e] = "V"
+    cert = _certify(d, dataclasses.replace(p, edge_assignment=assign))
+    assert _failed(cert) == {"M/V"}
+    assert cert["M/V"].value == 1 and cert["M/V"].worst == {"pattern_edge": e}
+    # flipped with its angle, the written data agree but the folded form does not
+    angle = p.edge_fold_angle.copy()
+    angle[e] = -angle[e]
+    cert = _certify(d, dataclasses.replace(p, edge_assignment=assign, edge_fold_angle=angle))
+    assert _failed(cert) == {"M/V", "fold-angle match"}
+
+
+@pytest.mark.parametrize(
+    ("wrong", "failing"),
+    [
+        (lambda a: -179.9, {"fold-angle range", "fold-angle match"}),
+        (lambda a: -1e-9, {"smallest fold angle", "fold-angle match"}),
+        (lambda a: 1.001 * a, {"fold-angle match"}),
+    ],
+    ids=["folds-flat", "does-not-fold", "off-by-0.1%"],
+)
+def test_fold_angle_checks_fail_on_a_wrong_angle(wrong, failing):
+    d = design_of("cube")
+    p = d.pattern
+    e = int(np.flatnonzero(p.edge_assignment == "M")[7])
+    angle = p.edge_fold_angle.copy()
+    angle[e] = wrong(angle[e])
+    cert = _certify(d, dataclasses.replace(p, edge_fold_angle=angle))
+    assert _failed(cert) == failing
+    for name in failing:
+        assert cert[name].worst == {"pattern_edge": e}
+
+
+def _pieces_on_top(pattern) -> np.ndarray:
+    """2D coordinates with piece 1 moved onto piece 0 (their centres together)."""
+    v2 = pattern.vertices_2d.copy()
+    points = [
+        np.unique(
+            np.concatenate(
+                [f for f, k in zip(pattern.faces, pattern.face_piece, strict=True) if k == i]
+            )
+        )
+        for i in (0, 1)
+    ]
+    v2[points[1]] += v2[points[0]].mean(axis=0) - v2[points[1]].mean(axis=0)
+    return v2
+
+
+def test_no_overlap_fails_when_a_piece_lies_on_another():
+    d = design_of("cube")
+    cert = _certify(d, dataclasses.replace(d.pattern, vertices_2d=_pieces_on_top(d.pattern)))
+    assert _failed(cert) == {"no overlap"}
+    assert cert["no overlap"].value > 0.01
+    a, b = cert["no overlap"].worst["pattern_faces"]
+    assert {d.pattern.face_piece[a], d.pattern.face_piece[b]} == {0, 1}
+
+
+def test_no_overlap_fails_on_a_face_that_crosses_itself():
+    d = design_of("cube")
+    p = d.pattern
+    faces = list(p.faces)
+    k = next(int(k) for k in _patch_faces(p, "cylinder") if len(faces[k]) == 4)
+    b0, b1, t1, t0 = faces[k]
+    faces[k] = np.array([b0, t1, b1, t0])  # a bow tie
+    cert = _certify(d, dataclasses.replace(p, faces=faces))
+    assert "no overlap" in _failed(cert)
+    assert "not simple polygons" in cert["no overlap"].detail
+
+
+def test_face_orientation_fails_on_a_clockwise_face():
+    d = design_of("cube")
+    p = d.pattern
+    k = int(_patch_faces(p, "face")[1])
+    faces = list(p.faces)
+    faces[k] = faces[k][::-1]
+    cert = _certify(d, dataclasses.replace(p, faces=faces))
+    assert "face orientation" in _failed(cert)
+    assert cert["face orientation"].worst == {"pattern_face": k}
+    assert cert["face orientation"].value < 0
+
+
+def test_smallest_edge_fails_on_a_tiny_edge():
+    d = design_of("cube")
+    p = d.pattern
+    e = int(np.flatnonzero(p.edge_assignment == "B")[0])
+    a, b = p.edges[e]
+    v2, v3 = p.vertices_2d.copy(), p.vertices_3d.copy()
+    v2[b] = v2[a] + 1e-9 * (v2[b] - v2[a])
+    v3[b] = v3[a] + 1e-9 * (v3[b] - v3[a])
+    cert = _certify(d, dataclasses.replace(p, vertices_2d=v2, vertices_3d=v3))
+    assert "smallest edge" in _failed(cert)
+    assert cert["smallest edge"].worst == {"pattern_edge": e}
+
+
+# ------------------------------------------------------------------ overlap against shapely
+
+
+def _polygon(rng, k: int) -> np.ndarray:
+    """A random star-shaped counter-clockwise polygon of ``k`` corners, convex or not (every
+    turn round its centre under half a turn, so a simple polygon)."""
+    gap = rng.uniform(1.0, 1.9, k)
+    angle = np.cumsum(gap * 2 * np.pi / gap.sum())
+    radius = rng.uniform(0.05, 0.3) * rng.uniform(0.4, 1.0, k)
+    return rng.uniform(0, 1, 2) + radius[:, None] * np.c_[np.cos(angle), np.sin(angle)]
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(2, 7), fan=st.booleans())
+def test_overlap_agrees_with_shapely(seed, n, fan):
+    """Random polygons (or a fan of triangles round a shared point, like a cone's): the
+    certificate finds an overlap exactly when shapely measures one."""
+    rng = np.random.default_rng(seed)
+    if fan:  # triangles sharing the centre and their sides: overlapping only if turned back
+        turn = np.cumsum(rng.uniform(0.1, 1.4, n + 1))
+        ring = np.c_[np.cos(turn), np.sin(turn)] * rng.uniform(0.5, 1, (n + 1, 1))
+        v2 = np.vstack([[0.0, 0.0], ring])
+        faces = [np.array([0, i, i + 1]) for i in range(1, n + 1)]
+    else:
+        polys = [_polygon(rng, int(rng.integers(3, 7))) for _ in range(n)]
+        v2 = np.vstack(polys)
+        start = np.cumsum([0] + [len(q) for q in polys])
+        faces = [np.arange(start[i], start[i + 1]) for i in range(n)]
+    shapes = [shapely.Polygon(v2[f]) for f in faces]
+    expected = any(
+        shapes[i].intersection(shapes[j]).area > 1e-9 * min(shapes[i].area, shapes[j].area)
+        for i in range(len(faces))
+        for j in range(i)
+    )
+    pattern = CreasePattern(
+        np.asarray(v2, dtype=float),
+        np.c_[v2, np.zeros(len(v2))],
+        faces,
+        ["face 0"] * len(faces),
+        np.arange(len(faces)),
+        np.zeros(len(faces), dtype=np.int64),
+    )
+    edges = {k: np.zeros((0, 2) if k in ("vertices", "faces") else 0) for k in _edge_keys()}
+    cert = certify(pattern, np.eye(3) * [1, 1, 0], [[0, 1, 2]], edges, np.full((3, 3), np.nan))
+    assert cert["no overlap"].ok is not expected, cert["no overlap"].line()
+    assert cert["on planes"].ok and cert["face orientation"].ok
+
+
+def _edge_keys():
+    return ("vertices", "faces", "radius", "half_angle", "kappa")
+
+
+# ------------------------------------------------------------------ files and errors
+
+
+def _rewrite_fold(folder, change) -> None:
+    path = f"{folder}/design.fold"
+    with open(path) as fh:
+        doc = json.load(fh)
+    change(doc)
+    with open(path, "w") as fh:
+        json.dump(doc, fh)
+
+
+def test_check_exits_1_when_the_file_breaks_an_invariant(tmp_path, capsys):
+    folder = tmp_path / "ico"
+    design_of("icosahedron").export(folder, formats="fold,json")
+
+    def flip(doc):  # an M crease written as a valley, with its angle: readable, but wrong
+        e = doc["edges_assignment"].index("M")
+        doc["edges_assignment"][e] = "V"
+        doc["edges_foldAngle"][e] = -doc["edges_foldAngle"][e]
+
+    _rewrite_fold(folder, flip)
+    assert _failed(check_folder(folder)) == {"M/V", "fold-angle match"}
+    assert main(["check", str(folder)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in out if " FAIL " in line] == ["M/V", "fold-angle"]
+    assert out[-1].startswith("NOT VALID: 2 check(s) fail")
+
+
+def test_check_finds_overlapping_pieces_in_the_file(tmp_path):
+    folder = tmp_path / "cube"
+    d = design_of("cube")
+    d.export(folder, formats="fold,json")
+    v2 = _pieces_on_top(d.pattern)
+    _rewrite_fold(folder, lambda doc: doc.update(vertices_coords=v2.tolist()))
+    assert _failed(check_folder(folder)) == {"no overlap"}
+
+
+def _error_line(args, capsys) -> str:
+    assert main(args) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip()
+    assert captured.out == "" and "\n" not in err and err.startswith("error: ")
+    assert "Traceback" not in err
+    return err
+
+
+def test_missing_or_unreadable_input_exits_2_with_one_line(tmp_path, tmp_root, capsys):
+    missing = tmp_path / "no-such-design-folder-with-a-long-name-that-a-console-would-wrap"
+    assert str(missing) in _error_line(["check", str(missing)], capsys)
+    with pytest.raises(MeshReadError, match="no such folder"):
+        check_folder(missing)
+    folder = tmp_path / "partial"
+    folder.mkdir()
+    (folder / "design.fold").write_text((tmp_path / "x").as_posix())
+    assert "report.json: no such file" in _error_line(["check", str(folder)], capsys)
+    (folder / "report.json").write_text("{}")
+    assert "design.fold: not a FOLD file" in _error_line(["check", str(folder)], capsys)
+    cube, ico = written("cube", tmp_root), written("icosahedron", tmp_root)
+    (folder / "design.fold").write_text(open(f"{cube}/design.fold").read())
+    assert "report.json: not a filletfold report" in _error_line(["check", str(folder)], capsys)
+    (folder / "design.fold").write_text(open(f"{ico}/design.fold").read())  # another design's
+    (folder / "report.json").write_text(open(f"{cube}/report.json").read())
+    err = _error_line(["check", str(folder)], capsys)
+    assert "does not match report.json" in err and "there is no mesh" in err
+    (folder / "report.json").write_text("[1, 2")
+    assert "report.json: not a report (invalid JSON" in _error_line(["check", str(folder)], capsys)
