@@ -572,7 +572,7 @@ def test_near_straight_corner_next_to_a_rounded_edge_is_split():
     sides = [np.array([i, (i + 1) % 5, (i + 1) % 5 + 5, i + 5]) for i in range(5)]
     mesh, log = clean_mesh(v, [np.arange(5)[::-1], top, *sides])
     split = [r for r in log.repairs if r.what == "split-face"]
-    assert len(split) == 2 and all("of straight" in r.why for r in split)
+    assert len(split) == 2 and all("from straight" in r.why for r in split)
     assert mesh.n_faces == 9
     angles = mesh.corner_angles()
     assert np.abs(angles - np.pi).min() > tol.straight

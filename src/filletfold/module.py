@@ -540,10 +540,12 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
     prev = mesh.halfedge_prev
     delta = base - base[prev]
     cos = np.einsum("ij,ij->i", u[prev], u)
+    sin2 = 1 - cos**2
+    parallel = sin2 < 1e-24  # a straight corner between unrounded edges: T is the corner
     z = (np.einsum("ij,ij->i", u[prev], delta) - cos * np.einsum("ij,ij->i", u, delta)) / (
-        1 - cos**2
+        np.where(parallel, 1.0, sin2)
     )
-    T = base[prev] + z[:, None] * u[prev]
+    T = np.where(parallel[:, None], base, base[prev] + z[:, None] * u[prev])
     # face coordinates: origin at the first corner, e1 along the first edge
     origin = p[start[:-1]]
     e1 = u[start[:-1]]

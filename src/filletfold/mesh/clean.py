@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import math
 from collections import deque
 from dataclasses import dataclass, field
 
@@ -29,8 +30,10 @@ from .polymesh import PolyMesh
 from .repair import (
     RepairLog,
     corner_turns,
+    detach_faces,
     drop_duplicate_faces,
     fix_degenerate_faces,
+    planarize,
     plane_axes,
     polygon_normal,
     split_face_loops,
@@ -169,6 +172,10 @@ def clean_mesh(
     # 5. non-manifold vertices and edges
     face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
     he = _HalfEdges(face_list, len(v))
+    if not strict and (he.edge_count > 2).any():  # sheets still joined elsewhere: cut them off
+        face_list, v, vert_orig = detach_faces(face_list, face_origin, v, vert_orig, he, log)
+        face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
+        he = _HalfEdges(face_list, len(v))
     _check_manifold(he, vert_orig)
 
     # 6. orientation (a component that cannot be oriented is cut where it conflicts)
@@ -192,11 +199,7 @@ def clean_mesh(
     if merge_coplanar and coplanar_deg > 0 and len(face_list) > 1:
         n_before = len(face_list)
         for _ in range(8):  # interior vertices of flat regions are removed, then merged again
-            while True:  # regions merged into regions too, until nothing merges
-                n_pass = len(face_list)
-                face_list, face_origin = _merge_coplanar(face_list, face_origin, v, coplanar_deg)
-                if len(face_list) == n_pass:
-                    break
+            face_list, face_origin = _merge_coplanar(face_list, face_origin, v, coplanar_deg)
             face_list, face_origin, removed = _remove_flat_vertices(
                 face_list, face_origin, v, coplanar_deg
             )
@@ -218,7 +221,23 @@ def clean_mesh(
         v = v[used]
         face_list = [compact[f] for f in face_list]
 
-    # 9. planarity
+    # 9. planarity: exact (to round-off) where the polygons are planar within the tolerance
+    if not strict:
+        v, residual = planarize(face_list, v, log)
+        rest = np.flatnonzero(residual > 1e-12)
+        if len(rest):  # polygons the planes of their neighbours do not let be planar
+            face_list, face_origin = triangulate_faces(
+                face_list,
+                face_origin,
+                v,
+                rest,
+                log,
+                lambda i: (
+                    f"not planar to round-off ({residual[i]:.2g} of its diameter) once "
+                    "its vertices are moved onto their planes"
+                ),
+                lambda o, i: "",
+            )
     _check_planar(face_list, v, face_origin)
 
     mesh = PolyMesh(v, face_list)
@@ -634,13 +653,15 @@ def _split_non_convex(face_list, face_origin, v, log: RepairLog):
 
 # ------------------------------------------------------------------------ 8. coplanar merge
 def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
-    """Merge neighbouring coplanar faces into convex polygons, region by region.
+    """Merge neighbouring coplanar faces into convex polygons.
 
-    Each region grows breadth first from its lowest face through edges whose faces' normals
-    differ by less than ``coplanar_deg``; a face joins when the merged polygon stays one
-    simple loop (it shares one chain of edges with the region), convex, planar within
-    ``tol.planar`` and without a corner within ``tol.straight`` of straight that is not
-    straight within ``tol.angle``. A face that cannot join starts a region of its own.
+    Regions start as the faces; neighbouring regions across an edge whose faces' normals
+    differ by less than ``coplanar_deg`` are merged, pair after pair from a work list (in
+    face order, breadth first; a merged region's pairs are tried again), when the merged
+    polygon stays one simple loop (the two share one chain of edges), convex, within
+    ``tol.planar`` of its diameter from the first face's plane, and without a corner within
+    ``tol.straight`` of straight that is not straight within ``tol.angle``. Only the two
+    corners at the ends of the shared chain change, so only they are checked.
 
     Returns
     -------
@@ -659,34 +680,55 @@ def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
     if not flat.any():
         return face_list, face_origin
     n_faces = len(face_list)
-    neighbours: list[list[int]] = [[] for _ in range(n_faces)]
-    for a, b in zip(fa[flat].tolist(), fb[flat].tolist(), strict=True):
-        neighbours[a].append(b)
-        neighbours[b].append(a)
-    region = -np.ones(n_faces, dtype=np.int64)
-    out, origin = [], []
-    for seed in range(n_faces):
-        if region[seed] >= 0:
+    neighbours: list[set] = [set() for _ in range(n_faces)]
+    for x, y in zip(fa[flat].tolist(), fb[flat].tolist(), strict=True):
+        neighbours[x].add(y)
+        neighbours[y].add(x)
+    parent = list(range(n_faces))  # union-find of regions; a region is named by its root
+
+    def root(x: int) -> int:
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    loop = {f: face_list[f].tolist() for f in range(n_faces) if neighbours[f]}
+    axes_of = _plane_axes_many(normal)
+    plane = {}  # root -> (normal, point, axes)
+    diam = {}
+    pts = v.tolist()
+    work = deque((f, g) for f in range(n_faces) for g in sorted(neighbours[f]) if f < g)
+    while work:
+        x, y = (root(f) for f in work.popleft())
+        if x == y:
             continue
-        region[seed] = len(out)
-        loop = face_list[seed].tolist()
-        members = [seed]
-        if neighbours[seed]:
-            axes = plane_axes(normal[seed])
-            queue = deque(neighbours[seed])
-            while queue:
-                g = queue.popleft()
-                if region[g] >= 0:
-                    continue
-                merged = _splice(loop, face_list[g].tolist())
-                if merged is None or not _convex_planar(v[merged], axes):
-                    continue
-                loop = merged
-                members.append(g)
-                region[g] = len(out)
-                queue.extend(x for x in neighbours[g] if region[x] < 0)
-        out.append(np.asarray(loop, dtype=np.int64) if len(members) > 1 else face_list[seed])
-        origin.append(int(face_origin[members].min()))
+        a, b = min(x, y), max(x, y)  # the region of the lower face absorbs the other
+        merged = _splice(loop[a], loop[b])
+        if merged is None:
+            continue
+        if a not in plane:
+            plane[a] = (normal[a], v[loop[a][0]], axes_of[a])
+            diam[a] = _diameter(v[loop[a]])
+        n, p0, axes = plane[a]
+        d = max(diam[a], _diameter(v[merged]))
+        off = np.abs((v[loop[b]] - p0) @ n).max()
+        if off > tol.planar * d or not _convex_ends(merged, loop[a], loop[b], pts, axes):
+            continue
+        parent[b] = a
+        loop[a] = merged
+        diam[a] = d
+        neighbours[a] |= neighbours[b]
+        for g in sorted(neighbours[b]):
+            if root(g) != a:
+                work.append((a, g))
+    out, origin = [], []
+    members: dict[int, list[int]] = {}
+    for f in range(n_faces):
+        members.setdefault(root(f), []).append(f)
+    for r in sorted(members):
+        fs = members[r]
+        out.append(np.asarray(loop[r], dtype=np.int64) if len(fs) > 1 else face_list[r])
+        origin.append(int(face_origin[fs].min()))
     return out, np.asarray(origin, dtype=np.int64)
 
 
@@ -774,6 +816,43 @@ def _fan_boundary(u: int, fan: list) -> list | None:
     return loop
 
 
+def _plane_axes_many(n: np.ndarray) -> np.ndarray:
+    """(k, 2, 3) in-plane axes ``e1, e2`` (``e1 x e2 = n``) of unit normals ``n`` (k, 3), as
+    :func:`~filletfold.mesh.repair.plane_axes` gives them one at a time."""
+    pick = np.eye(3)[np.argmin(np.abs(n), axis=1)]
+    e1 = np.cross(n, pick)
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    return np.stack([e1, np.cross(n, e1)], axis=1)
+
+
+def _diameter(p: np.ndarray) -> float:
+    """Diagonal of the bounding box of points (k, 3): at least their diameter, at most
+    sqrt(3) times it."""
+    return float(np.linalg.norm(p.max(axis=0) - p.min(axis=0)))
+
+
+def _convex_ends(merged: list, loop_a: list, loop_b: list, pts: list, axes) -> bool:
+    """Whether the corners of ``merged`` where ``loop_a`` and ``loop_b`` meet (the two ends
+    of their shared chain: the only vertices of both) are convex seen along ``e1 x e2`` of
+    ``axes``, and not within ``tol.straight`` of straight unless straight within
+    ``tol.angle``."""
+    k = len(merged)
+    both = set(loop_a).intersection(loop_b)
+    (e10, e11, e12), (e20, e21, e22) = axes.tolist()
+    for i, x in enumerate(merged):
+        if x not in both:
+            continue  # a corner of one of the two, unchanged
+        p, q, r = pts[merged[i - 1]], pts[x], pts[merged[(i + 1) % k]]
+        u = (q[0] - p[0], q[1] - p[1], q[2] - p[2])
+        w = (r[0] - q[0], r[1] - q[1], r[2] - q[2])
+        ux, uy = u[0] * e10 + u[1] * e11 + u[2] * e12, u[0] * e20 + u[1] * e21 + u[2] * e22
+        wx, wy = w[0] * e10 + w[1] * e11 + w[2] * e12, w[0] * e20 + w[1] * e21 + w[2] * e22
+        turn = math.atan2(ux * wy - uy * wx, ux * wx + uy * wy)
+        if turn < -tol.angle or tol.angle < turn < tol.straight:
+            return False
+    return True
+
+
 def _splice(loop: list, face: list) -> list | None:
     """The loop of a region and a face merged along the one chain of edges they share
     (counter-clockwise, both), or None when they share no edge, several chains, or the
@@ -797,20 +876,6 @@ def _splice(loop: list, face: list) -> list | None:
     if len(part) != n + k - 2 * m or len(set(part)) != len(part):
         return None
     return part
-
-
-def _convex_planar(p: np.ndarray, axes: np.ndarray) -> bool:
-    """Whether the polygon ``p`` (k, 3) is convex seen along ``e1 x e2`` of ``axes`` (corners
-    straight within ``tol.angle`` allowed, none nearer straight than ``tol.straight`` else),
-    and planar within ``tol.planar`` of its diameter."""
-    xy = (p - p[0]) @ axes.T
-    turn = corner_turns(xy)
-    if (turn < -tol.angle).any() or ((turn > tol.angle) & (turn < tol.straight)).any():
-        return False
-    n = polygon_normal(p)
-    dist = np.abs((p - p.mean(axis=0)) @ (n / np.linalg.norm(n))).max()
-    diam = np.linalg.norm(xy.max(axis=0) - xy.min(axis=0))
-    return bool(dist <= tol.planar * diam)
 
 
 def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
@@ -885,14 +950,19 @@ def _split_straight_corners(face_list, face_origin, v, vert_orig, coplanar_deg, 
             ]
             if bad:
                 i = bad[0]
-                j = (i + k // 2) % k
+                # to the corner furthest from the straight line at i: both parts keep an area
+                p = v[f]
+                d = p[(i + 1) % k] - p[i - 1]
+                off = np.linalg.norm(np.cross(p - p[i], d / np.linalg.norm(d)), axis=1)
+                off[[i - 1, i, (i + 1) % k]] = -1.0
+                j = int(np.argmax(off))
                 lo, hi = min(i, j), max(i, j)
                 log.add(
                     "split-face",
                     f"face {o}",
-                    f"its corner at vertex {int(vert_orig[f[i]])} is within "
-                    f"{np.degrees(abs(turn[i])):.2g} deg of straight next to a rounded edge: "
-                    "split there",
+                    f"its corner at vertex {int(vert_orig[f[i]])} is "
+                    f"{np.degrees(abs(turn[i])):.2g} deg from straight (below "
+                    f"{np.degrees(tol.straight):.2g}) next to a rounded edge: split there",
                     error="",
                 )
                 pending[:0] = [(f[lo : hi + 1], o), (np.concatenate([f[hi:], f[: lo + 1]]), o)]

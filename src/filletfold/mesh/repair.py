@@ -455,6 +455,50 @@ def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=()):
     return out, v2, vorig2
 
 
+def detach_faces(faces, origin, v, vorig, he, log: RepairLog):
+    """Cut off, at each edge still shared by more than two faces, every face but the first
+    two: it gets its own copies of the edge's two vertices (a border there, and along its
+    other edges at those vertices). The last resort after :func:`split_non_manifold`, where
+    the sheets around an edge also meet elsewhere around its vertices.
+
+    Parameters
+    ----------
+    he : clean._HalfEdges
+        Of ``faces``.
+
+    Returns
+    -------
+    faces : list of (k,) int
+    v : (n_vertices', 3) float
+    vorig : (n_vertices',) int
+    """
+    faces = [f.copy() for f in faces]
+    extra_v, extra_o = [], []
+    n = len(v)
+    for e in np.flatnonzero(he.edge_count > 2).tolist():
+        a, b = (int(x) for x in he.edge_ends[e])
+        hs = np.flatnonzero(he.edge == e)
+        for h in hs[2:].tolist():
+            f = int(he.face[h])
+            for x in (a, b):
+                k = np.flatnonzero(faces[f] == x)
+                if len(k):
+                    faces[f][k] = n + len(extra_v)
+                    extra_v.append(v[x])
+                    extra_o.append(vorig[x])
+        log.add(
+            "cut-edge",
+            f"edge ({int(vorig[a])}, {int(vorig[b])})",
+            f"still shared by {len(hs)} faces once its vertices are split per fan: "
+            f"{len(hs) - 2} face(s) cut off there",
+            error="",
+        )
+    if extra_v:
+        v = np.vstack([v, np.asarray(extra_v)])
+        vorig = np.concatenate([vorig, np.asarray(extra_o, dtype=np.int64)])
+    return faces, v, vorig
+
+
 def _pair_around_edge(hs, a, b, frm, face, start, size, v):
     """Pair the half-edges ``hs`` of the faces around edge (a, b) by angular order.
 
@@ -554,3 +598,90 @@ def triangulate_faces(faces, origin, v, which, log: RepairLog, why, error):
             out.append(f[list(t)])
             out_origin.append(o)
     return out, np.asarray(out_origin, dtype=np.int64)
+
+
+# ------------------------------------------------------------------------- exact planes
+def planarize(faces, v, log: RepairLog, *, rounds: int = 60, rel: float = 1e-13):
+    """Move vertices onto the planes of their polygons, so every polygon of more than three
+    corners is planar to round-off (not only within ``tol.planar``).
+
+    A polygon planar only within a tolerance (a CAD export in float32, a merged region)
+    leaves its edges a little out of its plane, and the development's gluing maps are then
+    not rigid at the square of that angle: ruling lengths in 2D and 3D part by ~1e-11 where
+    1e-16 is due. Each round fits every polygon's plane (Newell normal through the centroid)
+    and moves every vertex by the least-squares step onto the planes of its polygons, until
+    every corner is within ``rel`` of its polygon's diameter from the plane.
+
+    Parameters
+    ----------
+    faces : list of (k,) int
+    v : (n_vertices, 3) float
+    log : RepairLog
+    rounds : int
+    rel : float
+
+    Returns
+    -------
+    v : (n_vertices, 3) float
+        The moved vertices (a copy; ``v`` itself when nothing moved).
+    residual : (n_faces,) float
+        Each polygon's largest corner distance from its plane over its diameter, afterwards
+        (0 for triangles).
+    """
+    poly = np.flatnonzero(np.fromiter(map(len, faces), dtype=np.int64, count=len(faces)) > 3)
+    residual = np.zeros(len(faces))
+    if not len(poly):
+        return v, residual
+    size = np.array([len(faces[i]) for i in poly.tolist()])
+    start = np.concatenate([[0], np.cumsum(size)])
+    idx = np.concatenate([faces[i] for i in poly.tolist()])
+    face = np.repeat(np.arange(len(poly)), size)
+    nxt = np.arange(len(idx)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    x = v.copy()
+    diam = np.maximum.reduceat(np.linalg.norm(x[idx] - x[idx[nxt]], axis=1), start[:-1])
+    cap = None  # how far each vertex may move: 4 x its polygons' largest initial deviation
+    for _ in range(rounds):
+        p = x[idx]
+        c = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
+        q = p - c[face]
+        n = np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        d = np.einsum("ij,ij->i", q, n[face])  # signed distance of each corner
+        dev = np.maximum.reduceat(np.abs(d), start[:-1]) / diam
+        if cap is None:
+            cap = np.zeros(len(x))
+            np.maximum.at(cap, idx, 4 * (dev * diam)[face])
+        if dev.max() <= rel:
+            break
+        nf = n[face]
+        a = np.zeros((len(x), 3, 3))
+        b = np.zeros((len(x), 3))
+        np.add.at(a, idx, nf[:, :, None] * nf[:, None, :])
+        np.add.at(b, idx, -d[:, None] * nf)
+        used = np.unique(idx)
+        step = np.linalg.solve(a[used] + 1e-9 * np.eye(3), b[used][..., None])[..., 0]
+        x[used] += step
+    far = np.linalg.norm(x - v, axis=1) > cap  # not a small correction: leave those be
+    if far.any():
+        x[far] = v[far]
+        p = x[idx]
+        c = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
+        q = p - c[face]
+        n = np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        dev = np.maximum.reduceat(np.abs(np.einsum("ij,ij->i", q, n[face])), start[:-1]) / diam
+    residual[poly] = dev
+    moved = np.linalg.norm(x - v, axis=1)
+    if moved.max() > 0:
+        box = np.ptp(v[np.unique(idx)], axis=0)
+        scale = float(np.linalg.norm(box)) or 1.0
+        log.add(
+            "planarize",
+            f"{int((moved > 0).sum())} vertices",
+            f"moved by at most {moved.max():.2g} ({moved.max() / scale:.2g} of the mesh size) "
+            "onto the planes of their polygons, which were planar only within the tolerance",
+            error="",
+        )
+        return x, residual
+    return v, residual
