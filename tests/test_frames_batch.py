@@ -62,8 +62,8 @@ def _side(mesh, rounding, u, e, n_prev, n_next):
     r = float(rounding.radius[e])
     if r <= 0:
         return Side(rounded=True, O=M, N0=n_prev, B=np.cross(R, n_prev), **common)
-    B = n_next - (n_next @ n_prev) * n_prev
-    B /= np.linalg.norm(B)
+    B = np.cross(R, n_prev)  # across the edge, turned toward the next face's normal
+    B *= np.sign(B @ n_next)
     return Side(
         rounded=True,
         radius=r,
@@ -95,6 +95,8 @@ def _tangent(side, s):
 
 def _gluing(side, frame, s):
     tan = _tangent(side, s)
+    if side.radius == 0:  # a flat or sharp side meets each face along its own line
+        tan = np.cross(side.R, np.cross(frame[1], frame[2]))
     lin = np.array([[tan @ frame[1], side.R @ frame[1]], [tan @ frame[2], side.R @ frame[2]]])
     q = _point(side, s) - frame[0]
     p = np.array([q @ frame[1], q @ frame[2]])

@@ -655,8 +655,11 @@ def vertex_frames(
     B = np.where(rounded[:, None], np.cross(R, n_prev), 0.0)
     c = np.nonzero(curved)[0]
     n_next = normals[f_next[c]]
-    b = n_next - _dot(n_next, n_prev[c])[:, None] * n_prev[c]
-    B[c] = b / _norm(b)[:, None]
+    # B: the unit vector across the edge in the plane of N0 and N(a), turned toward N(a). As
+    # R x N0 it is orthogonal to R and N0 to round-off; orthogonalising N(a) against N0
+    # instead loses digits on a nearly flat edge (1e-12 off R at a 0.1 degree bend, and the
+    # development's maps stop being rigid by as much)
+    B[c] *= np.sign(_dot(B[c], n_next))[:, None]
     O = M.copy()
     O[c] = rounding.axis_point[edge[c]]
     radius = np.where(curved, rounding.radius[edge], 0.0)
