@@ -96,6 +96,8 @@ OVERLAP_TOL = 1e-9
 MIN_EDGE = 1e-7
 #: Relative rounding of a float written with :data:`FOLD_DIGITS` significant digits.
 FILE_ROUNDING = 0.5 * 10.0 ** (1 - FOLD_DIGITS)
+#: Round-off of an in-memory coordinate, in units in the last place of the largest one.
+ROUNDOFF_ULPS = 16
 #: With every coordinate within ``q`` of its value, a 2D length is within ``2 sqrt(2) q`` and a
 #: 3D length within ``2 sqrt(3) q`` of its own, so the two differ by this many ``q`` more.
 LENGTH_QUANTA = 2.0 * (math.sqrt(2.0) + math.sqrt(3.0))
@@ -245,14 +247,16 @@ def _distinct(x: np.ndarray) -> int:
     return int(np.count_nonzero(np.bincount(x))) if len(x) else 0
 
 
-def _quantum_note(q: float, what: str) -> str:
-    return f"; limit {what}, q = {q:.2g} (coordinates rounded to {FOLD_DIGITS} digits)" if q else ""
+def _quantum_note(q: float, what: str, source: str) -> str:
+    return f"; limit {what}, q = {q:.2g} ({source})" if q else ""
 
 
 class _Data:
     """The pattern and mesh as arrays, checked for consistency, with what several checks use."""
 
-    def __init__(self, pattern, mesh_vertices, mesh_faces, edges, vertex_apex, coord_quantum):
+    def __init__(
+        self, pattern, mesh_vertices, mesh_faces, edges, vertex_apex, coord_quantum, quantum_source
+    ):
         if not isinstance(pattern, CreasePattern):
             raise ParameterError(
                 f"expected a CreasePattern, got {type(pattern).__name__}", name="pattern"
@@ -284,6 +288,7 @@ class _Data:
         if not (math.isfinite(q) and q >= 0):
             raise ParameterError(f"coord_quantum must be >= 0, got {coord_quantum}")
         self.q = q
+        self.q_source = quantum_source
         lo, hi = self.v3.min(axis=0), self.v3.max(axis=0)
         self.size = float(np.linalg.norm(hi - lo)) or 1.0
         self.patch = list(map(str, pattern.face_patch))
@@ -429,6 +434,7 @@ def certify(
     vertex_apex,
     *,
     coord_quantum: float = 0.0,
+    quantum_source: str = f"coordinates rounded to {FOLD_DIGITS} digits",
 ) -> Certificate:
     """Measure the invariants of a crease pattern against the mesh it rounds.
 
@@ -451,6 +457,8 @@ def certify(
         ``LENGTH_QUANTA * coord_quantum`` per edge, the fold-angle limit by what moving every
         corner of the edge's two faces by ``sqrt(3) coord_quantum`` can turn their normals:
         ``sqrt(3) q (P_a / A_a + P_b / A_b)`` radians (``P`` perimeter, ``A`` area, in 3D).
+    quantum_source : str
+        Where ``coord_quantum`` comes from, for the lines of the certificate.
 
     Returns
     -------
@@ -462,7 +470,9 @@ def certify(
         When the data are inconsistent: a face's patch names no element of the mesh, arrays of
         the wrong shape, coordinates that are not finite.
     """
-    data = _Data(pattern, mesh_vertices, mesh_faces, edges, vertex_apex, coord_quantum)
+    data = _Data(
+        pattern, mesh_vertices, mesh_faces, edges, vertex_apex, coord_quantum, quantum_source
+    )
     checks = [
         _ruling_isometry(data),
         _contraction(data),
@@ -512,7 +522,7 @@ def _ruling_isometry(g: _Data) -> Check:
         if g.q:
             rel = diff / np.where(length > 0, length, 1.0)
             detail += f", largest |d|/len {float(rel.max()):.2e}"
-    detail += _quantum_note(g.q, f"{RULING_TOL:g} + {LENGTH_QUANTA:.2f} q / len")
+    detail += _quantum_note(g.q, f"{RULING_TOL:g} + {LENGTH_QUANTA:.2f} q / len", g.q_source)
     if len(missing):
         f = int(missing[0])
         u = int(g.index[f])
@@ -543,7 +553,7 @@ def _contraction(g: _Data) -> Check:
     detail = f"{len(g.edges)} pattern edges; worst pattern edge {e} ({g.assign[e]})"
     if n_longer:
         detail += f"; {n_longer} longer folded than flat"
-    detail += _quantum_note(g.q, f"{CONTRACTION_TOL:g} + {LENGTH_QUANTA:.2f} q / len")
+    detail += _quantum_note(g.q, f"{CONTRACTION_TOL:g} + {LENGTH_QUANTA:.2f} q / len", g.q_source)
     return Check(name, ok, value, limit, detail, "<=", {"pattern_edge": e})
 
 
@@ -659,7 +669,7 @@ def _fold_angles(g: _Data) -> list[Check]:
     detail = (
         f"|written - folded form| (deg) of {len(crease)} creases; worst pattern edge {e} "
         f"(written {written[k]:.6g})"
-        + _quantum_note(g.q, f"{ANGLE_TOL_DEG:g} deg + sqrt(3) q (P_a/A_a + P_b/A_b)")
+        + _quantum_note(g.q, f"{ANGLE_TOL_DEG:g} deg + sqrt(3) q (P_a/A_a + P_b/A_b)", g.q_source)
     )
     match = Check(
         names[1],
@@ -932,17 +942,35 @@ def certify_design(design) -> Certificate:
         "half_angle": rd.half_angle,
         "kappa": rd.kappa,
     }
-    return certify(design.pattern, mesh.vertices, mesh.faces, edges, design.vertices.apex)
+    return certify(
+        design.pattern,
+        mesh.vertices,
+        mesh.faces,
+        edges,
+        design.vertices.apex,
+        coord_quantum=memory_quantum(design.pattern),
+        quantum_source=f"round-off: {ROUNDOFF_ULPS} ulp of the largest coordinate",
+    )
+
+
+def memory_quantum(pattern: CreasePattern) -> float:
+    """How far a coordinate computed in floating point may be from its exact value:
+    :data:`ROUNDOFF_ULPS` units in the last place of the largest ``|coordinate|`` in 2D or 3D
+    (the pieces' points come out of chained rigid maps and a layout translation)."""
+    return ROUNDOFF_ULPS * np.finfo(float).eps * _largest_coordinate(pattern)
+
+
+def _largest_coordinate(pattern: CreasePattern) -> float:
+    return max(
+        float(np.abs(pattern.vertices_2d).max(initial=0.0)),
+        float(np.abs(pattern.vertices_3d).max(initial=0.0)),
+    )
 
 
 def file_quantum(pattern: CreasePattern) -> float:
     """How far a coordinate of a pattern read from a FOLD file may be from the one computed:
     :data:`FILE_ROUNDING` (5e-12) times the largest ``|coordinate|`` in 2D or 3D."""
-    largest = max(
-        float(np.abs(pattern.vertices_2d).max(initial=0.0)),
-        float(np.abs(pattern.vertices_3d).max(initial=0.0)),
-    )
-    return FILE_ROUNDING * largest
+    return FILE_ROUNDING * _largest_coordinate(pattern)
 
 
 def check_folder(path) -> Certificate:

@@ -92,6 +92,7 @@ def report_records(design) -> dict:
             "max_relative_edge_mismatch": float(relative.max(initial=0.0)),
         },
         "repairs": [r.as_dict() for r in design.repairs],
+        "certificate": design.certificate.as_dict() if design.certificate is not None else None,
         "fitting": _fitting_report(design),
         "layout": {"kind": design.layout, "note": design.layout_note or None},
         "fabrication": _fabrication_report(design),
@@ -298,8 +299,26 @@ def design_summary(design, max_listed: int = 8) -> str:
         lines.append(f"  vertex {u}: {design.vertices.status[u]} - {reason}")
     if len(flagged) > max_listed:
         lines.append(f"  ... and {len(flagged) - max_listed} more (see report.json)")
+    cert = design.certificate
+    if cert is not None:
+        if cert.ok:
+            lines.append(
+                f"certificate: valid ({sum(c.limit is not None for c in cert.checks)} checks)"
+            )
+        else:
+            lines.append(
+                "certificate: NOT VALID: "
+                + "; ".join(
+                    f"{c.name} {_figure(c.value)} (limit {_figure(c.limit)})" for c in cert.failed
+                )
+            )
     lines.append(f"time: {design.timings.get('total', 0.0):.2f} s")
     return "\n".join(lines)
+
+
+def _figure(x) -> str:
+    """A certificate figure for the summary (a number with 3 digits, or as it is)."""
+    return f"{x:.3g}" if isinstance(x, float | int) and not isinstance(x, bool) else str(x)
 
 
 def _repair_lines(design, max_listed: int) -> list[str]:
