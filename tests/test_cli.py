@@ -79,7 +79,8 @@ def test_file_input_and_clamp(tmp_path):
     ("args", "match"),
     [
         (["round", "no-such-thing"], "no such file and no built-in example"),
-        (["round", "cube", "--radius", "3"], "exceeds its limit"),
+        (["round", "cube", "--radius", "3", "--strict-radius"], "exceeds its limit"),
+        (["round", "cube", "--radius", "3", "--strict"], "exceeds its limit"),
         (["round", "cube", "--depth", "abc"], "depth must be a number"),
         (["round", "cube", "--arc-step", "-1"], "arc step must be in [0, 180] degrees"),
     ],
@@ -88,7 +89,58 @@ def test_errors_are_one_line_with_exit_code_2(args, match, capsys, tmp_path):
     assert main([*args, "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "error:" in err and match in " ".join(err.split())
+    assert len(err.strip().splitlines()) == 1  # one line, never wrapped
     assert "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def duplicate_face_obj(path):
+    """A tetrahedron with its first face given twice."""
+    path.write_text(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\nf 1 3 2\n"
+    )
+    return path
+
+
+def test_defects_are_repaired_and_listed_or_refused_with_strict(tmp_path, capsys):
+    mesh = duplicate_face_obj(tmp_path / "dup.obj")
+    assert main(["round", str(mesh), "-o", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "repairs: 1 (1 drop-face" in out and "face 4: it uses the same vertices" in out
+    report = json.loads((tmp_path / "o" / "report.json").read_text())
+    assert report["repairs"] == [
+        {
+            "what": "drop-face",
+            "where": "face 4",
+            "why": "it uses the same vertices as face 0 (duplicate face)",
+        }
+    ]
+    assert report["certificate"]["ok"] is True
+    assert main(["round", str(mesh), "--strict", "-o", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert "degenerate face 4: it uses the same vertices as face 0" in err
+    assert not (tmp_path / "s").exists()
+
+
+def test_unforeseen_failure_is_one_line_and_debug_shows_the_traceback(
+    tmp_path, capsys, monkeypatch
+):
+    from filletfold import design
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("float division by zero\nsecond line")
+
+    monkeypatch.setattr(design, "face_piece_centres", broken)
+    assert main(["round", "cube", "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.strip().splitlines() == [
+        "error: rounding the edges failed: ZeroDivisionError: float division by zero (run "
+        "with --debug for the traceback)"
+    ]
+    assert main(["round", "cube", "--debug", "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback (most recent call last)" in err and "in broken" in err
+    assert err.strip().splitlines()[-1].startswith("error: rounding the edges failed")
     assert not (tmp_path / "o").exists()
 
 

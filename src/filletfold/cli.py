@@ -22,18 +22,21 @@ Commands
 
 from __future__ import annotations
 
+import logging
 import sys
+import traceback
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from . import __version__
 from .design import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES, round_mesh
-from .errors import FilletfoldError
+from .errors import FilletfoldError, InternalError, one_line
 from .tolerances import tol
 
 app = typer.Typer(
@@ -117,9 +120,19 @@ SheetOption = Annotated[
 
 
 def _error(message: str) -> typer.Exit:
-    """Print ``message`` as an error; return the exit (code 2) to raise."""
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False)
+    """Print ``message`` as an error on one line (never wrapped); return the exit (code 2)."""
+    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False, soft_wrap=True)
     return typer.Exit(2)
+
+
+def _failure(exc: BaseException, debug: bool) -> typer.Exit:
+    """The one-line error of a failure; with ``debug`` the traceback of its cause first."""
+    if debug:
+        cause = exc.__cause__ if isinstance(exc, InternalError) and exc.__cause__ else exc
+        traceback.print_exception(cause, file=sys.stderr)
+    if isinstance(exc, FilletfoldError):
+        return _error(str(exc))
+    return _error(f"internal error: {one_line(exc)} (run with --debug for the traceback)")
 
 
 def _default_out(mesh: str) -> Path:
@@ -175,12 +188,34 @@ def round_cmd(
         ),
     ] = DEFAULT_ARC_STEP,
     clamp: Annotated[
+        bool | None,
+        typer.Option(
+            "--clamp/--strict-radius",
+            help="Reduce each radius over its edge's limit to 90% of the limit (the default), "
+            "or refuse such a radius naming the edge. Fillets narrower than 0.1% of their edge "
+            "are left sharp.",
+            show_default=False,
+        ),
+    ] = None,
+    fit_vertices: Annotated[
+        bool | None,
+        typer.Option(
+            "--fit-vertices/--no-fit-vertices",
+            help="Halve the radii of an infeasible vertex's edges (up to 4 times) where that "
+            "makes its cone feasible (the default); off, its reason only says what works.",
+            show_default=False,
+        ),
+    ] = None,
+    strict: Annotated[
         bool,
         typer.Option(
-            "--clamp",
-            help="Reduce each radius over its edge's "
-            "limit to 90% of the limit instead of stopping.",
+            "--strict",
+            help="Refuse instead of repairing or fitting: a defect of the mesh, or a radius "
+            "over its edge's limit, stops with the error naming it.",
         ),
+    ] = False,
+    debug: Annotated[
+        bool, typer.Option("--debug", help="On an unforeseen failure, print its traceback.")
     ] = False,
     material_loss: Annotated[
         bool,
@@ -266,6 +301,8 @@ def round_cmd(
                 samples=samples,
                 arc_step=arc_step,
                 clamp=clamp,
+                fit_vertices=fit_vertices,
+                strict=strict,
                 material_loss=material_loss,
                 max_loss=max_loss,
                 layout=layout,
@@ -284,9 +321,14 @@ def round_cmd(
         written = export_design(
             design, target, formats=chosen, units=units, scale=scale, page=sheet or "A4"
         )
-    except FilletfoldError as exc:
-        raise _error(str(exc)) from None
+    except typer.Exit:
+        raise
+    except Exception as exc:  # every failure is one line; --debug adds the traceback
+        raise _failure(exc, debug) from None
     console.print(f"wrote {len(written)} files to {target}/", highlight=False)
+    if design.certificate is not None and not design.certificate.ok:
+        names = ", ".join(c.name for c in design.certificate.failed)
+        raise _error(f"the design fails its certificate ({names}): see report.json")
 
 
 def _check_export_options(units: str, scale, sheet: str, formats) -> None:
@@ -418,7 +460,16 @@ def app_cmd(
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line with ``argv`` (default ``sys.argv[1:]``); return the exit code."""
+    """Run the command line with ``argv`` (default ``sys.argv[1:]``); return the exit code.
+
+    Python warnings (a numerical library's RuntimeWarning) go to the ``py.warnings`` logger,
+    shown only with ``--debug``: what a user reads is the summary and one-line errors.
+    """
+    logging.captureWarnings(True)
+    if "--debug" in (sys.argv[1:] if argv is None else argv):
+        logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
+    else:  # a handler that drops them (else logging's last resort prints them)
+        logging.getLogger("py.warnings").addHandler(logging.NullHandler())
     try:
         app(args=argv, prog_name="filletfold", standalone_mode=True)
     except SystemExit as exc:
