@@ -425,3 +425,19 @@ def test_face_that_is_not_star_shaped_is_named():
 
     with pytest.raises(MeshError, match=r"face \d+ is not star-shaped"):
         filletfold.round_mesh(s_prism(), radius=0.05, strict=True)
+
+
+def test_a_mesh_far_from_the_origin_is_computed_about_its_centre():
+    """Moved by 1e6 (survey coordinates), a mesh gives the design of the original, moved:
+    without centring, every difference of two points would lose six digits."""
+    from filletfold.mesh import example_mesh
+
+    v, f = example_mesh("random-convex")
+    near = filletfold.round_mesh((v, f))
+    far = filletfold.round_mesh((v + 1e6, f))
+    assert far.certificate.ok
+    assert_allclose(far.mesh.vertices - 1e6, near.mesh.vertices, atol=1e-9)
+    assert_allclose(far.pattern.vertices_3d - 1e6, near.pattern.vertices_3d, atol=1e-8)
+    assert_allclose(far.pattern.vertices_2d, near.pattern.vertices_2d, atol=1e-8)
+    assert_allclose(far.vertices.apex - 1e6, near.vertices.apex, atol=1e-8)
+    assert_allclose(far.rounding.axis_point - 1e6, near.rounding.axis_point, atol=1e-8)

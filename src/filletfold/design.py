@@ -8,6 +8,7 @@ lay them out, and derive the crease pattern.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -578,6 +579,9 @@ def round_mesh(
     floor = 0.0 if strict else tol.fillet_floor
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
     pm, clean_log = load_mesh(mesh, coplanar_deg=coplanar_deg, strict=strict)
+    shift = far_offset(pm.vertices)
+    if shift is not None:  # far from the origin: compute about the centre, shift back at the end
+        pm = PolyMesh(pm.vertices - shift, pm.faces)
     timings["read"] = time.perf_counter() - t0
     params = Parameters(
         radius=radius,
@@ -765,11 +769,15 @@ def round_mesh(
         fab.update(sheet_stats)
     locate_apices(pattern, res)
     timings["surface"] = time.perf_counter() - t
+    mesh_out, rounding_out, res_out, pieces = pm, rounding, res, pieces
+    if shift is not None:  # back where the mesh was (the stages stay about the centre)
+        mesh_out, rounding_out, res_out, pieces = _shifted(pm, rounding, res, pieces, shift)
+        pattern.vertices_3d = pattern.vertices_3d + shift
     design = Design(
-        mesh=pm,
+        mesh=mesh_out,
         params=params,
-        rounding=rounding,
-        vertices=res,
+        rounding=rounding_out,
+        vertices=res_out,
         pattern=pattern,
         pieces=pieces,
         timings=timings,
@@ -780,7 +788,7 @@ def round_mesh(
         fabrication=fab,
         stages=stages,
         repairs=list(clean_log.repairs),
-        fitting=_fitting(rounding, requested, fitted_radius, rescue),
+        fitting=_fitting(rounding_out, requested, fitted_radius, rescue),
     )
     if certify:
         from .check import certify_design
@@ -791,6 +799,40 @@ def round_mesh(
         timings["certificate"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     return design
+
+
+def far_offset(vertices: np.ndarray) -> np.ndarray | None:
+    """The centre of the bounding box of ``vertices`` (n, 3) when it lies further from the
+    origin than the box's diagonal, else None.
+
+    A mesh far from the origin (a model in survey coordinates, a fuzzed copy moved by 1e6)
+    loses digits in every difference of two points; its design is computed about this centre
+    and moved back (the outputs are where the mesh is).
+    """
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    centre = 0.5 * (lo + hi)
+    if np.linalg.norm(centre) <= np.linalg.norm(hi - lo):
+        return None
+    return centre
+
+
+def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, shift):
+    """The mesh, rounding, vertex results and pieces of a design computed about a centre,
+    moved by ``shift`` (copies: the stages keep the centred ones)."""
+    mesh = PolyMesh(pm.vertices + shift, pm.faces)
+    rounding = dataclasses.replace(
+        rounding,
+        axis_point=rounding.axis_point + shift,
+        tangent_point=rounding.tangent_point + shift,
+    )
+    res = copy.deepcopy(res)
+    res.apex = res.apex + shift
+    moved = []
+    for piece in pieces:
+        piece = copy.copy(piece)
+        piece.points_3d = np.asarray(piece.points_3d, dtype=float) + shift
+        moved.append(piece)
+    return mesh, rounding, res, moved
 
 
 def _solve_apices(frames, depths, res: VertexResult, centres, progress, pending) -> dict:
