@@ -111,7 +111,7 @@ def rescue_vertices(
     factor = {u: 1.0 for u in bad}
     trial = VertexResult.empty(mesh.n_vertices) if not apply else None
     edge_face = mesh.edge_faces
-    for _ in range(ROUNDS):
+    for round_ in range(ROUNDS):
         if not bad:
             break
         edges = np.unique(np.concatenate([frames[u].ring.edges for u in bad]))
@@ -144,6 +144,7 @@ def rescue_vertices(
             target,
             new_centres,
             vertices=todo,
+            thorough=round_ == ROUNDS - 1,  # the hard cases' fallbacks only at the last factor
         )
         if apply:
             out.resolved.update(affected.tolist())

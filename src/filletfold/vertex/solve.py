@@ -440,6 +440,7 @@ def solve_apices(
     centres: np.ndarray | None = None,
     progress=None,
     vertices=None,
+    thorough: bool = True,
 ) -> dict:
     """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
 
@@ -467,6 +468,10 @@ def solve_apices(
         ``progress("apices", done, total)`` after every slice of a round.
     vertices : iterable of int, optional
         The vertices to solve (default: every vertex whose status is still empty).
+    thorough : bool
+        False skips what only decides a hard case (more feasibility starts and the SLSQP
+        fallback of the last attempts): faster, and a vertex may be called infeasible that
+        the thorough solve would solve (the vertex rescue's trial rounds use it).
 
     Returns
     -------
@@ -489,7 +494,9 @@ def solve_apices(
         order = list(pending)
         slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
         # the slices are independent (each settles its own vertices): in threads
-        for _ in thread_map(lambda part: _solve_round(part, pending, res, out, centres), slices):
+        for _ in thread_map(
+            lambda part: _solve_round(part, pending, res, out, centres, thorough), slices
+        ):
             if progress is not None:
                 progress("apices", total - len(pending), total)
     return out
@@ -526,7 +533,9 @@ def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
         p.attempts.insert(0, attempt)
 
 
-def _solve_round(order: list, pending: dict, res: VertexResult, out: dict, centres) -> None:
+def _solve_round(
+    order: list, pending: dict, res: VertexResult, out: dict, centres, thorough: bool = True
+) -> None:
     """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
     solved ones at once, and settle every vertex that is done (ok, or out of attempts)."""
     tries = [pending[u].attempts.pop(0) for u in order]
@@ -536,7 +545,7 @@ def _solve_round(order: list, pending: dict, res: VertexResult, out: dict, centr
         cons,
         [pending[u].target for u in order],
         [pending[u].starts for u in order],
-        thorough=[t[1] < 1.0 for t in tries],  # only the thin attempts end a vertex
+        thorough=[thorough and t[1] < 1.0 for t in tries],  # only thin attempts end a vertex
     )
     # the dense validation of every solved vertex at once
     solved = [
