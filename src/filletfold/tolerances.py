@@ -22,9 +22,13 @@ class Tolerances:
     degenerate : float
         A face whose height over its longest edge is below ``degenerate`` times that edge has
         (almost) zero area: it is removed on input.
+    collinear : float
+        A polygon corner within this angle (radians) of straight is straight on input: the
+        coordinates' own noise (float32 in an STL is 6e-8 of the size) bends a straight
+        line by about this much.
     straight : float
         A polygon corner within this angle (radians) of straight is split on input (no
-        tangent-line crossing could be placed there), unless straight within ``angle`` and
+        tangent-line crossing could be placed there), unless straight within ``collinear`` and
         removable.
     planar : float
         A polygon face is planar when every vertex is within ``planar * face_size`` of its plane.
@@ -54,6 +58,7 @@ class Tolerances:
     merge: float = 1e-9
     weld: float = 1e-6
     degenerate: float = 1e-9
+    collinear: float = 1e-6
     straight: float = 0.0175  # 1 degree
     planar: float = 1e-6
     area: float = 1e-12

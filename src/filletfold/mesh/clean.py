@@ -134,7 +134,7 @@ def clean_mesh(
     ``tol.straight`` of straight (exactly straight corners excepted: they are removed where
     the vertex has no other edge). A straight corner is removed when it has exactly two edges
     (two faces inside the surface, or one face on the boundary) and its angle is pi within
-    ``tol.angle`` in each of its faces.
+    ``tol.collinear`` in each of its faces.
     """
     v, face_list = _validate(vertices, faces)
     n_input = len(v)
@@ -198,13 +198,14 @@ def clean_mesh(
     merged_faces = 0
     if merge_coplanar and coplanar_deg > 0 and len(face_list) > 1:
         n_before = len(face_list)
-        for _ in range(8):  # interior vertices of flat regions are removed, then merged again
-            face_list, face_origin = _merge_coplanar(face_list, face_origin, v, coplanar_deg)
+        face_list, face_origin = _merge_coplanar(face_list, face_origin, v, coplanar_deg)
+        for _ in range(64):  # interior vertices of flat regions are removed, then merged again
             face_list, face_origin, removed = _remove_flat_vertices(
                 face_list, face_origin, v, coplanar_deg
             )
             if not removed:
                 break
+            face_list, face_origin = _merge_coplanar(face_list, face_origin, v, coplanar_deg)
         merged_faces = n_before - len(face_list)
     face_list = _remove_straight_corners(face_list, v)
     if not strict:
@@ -635,7 +636,7 @@ def _split_non_convex(face_list, face_origin, v, log: RepairLog):
     """Triangulate every polygon with a reflex corner (a reflex corner would leave its vertex
     without a cone); the coplanar merge regroups the triangles into convex parts."""
     fl = _Flat.of(face_list)
-    reflex = _corner_angles(fl, v) > np.pi + tol.angle
+    reflex = _corner_angles(fl, v) > np.pi + tol.collinear
     bad = np.flatnonzero(np.bincount(fl.face[reflex], minlength=len(fl.size)) > 0)
     return triangulate_faces(
         face_list,
@@ -660,7 +661,7 @@ def _merge_coplanar(face_list, face_origin, v, coplanar_deg):
     face order, breadth first; a merged region's pairs are tried again), when the merged
     polygon stays one simple loop (the two share one chain of edges), convex, within
     ``tol.planar`` of its diameter from the first face's plane, and without a corner within
-    ``tol.straight`` of straight that is not straight within ``tol.angle``. Only the two
+    ``tol.straight`` of straight that is not straight within ``tol.collinear``. Only the two
     corners at the ends of the shared chain change, so only they are checked.
 
     Returns
@@ -835,7 +836,7 @@ def _convex_ends(merged: list, loop_a: list, loop_b: list, pts: list, axes) -> b
     """Whether the corners of ``merged`` where ``loop_a`` and ``loop_b`` meet (the two ends
     of their shared chain: the only vertices of both) are convex seen along ``e1 x e2`` of
     ``axes``, and not within ``tol.straight`` of straight unless straight within
-    ``tol.angle``."""
+    ``tol.collinear``."""
     k = len(merged)
     both = set(loop_a).intersection(loop_b)
     (e10, e11, e12), (e20, e21, e22) = axes.tolist()
@@ -848,7 +849,7 @@ def _convex_ends(merged: list, loop_a: list, loop_b: list, pts: list, axes) -> b
         ux, uy = u[0] * e10 + u[1] * e11 + u[2] * e12, u[0] * e20 + u[1] * e21 + u[2] * e22
         wx, wy = w[0] * e10 + w[1] * e11 + w[2] * e12, w[0] * e20 + w[1] * e21 + w[2] * e22
         turn = math.atan2(ux * wy - uy * wx, ux * wx + uy * wy)
-        if turn < -tol.angle or tol.angle < turn < tol.straight:
+        if turn < -tol.collinear or tol.collinear < turn < tol.straight:
             return False
     return True
 
@@ -880,7 +881,7 @@ def _splice(loop: list, face: list) -> list | None:
 
 def _remove_straight_corners(face_list, v) -> list[np.ndarray]:
     fl = _Flat.of(face_list)
-    is_straight = np.abs(_corner_angles(fl, v) - np.pi) <= tol.angle
+    is_straight = np.abs(_corner_angles(fl, v) - np.pi) <= tol.collinear
     if not is_straight.any():  # nothing to remove (the usual case)
         return [np.asarray(f, dtype=np.int64) for f in face_list]
     faces = [f.tolist() for f in face_list]
