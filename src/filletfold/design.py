@@ -637,7 +637,9 @@ def round_mesh(
         res.take(st.vertices, sorted(kept))
         pending = [u for u in pending if u not in kept]
     _stage("apices")
-    apices = _solve_apices(frames, depths, res, centres, progress, pending)
+    # with the rescue to come, the hard cases' fallbacks wait for its last, smallest radii
+    thorough = material_loss or not fit_vertices
+    apices = _solve_apices(frames, depths, res, centres, progress, pending, thorough)
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
         frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
@@ -835,12 +837,16 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
     return mesh, rounding, res, moved
 
 
-def _solve_apices(frames, depths, res: VertexResult, centres, progress, pending) -> dict:
+def _solve_apices(
+    frames, depths, res: VertexResult, centres, progress, pending, thorough=True
+) -> dict:
     """:func:`solve_apices` of the vertices ``pending``; when it fails unforeseen, the
     vertices are solved one by one and a vertex whose solve fails is infeasible, with the
     failure as its reason (a failure is data, not the end of the design)."""
     try:
-        return solve_apices(frames, depths, res, centres, progress, vertices=pending)
+        return solve_apices(
+            frames, depths, res, centres, progress, vertices=pending, thorough=thorough
+        )
     except FilletfoldError:
         raise
     except Exception as exc:
@@ -850,7 +856,9 @@ def _solve_apices(frames, depths, res: VertexResult, centres, progress, pending)
         for u in pending:
             res.status[u] = ""
             try:
-                out.update(solve_apices(frames, depths, res, centres, vertices=[u]))
+                out.update(
+                    solve_apices(frames, depths, res, centres, vertices=[u], thorough=thorough)
+                )
             except FilletfoldError:
                 raise
             except Exception as exc:
