@@ -11,6 +11,7 @@ import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
+from scipy.spatial import ConvexHull
 
 import filletfold
 from filletfold.errors import MeshReadError, ParameterError
@@ -441,3 +442,35 @@ def test_a_mesh_far_from_the_origin_is_computed_about_its_centre():
     assert_allclose(far.pattern.vertices_2d, near.pattern.vertices_2d, atol=1e-8)
     assert_allclose(far.vertices.apex - 1e6, near.vertices.apex, atol=1e-8)
     assert_allclose(far.rounding.axis_point - 1e6, near.rounding.axis_point, atol=1e-8)
+
+
+def test_infeasible_vertices_are_rescued_with_smaller_radii():
+    """On a cube with radius 0.45 every vertex is infeasible; halving its edges' radii once
+    makes each cone feasible: applied by default, only named in the reason without."""
+    d = filletfold.round_mesh("cube", radius=0.45)
+    assert d.status_counts()["ok"] == 8
+    assert d.fitting["rescued"] == dict.fromkeys(range(8), 0.5)
+    assert_allclose(d.rounding.radius[d.rounding.radius > 0], 0.225)
+    assert d.certificate.ok
+    assert "vertices rescued: 8 with the radii of their edges scaled by 0.5" in d.summary()
+    hint = filletfold.round_mesh("cube", radius=0.45, fit_vertices=False)
+    assert hint.status_counts()["infeasible"] == 8
+    assert_allclose(hint.rounding.radius[hint.rounding.radius > 0], 0.45)
+    assert all(
+        "feasible with the radii of its edges multiplied by 0.5" in r for r in hint.vertices.reason
+    )
+    assert "would be feasible" in hint.summary()
+
+
+@settings(max_examples=8, deadline=None)
+@given(seed=st.integers(0, 10_000))
+def test_a_convex_solid_has_no_infeasible_vertex(seed):
+    """Every vertex of a random convex hull gets a cone, with smaller radii where needed, or is
+    left sharp (its edges' fillets would be slivers, or no radius helped): no hole."""
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(60, 3))
+    p *= rng.uniform(0.8, 1.2, size=(60, 1)) / np.linalg.norm(p, axis=1)[:, None]
+    d = filletfold.round_mesh((p, ConvexHull(p).simplices), radius="5%")
+    counts = d.status_counts()
+    assert counts["infeasible"] == counts["saddle"] == 0
+    assert counts["ok"] + counts["sharp"] == d.mesh.n_vertices

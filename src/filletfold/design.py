@@ -256,7 +256,8 @@ class Design:
         limit; ``sharp`` (k,) int, the edges left sharp (their fillet would be narrower than
         ``tol.fillet_floor`` of the edge); ``rescued`` (dict vertex -> factor), the vertices
         whose edges' radii were scaled by ``factor`` to make their cone feasible (applied when
-        ``rescue_applied``, else only reported in their reason).
+        ``rescue_applied``, else only reported in their reason); ``sharpened``, the vertices
+        no radius rescued whose edges were left sharp instead (sharp vertices).
     """
 
     mesh: PolyMesh
@@ -909,4 +910,5 @@ def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue) -> dict:
         "sharp": np.flatnonzero(sharp),
         "rescued": dict(sorted(rescue.rescued.items())),
         "rescue_applied": rescue.applied,
+        "sharpened": sorted(rescue.sharpened),
     }

@@ -120,6 +120,7 @@ def _fitting_report(design) -> dict:
         "vertices_rescued": len(fit["rescued"]),
         "rescue_applied": bool(fit["rescue_applied"]),
         "rescued": [{"vertex": int(u), "factor": float(f)} for u, f in fit["rescued"].items()],
+        "sharpened": [int(u) for u in fit.get("sharpened", [])],
     }
 
 
@@ -368,6 +369,11 @@ def _fitting_lines(design) -> list[str]:
             f"vertices {verb}: {len(rescued)} with the radii of their edges scaled by "
             f"{f.min():g} to {f.max():g}"
             + ("" if fit["rescue_applied"] else " (--fit-vertices does so)")
+        )
+    if fit.get("sharpened"):
+        out.append(
+            f"vertices left sharp: {len(fit['sharpened'])} (no radius on their edges made their "
+            "cone feasible: their edges are sharp, their faces meet at the vertex)"
         )
     return out
 

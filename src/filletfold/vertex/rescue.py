@@ -8,7 +8,9 @@ round after round:
 
 * ``apply=True`` (``--fit-vertices``): the halved radii are kept; every vertex of a face that
   has a changed edge is classified and solved again (its frame, or the face piece centres its
-  creases must stay short of, changed), so the design stays consistent;
+  creases must stay short of, changed), so the design stays consistent; a vertex that no
+  halving rescues has its edges left sharp at last: a sharp vertex, its faces meeting at it,
+  rather than a hole;
 * ``apply=False``: only the infeasible vertices are solved again, on a copy; a vertex that
   becomes feasible gets the radius that works in its reason, and the design is unchanged.
 """
@@ -40,12 +42,16 @@ class Rescue:
         Edges whose radius changed (applied only).
     resolved : set of int
         Vertices classified and solved again on the changed radii (applied only).
+    sharpened : list of int
+        Vertices no halving rescued whose edges were then left sharp (applied only): they
+        are ``"sharp"`` vertices, their faces meeting at the vertex (no hole).
     """
 
     rescued: dict = field(default_factory=dict)
     applied: bool = False
     edges: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     resolved: set = field(default_factory=set)
+    sharpened: list = field(default_factory=list)
 
 
 def rescue_vertices(
@@ -111,17 +117,18 @@ def rescue_vertices(
     factor = {u: 1.0 for u in bad}
     trial = VertexResult.empty(mesh.n_vertices) if not apply else None
     edge_face = mesh.edge_faces
-    for round_ in range(ROUNDS):
+    steps = [0.5] * ROUNDS + ([0.0] if apply else [])  # halve; at last leave them sharp
+    for round_, step in enumerate(steps):
         if not bad:
             break
         edges = np.unique(np.concatenate([frames[u].ring.edges for u in bad]))
         edges = edges[radius[edges] > 0]
         if not len(edges):
             break
-        radius[edges] *= 0.5
+        radius[edges] *= step
         radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
         for u in bad:
-            factor[u] *= 0.5
+            factor[u] *= step
         new_rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor)
         new_centres = face_centres(mesh, new_rounding)
         if apply:
@@ -144,7 +151,7 @@ def rescue_vertices(
             target,
             new_centres,
             vertices=todo,
-            thorough=round_ == ROUNDS - 1,  # the hard cases' fallbacks only at the last factor
+            thorough=round_ >= ROUNDS - 1,  # the hard cases' fallbacks at the last factor
         )
         if apply:
             out.resolved.update(affected.tolist())
@@ -155,6 +162,14 @@ def rescue_vertices(
         for u in list(bad):
             if target.status[u] == "ok":
                 out.rescued[u] = factor[u]
+                bad.remove(u)
+            elif target.status[u] == "sharp":  # its edges all left sharp: its faces meet at it
+                out.sharpened.append(u)
+                target.reason[u] = (
+                    "no radius on its edges (down to "
+                    f"{0.5**ROUNDS:g} of them) made its cone feasible: its edges are left sharp "
+                    "and its faces meet at the vertex itself"
+                )
                 bad.remove(u)
         if apply:  # neighbours made infeasible by the change join the next round
             for u in _infeasible(res):
