@@ -214,7 +214,13 @@ class AppSession:
             :func:`~filletfold.design.round_mesh` (called during its long stages, in the
             computing thread). An exception it raises stops the computation and propagates.
         """
-        design = round_mesh(request.mesh, **request.params, progress=progress, reuse=request.reuse)
+        design = round_mesh(
+            request.mesh,
+            **request.params,
+            progress=progress,
+            reuse=request.reuse,
+            certify=False,  # a slider drag needs the picture; the download certifies
+        )
         design.source = request.name
         return design
 
