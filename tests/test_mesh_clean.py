@@ -360,8 +360,8 @@ def test_two_cubes_touching_at_a_corner_rejected():
     assert info.value.vertex == corner
 
 
-def test_moebius_strip_rejected():
-    n = 8
+def moebius_strip(n: int = 8):
+    """A triangulated Moebius band: vertices (2n, 3) and 2n triangles."""
     t = 2 * np.pi * np.arange(n) / n
     verts, quads = [], []
     for i, ti in enumerate(t):
@@ -373,8 +373,12 @@ def test_moebius_strip_rejected():
         c, d = (2 * j, 2 * j + 1) if j else (2 * j + 1, 2 * j)  # the half twist
         quads.append([a, c, d, b])
     tris = [t for q in quads for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]])]
+    return np.array(verts), tris
+
+
+def test_moebius_strip_rejected():
     with pytest.raises(MeshError, match=r"non-orientable surface: the component containing face"):
-        clean_mesh(np.array(verts), tris, strict=True)
+        clean_mesh(*moebius_strip(), strict=True)
 
 
 def test_non_planar_face_rejected():
@@ -533,21 +537,10 @@ def test_fin_on_an_edge_is_cut_off_as_a_border():
 
 
 def test_moebius_strip_is_cut_open_and_oriented():
-    n = 8
-    t = 2 * np.pi * np.arange(n) / n
-    verts, quads = [], []
-    for i, ti in enumerate(t):
-        for s in (-0.3, 0.3):
-            r = 1 + s * np.cos(ti / 2)
-            verts.append([r * np.cos(ti), r * np.sin(ti), s * np.sin(ti / 2)])
-        j = (i + 1) % n
-        a, b = 2 * i, 2 * i + 1
-        c, d = (2 * j, 2 * j + 1) if j else (2 * j + 1, 2 * j)
-        quads.append([a, c, d, b])
-    tris = [t for q in quads for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]])]
-    mesh, log = clean_mesh(np.array(verts), tris)
+    verts, tris = moebius_strip()
+    mesh, log = clean_mesh(verts, tris)
     assert "cut-edge" in whats(log)
-    area = sum(PolyMesh(np.array(verts), [t]).face_area[0] for t in tris)
+    area = sum(PolyMesh(verts, [t]).face_area[0] for t in tris)
     assert_allclose(mesh.face_area.sum(), area, rtol=1e-12)
     assert "cannot be oriented" in next(r.why for r in log.repairs if r.what == "cut-edge")
 
