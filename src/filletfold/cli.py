@@ -315,7 +315,7 @@ def round_cmd(
                 keep_stages=False,  # nothing is reused: let frames and modules go early
             )
         if not quiet:
-            console.print(design.summary(), highlight=False)
+            console.print(design.summary(), highlight=False, soft_wrap=True)
         if dry_run:
             return
         written = export_design(

@@ -318,8 +318,8 @@ def design_summary(design, max_listed: int = 8) -> str:
 
 
 def _figure(x) -> str:
-    """A certificate figure for the summary (a number with 3 digits, or as it is)."""
-    return f"{x:.3g}" if isinstance(x, float | int) and not isinstance(x, bool) else str(x)
+    """A certificate figure for the summary (a number with 5 digits, or as it is)."""
+    return f"{x:.5g}" if isinstance(x, float | int) and not isinstance(x, bool) else str(x)
 
 
 def _repair_lines(design, max_listed: int) -> list[str]:
