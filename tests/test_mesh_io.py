@@ -340,3 +340,17 @@ def test_bunny_lowres_loads_and_cleans():
     assert log.flipped_faces == 0 and log.merged_faces == 0
     s = mesh.vertex_angle_sum
     assert (s > 2 * np.pi).any() and (s < 2 * np.pi).any()
+
+
+def test_errors_of_a_file_name_the_file(tmp_path):
+    """A defect found after reading (here a face index out of range, which trimesh passes
+    through from a PLY) is named with the file, like the reader's own errors."""
+    bad = tmp_path / "bad.ply"
+    bad.write_text(
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"
+    )
+    with pytest.raises(MeshError, match=rf"^{re.escape(str(bad))}: ") as info:
+        load_mesh(str(bad))
+    assert "vertex 7" in str(info.value) or "face 0" in str(info.value)

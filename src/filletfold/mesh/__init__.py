@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import MeshReadError
+from ..errors import MeshError, MeshReadError
 from ..tolerances import tol
 from .clean import CleanLog, clean_mesh
 from .examples import EXAMPLES, Example, example_mesh, example_names, find_example
@@ -71,11 +71,13 @@ def load_mesh(
     MeshError
         The mesh is invalid (see :func:`clean_mesh`).
     """
+    path = None  # the file, when the mesh is one: its errors name it
     if isinstance(source, PolyMesh):
         vertices, faces = source.vertices, source.faces
     elif isinstance(source, str):
         if Path(source).exists():
             vertices, faces = read_mesh(source)
+            path = source
         elif find_example(source) is not None:
             vertices, faces = example_mesh(source)
         else:
@@ -85,6 +87,7 @@ def load_mesh(
             )
     elif isinstance(source, os.PathLike):
         vertices, faces = read_mesh(source)
+        path = os.fspath(source)
     elif isinstance(source, tuple | list) and len(source) == 2:
         vertices, faces = source
         if isinstance(faces, np.ndarray) and faces.ndim == 2:
@@ -94,6 +97,13 @@ def load_mesh(
             f"cannot load a mesh from a {type(source).__name__}: expected a file path, a "
             f"built-in example name, a (vertices, faces) pair or a PolyMesh"
         )
-    return clean_mesh(
-        vertices, faces, coplanar_deg=coplanar_deg, merge_coplanar=merge_coplanar, strict=strict
-    )
+    try:
+        return clean_mesh(
+            vertices, faces, coplanar_deg=coplanar_deg, merge_coplanar=merge_coplanar, strict=strict
+        )
+    except MeshError as exc:
+        if path is None or str(exc).startswith(f"{path}:"):
+            raise
+        named = type(exc)(f"{path}: {exc}")
+        named.vertex, named.edge, named.face = exc.vertex, exc.edge, exc.face
+        raise named from None
