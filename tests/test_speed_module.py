@@ -116,15 +116,15 @@ def test_overlap_check_fires_on_crafted_failures():
 
 @pytest.mark.parametrize("turn", [1.0, 1.9 * np.pi, 2.0 * np.pi, 2.1 * np.pi, 3.5 * np.pi])
 def test_overlap_pairs_only_spare_the_union(turn):
-    """Pairs tried first give the measured answer: a clearly overlapping pair answers at once,
-    pairs that barely or never overlap leave the answer to the union."""
+    """Pairs tried first give the measured answer: an overlapping pair answers at once, pairs
+    that never overlap leave the answer to the union."""
     pts, faces = annulus_strip(turn)
     want = reference_overlap(pts, faces)
     n = len(faces)
     ends = [[0, n - 1], [1, n - 1], [0, n - 2]]
     for pairs in (None, ends, [[0, 1]], np.zeros((0, 2), dtype=int)):
         assert measured_overlap(pts, faces, pairs=pairs) is want
-    # a pair overlapping by less than SURE_OVERLAP of the total leaves the answer to the union
+    # a pair sharing more than rel (1e-9) of the smaller face overlaps; less is round-off
     square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
     pts = np.vstack([square, square + np.array([1 - 1e-8, 0])])
     assert measured_overlap(pts, [[0, 1, 2, 3], [4, 5, 6, 7]], pairs=[[0, 1]])

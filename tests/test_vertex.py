@@ -201,7 +201,11 @@ def test_developable_vertex_is_detected_and_reported():
 
 
 def test_crease_through_T_gives_a_clean_module():
-    """At l = l_max the straight crease on a face has zero length (METHOD-NOTES 11)."""
+    """At l = l_max the straight crease on a face has zero length (METHOD-NOTES 11): the
+    apex on the icosahedron vertex's axis at the depth where the creases run through every T
+    (to round-off: the two ends of each straight crease are then merged)."""
+    from scipy.optimize import brentq
+
     from filletfold.module import build_module, face_piece_centres, face_polygons
     from filletfold.vertex.apex import crease_length
 
@@ -210,12 +214,16 @@ def test_crease_through_T_gives_a_clean_module():
     fr = vertex_frame(m, rd, 0)
     v = fr.developed_apex()
     D = -fr.U / np.linalg.norm(fr.U)
-    sol = solve_apex(
-        build_constraints(fr, v, -1, 9, 0.0), fr.U + 0.02 * D, [fr.U + t * D for t in (0.2, 0.5)]
-    )
-    l_end, _ = crease_length(fr, 0, sol.apex, v, np.array([fr.sides[0].arc]))
-    assert_allclose(l_end[0], fr.lmax_end[0], rtol=1e-9)
-    pieces = build_module(m, fr, face_piece_centres(m, rd), 24, sol.apex, v)
+
+    def beyond_t(depth):
+        l_end, _ = crease_length(fr, 0, fr.U + depth * D, v, np.array([fr.sides[0].arc]))
+        return l_end[0] - fr.lmax_end[0]
+
+    apex = fr.U + brentq(beyond_t, 0.0, 0.3, xtol=1e-17) * D
+    for i in range(fr.n_sides):
+        ends, _ = crease_length(fr, i, apex, v, np.array([0.0, fr.sides[i].arc]))
+        assert_allclose(ends, [fr.lmax_start[i], fr.lmax_end[i]], rtol=1e-13)
+    pieces = build_module(m, fr, face_piece_centres(m, rd), 24, apex, v)
     assert len(pieces) == 1
     p2, _ = pieces[0].arrays()
     polys = face_polygons(p2, pieces[0].faces)

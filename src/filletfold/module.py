@@ -171,15 +171,16 @@ class Piece:
         """
         self._merge_coincident(eps)
 
-    def _merge_coincident(self, eps: float) -> np.ndarray:
-        """:meth:`merge_coincident`; returns ``points_2d`` (k, 2) as an array afterwards."""
+    def _merge_coincident(self, eps: float) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`merge_coincident`; returns ``points_2d`` (k, 2) as an array afterwards, and
+        which faces were kept ((n_faces,) bool, None when nothing changed)."""
         p2, p3 = self.arrays()
         x = np.sort(p2[:, 0])
         if not (np.diff(x) <= eps).any() and np.isfinite(x).all():
-            return p2  # no two points within eps even in x alone
+            return p2, None  # no two points within eps even in x alone
         pairs = cKDTree(p2).query_pairs(eps, output_type="ndarray")
         if len(pairs) == 0:
-            return p2
+            return p2, None
         pairs = pairs[np.linalg.norm(p3[pairs[:, 0]] - p3[pairs[:, 1]], axis=1) < eps]
         # each point goes to the lowest point of its group of coincident points
         n = len(p2)
@@ -199,7 +200,7 @@ class Piece:
         if self.apex_index is not None:
             r = new[root[self.apex_index]]
             self.apex_index = int(r) if r >= 0 else None
-        return self.arrays()[0]
+        return self.arrays()[0], kept
 
     def arrays(self):
         """(points_2d (k, 2), points_3d (k, 3))."""
@@ -224,19 +225,15 @@ def faces_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9) -> bool:
     return measured_overlap(points_2d, faces, rel)
 
 
-#: Share of the faces' total area by which two faces must overlap for
-#: :func:`measured_overlap` to answer from them without the union: a million times its ``rel``,
-#: far beyond any rounding of the union's area.
-SURE_OVERLAP = 1e-6
-
-
 def measured_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9, pairs=None) -> bool:
-    """:func:`faces_overlap` without the proof: a face is not a valid polygon, or the union of
-    the faces is smaller than the sum of their areas by more than ``rel`` of it.
+    """:func:`faces_overlap` without the proof: a face is not a valid polygon, two faces of
+    ``pairs`` share more than ``rel`` of the smaller one, or the union of the faces is smaller
+    than the sum of their areas by more than ``rel`` of it.
 
-    The union is not computed when two faces of ``pairs`` overlap by more than
-    :data:`SURE_OVERLAP` of the total area: the union is then smaller than the total by at least
-    that much (``|A u B u ...| <= |A| + |B| - |A n B| + ...``), far beyond ``rel``.
+    The pairs are measured first (the union is not computed when one of them overlaps). Their
+    test is the finer one: a sliver that two faces share, such as where the two sides of a
+    development's cut cross by a hair, is a tiny share of the whole piece but not of the
+    smaller face.
 
     Parameters
     ----------
@@ -245,7 +242,7 @@ def measured_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9, pairs=None
         Index lists into ``points_2d``.
     rel : float
     pairs : (m, 2) int, optional
-        Pairs of distinct faces likely to overlap, tried first.
+        Pairs of distinct faces likely to overlap.
 
     Returns
     -------
@@ -254,26 +251,47 @@ def measured_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9, pairs=None
     polys = face_polygons(points_2d, faces)
     if not shapely.is_valid(polys).all():
         return True
-    total = shapely.area(polys).sum()
-    if pairs is not None and _clear_overlap(polys, np.asarray(pairs), SURE_OVERLAP * total):
+    area = shapely.area(polys)
+    if pairs is not None and _pairs_overlap(polys, area, np.asarray(pairs).reshape(-1, 2), rel):
         return True
     union = shapely.union_all(polys).area
+    total = area.sum()
     return bool(union < total * (1 - rel))
 
 
-def _clear_overlap(polys: np.ndarray, pairs: np.ndarray, area: float) -> bool:
-    """Whether the valid polygons ``polys`` (n,) of some pair of ``pairs`` (m, 2) int overlap by
-    more than ``area`` (only pairs whose bounding boxes overlap by that much are intersected)."""
+def _pairs_overlap(polys: np.ndarray, area: np.ndarray, pairs: np.ndarray, rel: float) -> bool:
+    """Whether the valid polygons ``polys`` (n,) (areas ``area`` (n,)) of some pair of ``pairs``
+    (m, 2) int share more than ``rel`` of the smaller one (only pairs whose bounding boxes
+    overlap by that much are intersected)."""
     box = shapely.bounds(polys)  # (n, 4): xmin, ymin, xmax, ymax
     a, b = box[pairs[:, 0]], box[pairs[:, 1]]
     w = np.minimum(a[:, 2], b[:, 2]) - np.maximum(a[:, 0], b[:, 0])
     h = np.minimum(a[:, 3], b[:, 3]) - np.maximum(a[:, 1], b[:, 1])
-    near = pairs[(w > 0) & (h > 0) & (w * h > area)]
-    if not len(near):
+    limit = rel * np.minimum(area[pairs[:, 0]], area[pairs[:, 1]])
+    near = (w > 0) & (h > 0) & (w * h > limit)
+    if not near.any():
         return False
-    return bool(
-        (shapely.area(shapely.intersection(polys[near[:, 0]], polys[near[:, 1]])) > area).any()
-    )
+    pa, pb = pairs[near].T
+    shared = shapely.area(shapely.intersection(polys[pa], polys[pb]))
+    return bool((shared > limit[near]).any())
+
+
+def run_overlaps(points_2d: np.ndarray, faces, sector: np.ndarray) -> bool:
+    """:func:`measured_overlap` of a run's piece, its first sector's faces against its last's
+    as the pairs (where a ring that turns by a full turn or more, or whose development's cut
+    does not close, overlaps itself).
+
+    Parameters
+    ----------
+    points_2d : (k, 2) float
+    faces : list of list of int
+    sector : (n_faces,) int
+        Sector of each face, from 0.
+    """
+    sector = np.asarray(sector)
+    first, last = np.flatnonzero(sector == 0), np.flatnonzero(sector == sector.max())
+    pairs = np.stack(np.meshgrid(first, last, indexing="ij"), axis=-1).reshape(-1, 2)
+    return measured_overlap(points_2d, faces, pairs=pairs)
 
 
 def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: float):
@@ -597,6 +615,14 @@ def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
     return np.array([c.x, c.y])
 
 
+def merge_distance(frame: VertexFrame) -> float:
+    """The distance within which two points of the vertex's module are merged
+    (:meth:`Piece.merge_coincident`): ``tol.coincide`` times the larger of the shortest
+    incident edge and the largest coordinate of the vertex (their round-off)."""
+    shortest = min(s.length for s in frame.sides)
+    return tol.coincide * max(shortest, float(np.abs(frame.U).max()))
+
+
 def hole_heights(frame: VertexFrame) -> np.ndarray:
     """(n_sides,) height of the hole border above the midpoint cross-section on each side.
 
@@ -651,8 +677,12 @@ def build_module(
     pieces = []
     while pending:
         j0, j1 = pending.pop(0)
-        piece, p2 = _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)
-        if j1 > j0 and faces_overlap(p2, piece.faces):
+        piece, p2, sector = _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)
+        if (
+            j1 > j0
+            and not faces_interior_disjoint(p2, piece.faces)
+            and run_overlaps(p2, piece.faces, sector)
+        ):
             mid = (j0 + j1) // 2
             pending[:0] = [(j0, mid), (mid + 1, j1)]
             continue
@@ -850,8 +880,9 @@ def _add_strip(piece: Piece, bs: list, tp: list, strip: _Strip, patch: str, cone
 
 def _build_run(
     mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0, j1
-) -> tuple[Piece, np.ndarray]:
-    """The piece of sectors ``j0 .. j1`` and its ``points_2d`` (k, 2) as an array."""
+) -> tuple[Piece, np.ndarray, np.ndarray]:
+    """The piece of sectors ``j0 .. j1``, its ``points_2d`` (k, 2) as an array and the sector
+    of each of its faces ((n_faces,) int, from 0 at ``j0``)."""
     u = frame.vertex
     ring = frame.ring
     ne = len(frame.sides)
@@ -906,7 +937,9 @@ def _build_run(
         t = piece.point(("line", i, tag, "top"), apply(mp, to_chart(fr, t3)), t3)
         return b, t
 
+    sector = []
     for i in range(j0, j1 + 1):
+        n_before = len(piece.faces)
         side = frame.sides[i]
         # the half-cylinder of side i and the cone over its crease
         if side.rounded:
@@ -931,8 +964,10 @@ def _build_run(
         piece.face(corner, f"face {face}")
         if apex is not None:
             piece.face([piece.apex_index, t0, t1], cone)
-    p2 = piece._merge_coincident(1e-9 * min(s.length for s in frame.sides))
-    return piece, p2
+        sector += [i - j0] * (len(piece.faces) - n_before)
+    p2, kept = piece._merge_coincident(merge_distance(frame))
+    sector = np.array(sector, dtype=np.int64)
+    return piece, p2, sector if kept is None else sector[kept]
 
 
 def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:

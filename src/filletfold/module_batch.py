@@ -9,7 +9,7 @@ for all its runs together the arc samples, base curves and creases (or hole bord
 images, the face shares' centres, the lines of unrounded boundary sides and the end copies of the
 side after each run, every face with its area, then the merge and overlap checks of all the
 pieces. Only a run that the overlap proof does not clear has its union measured on its own
-(:func:`~filletfold.module.measured_overlap`, the measure of ``build_module``). The points and
+(:func:`~filletfold.module.run_overlaps`, the measure of ``build_module``). The points and
 faces come in the order ``build_module`` adds them, with the same arithmetic row by row, so the
 pieces are the same bit for bit.
 
@@ -36,10 +36,11 @@ from .module import (
     build_module,
     faces_interior_disjoint_many,
     hole_heights,
-    measured_overlap,
     polygon_area2,
+    run_overlaps,
 )
 from .parallel import thread_map
+from .tolerances import tol
 from .vertex.apex import _stack
 from .vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
 
@@ -193,7 +194,8 @@ class _Chunk:
     dn : (n_sides,) float
         The denominator of eq. (1) on each side.
     eps : (n_vert,) float
-        The merge distance of :meth:`~filletfold.module.Piece.merge_coincident`.
+        The merge distance of :meth:`~filletfold.module.Piece.merge_coincident`
+        (:func:`~filletfold.module.merge_distance`).
     patch : list of str
         Patch names: the cylinder of each side, the cone of each vertex, each ring face.
     """
@@ -258,7 +260,11 @@ class _Chunk:
             dev=dev,
             vi=vi,
             dn=vi[:, 1] - np.einsum("ij,ij->i", apex[sv] - sa.M, sa.R),
-            eps=1e-9 * np.minimum.reduceat(sa.length, side_first[:-1]),
+            eps=tol.coincide
+            * np.maximum(
+                np.minimum.reduceat(sa.length, side_first[:-1]),
+                np.abs(np.array([f.U for f in frames])).max(axis=1),
+            ),
             patch=[f"cylinder {e}" for e in sa.edge.tolist()]
             + [f"cone {f.vertex}" for f in frames]
             + [f"face {f}" for f in ring_face.tolist()],
@@ -310,7 +316,7 @@ def _chunk_modules(chunk: _Chunk) -> list:
         ):
             if piece is None:
                 failed[j] = True
-            elif j1 > j0 and not ok and _overlaps(piece, sector):
+            elif j1 > j0 and not ok and run_overlaps(piece.points_2d, piece.faces, sector):
                 mid = (j0 + j1) // 2
                 halves += [(j, j0, mid), (j, mid + 1, j1)]
             else:
@@ -484,22 +490,6 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
     count = runs[:, 2] - runs[:, 1] + 1
     sector = face_share - (np.cumsum(count) - count)[face_run]  # the share within its run
     return pieces, proved, np.split(sector, fb[1:-1])
-
-
-def _overlaps(piece: Piece, sector: np.ndarray) -> bool:
-    """:func:`~filletfold.module.measured_overlap` of a run's piece whose overlap was not
-    disproved, its first sector's faces and its last's tried first (where a ring that turns by
-    more than a full turn overlaps itself).
-
-    Parameters
-    ----------
-    piece : Piece
-    sector : (n_faces,) int
-        Sector of each face, from 0.
-    """
-    first, last = np.flatnonzero(sector == 0), np.flatnonzero(sector == sector.max())
-    pairs = np.stack(np.meshgrid(first, last, indexing="ij"), axis=-1).reshape(-1, 2)
-    return measured_overlap(piece.points_2d, piece.faces, pairs=pairs)
 
 
 def _run_points(chunk: _Chunk, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:

@@ -53,6 +53,13 @@ class Tolerances:
     fillet_floor : float
         An edge whose fillet would be narrower than this share of the edge's length is left
         sharp (not rounded): a narrower strip only makes slivers.
+    coincide : float
+        Two points of a vertex module are one point (merged) when they are this close in 2D
+        and in 3D, relative to the larger of the module's shortest edge and the size of its
+        coordinates: only round-off apart (about 45 units in the last place), so that a merge
+        moves no point by more than the rounding of its coordinates (a looser merge breaks the
+        ruling isometry and the contraction by as much, e.g. across the cut of a development
+        that closes to 1e-11).
     """
 
     merge: float = 1e-9
@@ -70,6 +77,7 @@ class Tolerances:
     closure: float = 1e-9
     validate: float = 1e-9
     fillet_floor: float = 1e-3
+    coincide: float = 1e-14
 
 
 tol = Tolerances()
