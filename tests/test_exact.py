@@ -54,16 +54,19 @@ def _largest_shared_area(piece) -> float:
     return float((shared / np.minimum(shapely.area(polys[i]), shapely.area(polys[j]))).max())
 
 
+def _small_mesh(ring: dict):
+    mesh = PolyMesh(np.array(ring["vertices"]), ring["faces"])
+    rd = round_edges(mesh, np.array(ring["radius"]))
+    return mesh, rd, vertex_frame(mesh, rd, ring["vertex"]), face_piece_centres(mesh, rd)
+
+
 @pytest.mark.parametrize("ring", _rings(), ids=lambda r: f"nut-{r['nut_vertex']}")
 def test_nearly_closed_hole_modules_contract_and_do_not_overlap(ring):
     """A developable vertex whose rounded development misses closing by 6e-13 .. 6e-9 of its
     edges: the two sides of the cut are not merged (a merge moves points by the gap, and the
     edges at them come out longer folded than flat), and where they cross by a hair the module
     is split (a sliver shared by two faces, a tiny share of the piece but not of the face)."""
-    mesh = PolyMesh(np.array(ring["vertices"]), ring["faces"])
-    rd = round_edges(mesh, np.array(ring["radius"]))
-    frame = vertex_frame(mesh, rd, ring["vertex"])
-    centres = face_piece_centres(mesh, rd)
+    mesh, _, frame, centres = _small_mesh(ring)
     gap = np.linalg.norm(frame.rho[:2, 2]) / min(s.length for s in frame.sides)
     assert 1e-13 < gap < 1e-8
     pieces = build_module(mesh, frame, centres, 24)
@@ -75,6 +78,33 @@ def test_nearly_closed_hole_modules_contract_and_do_not_overlap(ring):
     # the batched surface stage builds the same pieces
     (batched,) = build_modules(mesh, [frame], centres, 24, [None], [None])
     assert len(batched) == len(pieces)
+    for got, want in zip(batched, pieces, strict=True):
+        assert np.array_equal(got.arrays()[0], want.arrays()[0])
+        assert list(got.faces) == list(want.faces)
+
+
+@pytest.mark.parametrize(
+    "ring",
+    json.loads((DATA / "ant-saddles.json").read_text())["rings"],
+    ids=lambda r: f"ant-{r['ant_vertex']}",
+)
+def test_hole_borders_keep_the_face_shares_simple(ring):
+    """At a saddle beside thin faces, a face piece's centre lies near a side's line, on the
+    corner's side of the straight hole border: the border then goes through the corner T, and
+    every face of the module is a simple counter-clockwise polygon."""
+    mesh, _, frame, centres = _small_mesh(ring)
+    pieces = build_module(mesh, frame, centres, 24)
+    n_faces = 0
+    for piece in pieces:
+        p2, _ = piece.arrays()
+        for face, patch in zip(piece.faces, piece.patches, strict=True):
+            poly = shapely.Polygon(p2[list(face)])
+            assert poly.is_valid, (patch, shapely.is_valid_reason(poly))
+            assert poly.exterior.is_ccw
+            n_faces += patch.startswith("face")
+        assert _largest_shared_area(piece) <= 1e-9
+    assert n_faces == len(frame.ring.faces)
+    (batched,) = build_modules(mesh, [frame], centres, 24, [None], [None])
     for got, want in zip(batched, pieces, strict=True):
         assert np.array_equal(got.arrays()[0], want.arrays()[0])
         assert list(got.faces) == list(want.faces)

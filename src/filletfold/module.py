@@ -635,6 +635,54 @@ def hole_heights(frame: VertexFrame) -> np.ndarray:
     return 0.5 * lm
 
 
+def hole_corners(frame: VertexFrame, centres: np.ndarray) -> np.ndarray:
+    """(n_faces,) bool: the ring faces on whose share the hole border goes through the corner
+    T instead of straight across.
+
+    The straight border joins the tops of the two sides on the face (heights
+    :func:`hole_heights`); the share ``[top, base, centre, base, top]`` is a simple polygon only
+    when the face piece's centre lies beyond that segment, away from T. It does not at a
+    reflex corner (the segment would leave the face) nor on a thin face whose centre lies near
+    the side's line (the share's side from its base to the centre would cross the border).
+    Through T, the share is the vertex's whole wedge of the face piece, which its centre sees.
+
+    Parameters
+    ----------
+    frame : VertexFrame
+    centres : (n_faces, 3) float
+        Face piece centres (:func:`face_piece_centres`), by mesh face.
+    """
+    nf = len(frame.ring.faces)
+    sides = frame.sides
+    ne = len(sides)
+    h = hole_heights(frame)
+    i = np.arange(nf)
+    j = (i + 1) % ne
+    if frame.ring.closed:
+        sa = frame.arrays
+        end = sa.base(i, sa.arc[i]) + h[i, None] * sa.R[i]
+        start = sa.base(j, np.zeros(nf)) + h[j, None] * sa.R[j]
+    else:  # the unrounded ends: their lines, up to half their lmax (as line_points has them)
+        top = [
+            (s.end_point() + hh * s.R, s.start_point() + hh * s.R)
+            if s.rounded
+            else (s.M + 0.5 * frame.lmax_end[k] * s.R, s.M + 0.5 * frame.lmax_start[k] * s.R)
+            for k, (s, hh) in enumerate(zip(sides, h.tolist(), strict=True))
+        ]
+        end = np.array([top[k][0] for k in i.tolist()]).reshape(nf, 3)
+        start = np.array([top[k][1] for k in j.tolist()]).reshape(nf, 3)
+    axes = np.asarray(frame.face_frames)
+    normal = np.cross(axes[:, 1], axes[:, 2])
+    along = start - end
+    length = np.linalg.norm(along, axis=1)
+    side_c = np.einsum("ij,ij->i", np.cross(along, centres[frame.ring.faces] - end), normal)
+    side_t = np.einsum("ij,ij->i", np.cross(along, frame.T_end[:nf] - end), normal)
+    beyond = (side_c * np.sign(side_t) < -merge_distance(frame) * length) | (
+        length <= merge_distance(frame)  # no border on the face: the sides' tops meet
+    )
+    return (np.asarray(frame.corner_angle) > np.pi) | ~beyond
+
+
 def build_module(
     mesh: PolyMesh,
     frame: VertexFrame,
@@ -893,6 +941,7 @@ def _build_run(
     if apex is not None:
         piece.apex_index = piece.point(("apex",), dev_apex, apex)
     rounded = [i for i in range(j0, j1 + 1) if frame.sides[i].rounded]
+    through_t = hole_corners(frame, centres) if apex is None else None
     curves = _side_curves(frame, rounded, n_samples, apex, dev_apex, heights)
     strips = _strips(frame, rounded, curves, dev_apex if apex is not None else None)
 
@@ -957,8 +1006,8 @@ def _build_run(
             ("centre", face), apply(frame.face_map[i], to_chart(fr, centres[face])), centres[face]
         )
         corner = [t0, b0, c, b1, t1]
-        if apex is None and frame.corner_angle[i] > np.pi:
-            # at a reflex corner the straight hole border would leave the face: go through T
+        if apex is None and through_t[i]:
+            # a straight hole border would leave the face or cross the share: go through T
             T3 = frame.T_end[i]
             corner.append(piece.point(("T", i), apply(frame.face_map[i], to_chart(fr, T3)), T3))
         piece.face(corner, f"face {face}")

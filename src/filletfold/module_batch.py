@@ -15,7 +15,8 @@ pieces are the same bit for bit.
 
 A vertex takes the per-vertex :func:`~filletfold.module.build_module` instead when
 
-* a face occurs twice in its ring, a corner is reflex, or it has a cone on an open ring;
+* a face occurs twice in its ring, a corner is reflex, it has a cone on an open ring, or its
+  hole border goes through a corner T;
 * :meth:`~filletfold.module.Piece.merge_coincident` could change one of its pieces: two points
   coincide in 2D and 3D within the merge distance (with a margin), a point is not finite, a
   face has twice-area ``<= 2 eps**2`` or a point is in no face.
@@ -35,6 +36,7 @@ from .module import (
     apply_rows,
     build_module,
     faces_interior_disjoint_many,
+    hole_corners,
     hole_heights,
     polygon_area2,
     run_overlaps,
@@ -87,7 +89,7 @@ def build_modules(
     batched = [
         j
         for j, (frame, apex, v) in enumerate(zip(frames, apices, developed, strict=True))
-        if _batched_case(frame, apex, v)
+        if _batched_case(frame, apex, v, centres)
     ]
     if np.size(n_samples) == 0 or np.min(n_samples) < 1:
         batched = []  # no arc samples: let build_module handle (or refuse) it
@@ -118,10 +120,11 @@ def build_modules(
     return modules
 
 
-def _batched_case(frame: VertexFrame, apex, v) -> bool:
+def _batched_case(frame: VertexFrame, apex, v, centres) -> bool:
     """Whether the vertex may take the batched path: its ring's faces each once, its sides
     rounded (an open ring: all but the first and the last), no reflex corner (kept out although
-    with a cone its faces are built alike), and a cone only on a closed ring."""
+    with a cone its faces are built alike), a cone only on a closed ring, and without a cone no
+    hole border through a corner T (:func:`~filletfold.module.hole_corners`)."""
     closed = frame.ring.closed
     if apex is not None and (v is None or not closed):
         return False
@@ -134,6 +137,7 @@ def _batched_case(frame: VertexFrame, apex, v) -> bool:
         and (rounded.all() if closed else rounded.tolist() == [0 < i < n for i in range(n + 1)])
         and len(set(faces)) == n
         and not (np.asarray(frame.corner_angle) > np.pi).any()
+        and (apex is not None or not hole_corners(frame, centres).any())
     )
 
 
