@@ -10,11 +10,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+import filletfold
 from filletfold.mesh.polymesh import PolyMesh
 from filletfold.module import build_module, face_piece_centres
 from filletfold.module_batch import build_modules
 from filletfold.rounding import round_edges
+from filletfold.tolerances import tol
+from filletfold.vertex.apex import fold_planes
 from filletfold.vertex.frame import vertex_frame
 
 DATA = Path(__file__).parent / "data"
@@ -108,3 +113,52 @@ def test_hole_borders_keep_the_face_shares_simple(ring):
     for got, want in zip(batched, pieces, strict=True):
         assert np.array_equal(got.arrays()[0], want.arrays()[0])
         assert list(got.faces) == list(want.faces)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(np.radians(1.0), np.radians(179.0)),
+    st.floats(0.0, 1.0),
+    st.floats(0.0, 1.0),
+    st.floats(-3.0, 3.0),
+    st.floats(-3.0, 3.0),
+    st.floats(0.0, 1.0),
+    st.sampled_from([-1, 1]),
+)
+def test_fold_planes_bound_every_straight_crease(corner, s0, s1, x, y, lift, sigma):
+    """An apex on or above the three fold planes of a face (through the corner T) sees every
+    possible straight crease on the face (from a point of one side's line between T and the
+    midpoint to a point of the other's) under the angle ``tol.fold`` or more: the crease
+    folds by at most 180 degrees less that."""
+    # face in the plane z = 0 (front normal +z), T at the origin, the side lines along a, b
+    a = np.array([1.0, 0.0, 0.0])
+    b = np.array([np.cos(corner), np.sin(corner), 0.0])
+    normal = np.array([0.0, 0.0, 1.0])
+    (w,) = fold_planes(normal[None], -a[None], -b[None], np.array([sigma]))
+    foot = np.array([x, y, 0.0])
+    # the lowest height over the face at this foot that is on or above all three planes
+    need = max(0.0, *(-(sigma * wj[:2] @ foot[:2]) / wj[2] for wj in w))
+    apex = foot + sigma * (need + lift) * normal
+    assert (sigma * w @ apex >= -1e-12).all()
+    p0, p1 = s0 * a + 1e-6 * a, s1 * b + 1e-6 * b
+    tri = np.cross(p1 - p0, apex - p0)
+    # the angle between the face on the far side of the crease (away from T) and the triangle
+    along = (p1 - p0) / np.linalg.norm(p1 - p0)
+    away = np.cross(normal, along)
+    away = away if away @ (-p0) < 0 else -away
+    height = sigma * (apex - p0) @ normal
+    beyond = (apex - p0) @ away
+    assert np.linalg.norm(tri) > 0
+    assert np.arctan2(height, beyond) >= tol.fold * (1 - 1e-9)
+
+
+def test_straight_creases_fold_short_of_flat():
+    """resch with consistent material loss: developable vertices whose normal bound is tiny
+    had their apices 2e-6 above a face plane, over the face, and straight creases folded to
+    -179.999 degrees; every crease now folds by less than 180 degrees less ``tol.fold``."""
+    d = filletfold.round_mesh("resch", material_loss=True)
+    cert = d.certificate
+    assert cert["fold-angle range"].ok, cert["fold-angle range"].line()
+    p = d.pattern
+    angle = np.abs(np.asarray(p.edge_fold_angle, dtype=float))
+    assert angle.max() <= 180.0 - np.degrees(tol.fold) + 1e-9

@@ -58,15 +58,24 @@ def _reference_validate(frame, V, v, sigma, n_samples=65, centres=None) -> ApexC
     n = sa.face_normal
     face_val = sigma * np.einsum("ij,ij->i", V - frame.T_end[:nf], n)
     slack.append(face_val)
+    nxt = (np.arange(nf) + 1) % k
+    p0 = C[last[:nf]] + l[last[:nf], None] * sa.R[:nf]
+    p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
+    dvec = p1 - p0
+    length = np.linalg.norm(dvec, axis=1)
+    dvec = dvec / np.where(length > eps, length, 1.0)[:, None]
+    side_t = np.einsum("ij,ij->i", np.cross(dvec, frame.T_end[:nf] - p0), n)
+    # the fold: the apex's foot on the face, its distance from the crease line (positive on
+    # the far side from T), and the angle atan2(height, distance) of the cone triangle
+    rel = V - p0
+    foot = rel - np.einsum("ij,ij->i", rel, n)[:, None] * n
+    side_v = np.einsum("ij,ij->i", np.cross(dvec, foot), n)
+    w = -np.sign(side_t) * side_v
+    fold_val = np.cos(tol.fold) * face_val - np.sin(tol.fold) * w
+    fold_val = np.where(length > eps, fold_val, np.inf)
+    slack.append(fold_val[length > eps])
     centre_val = np.full(nf, np.inf)
     if centres is not None:
-        nxt = (np.arange(nf) + 1) % k
-        p0 = C[last[:nf]] + l[last[:nf], None] * sa.R[:nf]
-        p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
-        dvec = p1 - p0
-        length = np.linalg.norm(dvec, axis=1)
-        dvec = dvec / np.where(length > eps, length, 1.0)[:, None]
-        side_t = np.einsum("ij,ij->i", np.cross(dvec, frame.T_end[:nf] - p0), n)
         side_c = np.einsum("ij,ij->i", np.cross(dvec, centres[frame.ring.faces] - p0), n)
         centre_val = np.where(side_t != 0, -side_c * np.sign(side_t), np.abs(side_c))
         centre_val = np.where(length > eps, centre_val, np.inf)
@@ -76,6 +85,8 @@ def _reference_validate(frame, V, v, sigma, n_samples=65, centres=None) -> ApexC
             failing.append(f"{KINDS['face']} at face {int(f)}")
         if centre_val[i] < eps:
             failing.append(f"{KINDS['centre']} on face {int(f)}")
+        if fold_val[i] < eps:
+            failing.append(f"{KINDS['fold']} at face {int(f)}")
     return ApexCheck(not failing, float(np.min(np.concatenate(slack))), failing)
 
 

@@ -53,6 +53,11 @@ class Tolerances:
     fillet_floor : float
         An edge whose fillet would be narrower than this share of the edge's length is left
         sharp (not rounded): a narrower strip only makes slivers.
+    fold : float
+        Smallest angle (radians; 0.6 degrees) between a straight crease's cone triangle and
+        its face: the apex stays above each face's plane by at least ``sin(fold)`` times its
+        distance from the crease on that face, so that no straight crease folds by more than
+        180 degrees less this angle (an apex in a face's plane folds the cone flat onto it).
     coincide : float
         Two points of a vertex module are one point (merged) when they are this close in 2D
         and in 3D, relative to the larger of the module's shortest edge and the size of its
@@ -77,6 +82,7 @@ class Tolerances:
     closure: float = 1e-9
     validate: float = 1e-9
     fillet_floor: float = 1e-3
+    fold: float = 0.0105
     coincide: float = 1e-14
 
 

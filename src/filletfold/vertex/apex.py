@@ -9,7 +9,10 @@ Given the developed apex ``v`` (fixed point of ``rho``), the spatial apex ``V`` 
   ``num - 2 m Dn >= 0`` and ``2 Dn (l_max - m) - num >= 0`` with a safety margin ``m``;
 * non-intersection (eq. 2): ``sigma (V - C(s)) . N(s) > 0`` along the arc (sampled; the paper's
   chord-plane linearisation ``sigma (V - T_0) . N_e > 0`` is kept as well);
-* every incident face: ``sigma (V - T) . N_f > 0`` (METHOD-NOTES 3).
+* every incident face: ``sigma (V - T) . N_f > 0`` (METHOD-NOTES 3), and the apex above
+  three planes through T tilted from the face by a little more than ``tol.fold``, so that
+  the straight crease on the face folds by less than 180 degrees minus ``tol.fold`` (see
+  :func:`fold_planes`).
 
 The quadratic range constraints are sampled at a few points per arc during the solve. The
 constraint ``l <= l_max`` is reverse-convex, so the solve starts with a feasibility phase
@@ -41,6 +44,7 @@ KINDS = {
     "chord": "apex on the wrong side of the cylinder's chord plane",
     "face": "apex on the wrong side of a face",
     "centre": "the straight crease passes the face piece's centre",
+    "fold": "straight crease folds flat (apex too near a face's plane, over the face)",
 }
 
 
@@ -259,26 +263,32 @@ def build_constraints_many(
         q_side[r], q_sample[r] = sides, smp
         coef[r], sign[r], const[r] = c_, (-1.0 if block < 2 else 0.0), g_
         q_kind[r] = "l_max" if block < 2 else "patch"
-    # linear rows, per vertex: non-intersection along the arc, the chord plane, every face
+    # linear rows, per vertex: non-intersection along the arc, the chord plane, every face,
+    # then three fold planes per face
     chord = np.flatnonzero(sa.arc > 0)
     c = np.bincount(sv[chord], minlength=n)
-    l_start = np.cumsum(m + c + k) - (m + c + k)
+    l_count = m + c + 4 * k
+    l_start = np.cumsum(l_count) - l_count
     ne = np.cross(C[last[chord]] - C[first[chord]], sa.R[chord])
     ne /= np.linalg.norm(ne, axis=1)[:, None]
     T_start = np.concatenate([f.T_start for f in frames])
     T_end = np.concatenate([f.T_end[: len(f.ring.faces)] for f in frames])
-    lin_rows = int((m + c + k).sum())
+    lin_rows = int(l_count.sum())
     lin_a, lin_b = np.empty((lin_rows, 3)), np.empty(lin_rows)
     l_kind = np.empty(lin_rows, dtype=_KIND_TYPE)
     l_element = np.empty(lin_rows, dtype=np.int64)
     chord_rank = np.arange(len(chord)) - (np.cumsum(c) - c)[sv[chord]]
     ring_faces = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
+    face_row = sides - so[sv] + l_start[sv] + m[sv] + c[sv]
+    nxt = so[sv] + (sides - so[sv] + 1) % k[sv]
+    tilted = fold_planes(sa.face_normal, sa.R, sa.R[nxt], sigma[sv])
     for idx, vert, normal, point, kind, element in (
         (np.arange(len(s)) - mo[mv] + l_start[mv], mv, N, C, "nonint", sa.edge[side]),
         (chord_rank + l_start[sv[chord]] + m[sv[chord]], sv[chord], ne, T_start[chord], "chord",
          sa.edge[chord]),
-        (sides - so[sv] + l_start[sv] + m[sv] + c[sv], sv, sa.face_normal, T_end, "face",
-         ring_faces),
+        (face_row, sv, sa.face_normal, T_end, "face", ring_faces),
+        *((face_row + (1 + j) * k[sv], sv, tilted[:, j], T_end, "fold", ring_faces)
+          for j in range(3)),
     ):  # fmt: skip
         a_ = sigma[vert][:, None] * normal
         lin_a[idx] = a_
@@ -287,7 +297,7 @@ def build_constraints_many(
     quad_c, quad_s = C[q_sample], s[q_sample]
     quad_R, quad_M, quad_Q, quad_t = sa.R[q_side], sa.M[q_side], sa.Q[q_side], sa.t[q_side]
     q_element = sa.edge[q_side]
-    q_end, l_end = q_start + m + 3 * k, l_start + m + c + k
+    q_end, l_end = q_start + m + 3 * k, l_start + l_count
     out = []
     for j, (q0, q1, l0, l1) in enumerate(
         zip(q_start.tolist(), q_end.tolist(), l_start.tolist(), l_end.tolist(), strict=True)
@@ -315,6 +325,59 @@ def build_constraints_many(
             )
         )
     return out
+
+
+def fold_planes(face_normal, R_end, R_start, sigma) -> np.ndarray:
+    """The fold rows' normals of :func:`build_constraints_many`: three planes through the
+    corner T of each face, tilted from the face by a little more than ``tol.fold``.
+
+    The straight crease on a face joins a point of the side line ending there (through T,
+    along ``R_end``) to a point of the side line starting there (along ``R_start``), both
+    between T and the edge midpoints. The cone triangle over it meets the face at
+    ``atan2(h, w)``, ``h`` the apex's height over the face and ``w`` its distance beyond the
+    crease line, over the face piece: at ``tol.fold`` or more when the apex lies above the
+    plane through the crease tilted by ``tol.fold`` over the piece. Moving that line toward T
+    only raises the plane there, so the planes through T whose in-plane normals ``n`` point
+    into the face between those of the two side lines (``n_a``, ``n_b``, at the angle
+    ``pi`` minus the face's corner) bound every crease's plane; the three with ``n_a``, ``n_b``
+    and their bisector do, with the tilt ``delta`` of ``tan(delta) = tan(tol.fold) /
+    cos(theta / 4)`` (``theta`` the angle between ``n_a`` and ``n_b``), since between two of
+    them ``n . x <= max(n_1 . x, n_2 . x) / cos(theta / 4)``.
+
+    Parameters
+    ----------
+    face_normal : (k, 3) float
+        Front normal of each face.
+    R_end, R_start : (k, 3) float
+        Unit directions (toward the vertex) of the side ending on the face and of the side
+        starting on it.
+    sigma : (k,) int
+        Side of the apex (+1 front, -1 back).
+
+    Returns
+    -------
+    (k, 3, 3) float
+        Per face, the normals ``w`` of its three rows ``sigma w . (V - T) >= margin``:
+        ``cos(delta) N - sigma sin(delta) n``, for ``n = n_a``, the bisector, ``n_b``.
+    """
+    ca, cb = np.cross(face_normal, R_end), np.cross(face_normal, R_start)
+    # into the face: n_a toward the starting side's line away from T (along -R_start)
+    n_a = ca * np.where(_dot_rows(ca, R_start) > 0, -1.0, 1.0)[:, None]
+    n_b = cb * np.where(_dot_rows(cb, R_end) > 0, -1.0, 1.0)[:, None]
+    mid = n_a + n_b
+    two_cos_half = np.linalg.norm(mid, axis=1)  # 2 cos(theta / 2)
+    mid = mid / np.where(two_cos_half > 0, two_cos_half, 1.0)[:, None]
+    cos_quarter = np.sqrt(0.5 * (1.0 + 0.5 * two_cos_half))
+    tan_tilt = np.tan(tol.fold) / cos_quarter
+    cos_tilt = 1.0 / np.sqrt(1.0 + tan_tilt**2)
+    sin_tilt = tan_tilt * cos_tilt
+    n = np.stack([n_a, mid, n_b], axis=1)  # (k, 3, 3)
+    s = (np.asarray(sigma, dtype=float) * sin_tilt)[:, None, None]
+    return cos_tilt[:, None, None] * face_normal[:, None, :] - s * n
+
+
+def _dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", a, b)
 
 
 @dataclass
@@ -453,9 +516,11 @@ def validate_apices(
     """Check every condition along every arc of many vertices at once, without margin.
 
     Conditions: ``Dn > 0``; ``l(s) >= 0``; ``l <= l_max`` at both ends; ``sigma (V - C) . N > 0``
-    along the arc; ``sigma (V - T) . N_f > 0`` for every face; and, given the face pieces'
-    ``centres``, the straight crease on every face runs between the corner T and the centre,
-    so the vertex's share of the face stays a simple polygon.
+    along the arc; ``sigma (V - T) . N_f > 0`` for every face; the cone triangle over the
+    straight crease on every face meets the face at ``tol.fold`` or more (the crease folds by
+    at most 180 degrees less that); and, given the face pieces' ``centres``, the straight
+    crease on every face runs between the corner T and the centre, so the vertex's share of
+    the face stays a simple polygon.
 
     The two conditions along an arc are checked at ``n_samples`` points and then at the
     minimum between them, found by Newton steps on their closed forms (a convex quadratic
@@ -484,7 +549,7 @@ def validate_apices(
     list of ApexCheck
         One per vertex, in the order of ``frames``; ``failing`` lists, per vertex, the
         conditions of its sides in order (patch, l_min, l_max, nonint per side), then those of
-        its faces (face, centre per face).
+        its faces (face, centre, fold per face).
     """
     n = len(frames)
     if n == 0:
@@ -534,30 +599,38 @@ def validate_apices(
     nxt = offset[fvert] + (local + 1) % n_sides[fvert]  # (F,) side starting on it
     nrm = sa.face_normal
     face_val = sigma[fvert] * np.einsum("ij,ij->i", V[fside] - T_face, nrm)
-    centre_val = np.full(len(faces), np.inf)
+    # the straight crease on each face, from side i's end to side i + 1's start
+    p0 = C[last[fside]] + l[last[fside], None] * sa.R[fside]
+    p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
+    dvec = p1 - p0
+    length = np.linalg.norm(dvec, axis=1)
     e_face = eps[fvert]
+    crease = length > e_face
+    dvec = dvec / np.where(crease, length, 1.0)[:, None]
+    side_t = np.einsum("ij,ij->i", np.cross(dvec, T_face - p0), nrm)
+    # fold: the cone triangle meets the face at atan2(h, w) >= tol.fold (h the apex's height
+    # over the face, w its distance beyond the crease line, over the piece: away from T)
+    beyond = -np.sign(side_t)[:, None] * np.cross(nrm, dvec)  # in-plane normal away from T
+    w = np.einsum("ij,ij->i", V[fside] - p0, beyond)
+    fold_val = np.cos(tol.fold) * face_val - np.sin(tol.fold) * w
+    fold_val = np.where(crease, fold_val, np.inf)  # no crease: no fold
+    centre_val = np.full(len(faces), np.inf)
     if centres is not None:
-        p0 = C[last[fside]] + l[last[fside], None] * sa.R[fside]
-        p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
-        dvec = p1 - p0
-        length = np.linalg.norm(dvec, axis=1)
-        dvec = dvec / np.where(length > e_face, length, 1.0)[:, None]
-        side_t = np.einsum("ij,ij->i", np.cross(dvec, T_face - p0), nrm)
         side_c = np.einsum("ij,ij->i", np.cross(dvec, centres[faces] - p0), nrm)
         centre_val = np.where(side_t != 0, -side_c * np.sign(side_t), np.abs(side_c))
-        centre_val = np.where(length > e_face, centre_val, np.inf)  # no crease: no condition
+        centre_val = np.where(crease, centre_val, np.inf)  # no crease: no condition
     # the smallest slack per vertex (a NaN anywhere propagates, as in np.min)
     margin = np.full(n, np.inf)
     np.minimum.at(margin, vert, checks.min(axis=1))
-    np.minimum.at(margin, fvert, np.minimum(face_val, centre_val))
+    np.minimum.at(margin, fvert, np.minimum(np.minimum(face_val, centre_val), fold_val))
     failing = [[] for _ in range(n)]
     names = ("patch", "l_min", "l_max", "nonint")
     for i, c in zip(*np.nonzero(bad), strict=True):
         failing[vert[i]].append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
-    face_bad = np.stack([face_val < e_face, centre_val < e_face], axis=1)
+    face_bad = np.stack([face_val < e_face, centre_val < e_face, fold_val < e_face], axis=1)
+    texts = (f"{KINDS['face']} at face", f"{KINDS['centre']} on face", f"{KINDS['fold']} at face")
     for j, c in zip(*np.nonzero(face_bad), strict=True):
-        text = f"{KINDS['face']} at face" if c == 0 else f"{KINDS['centre']} on face"
-        failing[fvert[j]].append(f"{text} {int(faces[j])}")
+        failing[fvert[j]].append(f"{texts[c]} {int(faces[j])}")
     # where l or the non-intersection condition fails: the worst point, a sample to add
     cut_side, cut_kind = np.nonzero(bad[:, [1, 3]])
     cut_s = np.where(cut_kind == 0, l_at[cut_side], nonint_at[cut_side])
