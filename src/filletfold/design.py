@@ -40,7 +40,7 @@ from .sheet import glue_pieces
 from .tabs import add_tabs_and_labels
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
-from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
+from .vertex.solve import STATUSES, VertexResult, classify_vertices, mesh_size, solve_apices
 
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
@@ -640,7 +640,7 @@ def round_mesh(
     _stage("apices")
     # with the rescue to come, the hard cases' fallbacks wait for its last, smallest radii
     thorough = material_loss or not fit_vertices
-    apices = _solve_apices(frames, depths, res, centres, progress, pending, thorough)
+    apices = _solve_apices(frames, depths, res, centres, progress, pending, mesh_size(pm), thorough)
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
         frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
@@ -839,14 +839,14 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
 
 
 def _solve_apices(
-    frames, depths, res: VertexResult, centres, progress, pending, thorough=True
+    frames, depths, res: VertexResult, centres, progress, pending, size, thorough=True
 ) -> dict:
     """:func:`solve_apices` of the vertices ``pending``; when it fails unforeseen, the
     vertices are solved one by one and a vertex whose solve fails is infeasible, with the
     failure as its reason (a failure is data, not the end of the design)."""
     try:
         return solve_apices(
-            frames, depths, res, centres, progress, vertices=pending, thorough=thorough
+            frames, depths, res, centres, progress, vertices=pending, size=size, thorough=thorough
         )
     except FilletfoldError:
         raise
@@ -858,7 +858,9 @@ def _solve_apices(
             res.status[u] = ""
             try:
                 out.update(
-                    solve_apices(frames, depths, res, centres, vertices=[u], thorough=thorough)
+                    solve_apices(
+                        frames, depths, res, centres, vertices=[u], size=size, thorough=thorough
+                    )
                 )
             except FilletfoldError:
                 raise

@@ -58,6 +58,11 @@ class Tolerances:
         its face: the apex stays above each face's plane by at least ``sin(fold)`` times its
         distance from the crease on that face, so that no straight crease folds by more than
         180 degrees less this angle (an apex in a face's plane folds the cone flat onto it).
+    ruling : float
+        Shortest crease ruling aimed at, as a share of the mesh's size (its bounding-box
+        diagonal): the apex keeps every crease at least this far above its base curve (capped
+        at a quarter of the vertex's shortest ``l_max``), so that no ruling of a cylinder is a
+        sliver edge of the pattern (the certificate's shortest edge is 1e-7 of the design).
     coincide : float
         Two points of a vertex module are one point (merged) when they are this close in 2D
         and in 3D, relative to the larger of the module's shortest edge and the size of its
@@ -83,6 +88,7 @@ class Tolerances:
     validate: float = 1e-9
     fillet_floor: float = 1e-3
     fold: float = 0.0105
+    ruling: float = 2e-7
     coincide: float = 1e-14
 
 

@@ -155,6 +155,7 @@ def build_constraints(
     margin: float,
     lmax_scale: np.ndarray | None = None,
     extra: np.ndarray | None = None,
+    floor: float = 0.0,
 ) -> ApexConstraints:
     """Sample the sec. 3.2 constraints of a closed-ring vertex.
 
@@ -175,9 +176,14 @@ def build_constraints(
     extra : (m, 2) float, optional
         ``(side, s)``: further arc parameters at which ``l >= m`` and the non-intersection
         condition are sampled (where an earlier solution failed between the samples).
+    floor : float
+        Shortest crease ruling (length): the ``l >= m`` rows keep ``l >= max(m, floor)``, and
+        the ``l <= l_max - m`` rows keep the crease short of T by ``floor / (2 sin(alpha /
+        2))`` too (``alpha`` the face's corner; at most a quarter of ``l_max``), so that no
+        straight crease is shorter than ``floor``.
     """
     return build_constraints_many(
-        [frame], [v], [sigma], [n_samples], [margin], [lmax_scale], [extra]
+        [frame], [v], [sigma], [n_samples], [margin], [lmax_scale], [extra], [floor]
     )[0]
 
 
@@ -189,10 +195,11 @@ def build_constraints_many(
     margins,
     lmax_scales=None,
     extras=None,
+    floors=None,
 ) -> list[ApexConstraints]:
     """:func:`build_constraints` of many vertices at once (one value of each parameter per
-    vertex, in sequences of equal length; ``lmax_scales`` and ``extras`` may be None for
-    all). The arcs of all vertices are sampled together.
+    vertex, in sequences of equal length; ``lmax_scales``, ``extras`` and ``floors`` may be
+    None for all). The arcs of all vertices are sampled together.
 
     Every row of every vertex is computed in one pass over flat arrays, already in each
     vertex's row order, so a vertex's constraints are views of them; each row's arithmetic is
@@ -249,13 +256,20 @@ def build_constraints_many(
     coef, sign, const = np.empty(rows), np.empty(rows), np.empty(rows)
     sides = np.arange(len(sv))
     q_side[at], q_sample[at] = side, np.arange(len(s))
-    coef[at], sign[at], const[at] = 2 * margin[mv], 1.0, 0.0
+    floor = np.zeros(n) if floors is None else np.asarray(floors, dtype=float).reshape(n)
+    coef[at], sign[at], const[at] = 2 * np.maximum(margin, floor)[mv], 1.0, 0.0
     ms = margin[sv]
+    # short of T by the floor too, over 2 sin(corner / 2): the straight crease between two
+    # ends that short of T is at least the floor long (a crease through T exactly is merged)
+    corner = np.concatenate([np.asarray(f.corner_angle, dtype=float) for f in frames])
+    prev = so[sv] + (sides - so[sv] - 1) % k[sv]  # side i starts on face i - 1
+    short = floor[sv, None] / (2 * np.sin(0.5 * np.stack([corner[prev], corner], axis=1)))
+    m_t = np.maximum(ms[:, None], np.fmin(short, 0.25 * lmax))
     q_kind = np.full(rows, "l_min", dtype=_KIND_TYPE)
     for block, (smp, c_, g_) in enumerate(
         [
-            (first, -2 * (lmax[:, 0] - ms), 0.0),
-            (last, -2 * (lmax[:, 1] - ms), 0.0),
+            (first, -2 * (lmax[:, 0] - m_t[:, 0]), 0.0),
+            (last, -2 * (lmax[:, 1] - m_t[:, 1]), 0.0),
             (first, -scale[sv], -ms),
         ]
     ):
@@ -512,15 +526,16 @@ def validate_apices(
     sigmas,
     n_samples: int = 65,
     centres: np.ndarray | None = None,
+    floors=None,
 ) -> list[ApexCheck]:
     """Check every condition along every arc of many vertices at once, without margin.
 
-    Conditions: ``Dn > 0``; ``l(s) >= 0``; ``l <= l_max`` at both ends; ``sigma (V - C) . N > 0``
-    along the arc; ``sigma (V - T) . N_f > 0`` for every face; the cone triangle over the
-    straight crease on every face meets the face at ``tol.fold`` or more (the crease folds by
-    at most 180 degrees less that); and, given the face pieces' ``centres``, the straight
-    crease on every face runs between the corner T and the centre, so the vertex's share of
-    the face stays a simple polygon.
+    Conditions: ``Dn > 0``; ``l(s) >= 0`` (at least the vertex's ``floor``); ``l <= l_max`` at
+    both ends; ``sigma (V - C) . N > 0`` along the arc; ``sigma (V - T) . N_f > 0`` for every
+    face; the cone triangle over the straight crease on every face meets the face at
+    ``tol.fold`` or more (the crease folds by at most 180 degrees less that); and, given the
+    face pieces' ``centres``, the straight crease on every face runs between the corner T and
+    the centre, so the vertex's share of the face stays a simple polygon.
 
     The two conditions along an arc are checked at ``n_samples`` points and then at the
     minimum between them, found by Newton steps on their closed forms (a convex quadratic
@@ -543,6 +558,8 @@ def validate_apices(
         Samples per arc (both ends included).
     centres : (n_faces, 3) float, optional
         Face pieces' centres, indexed by mesh face: adds the face-centre condition.
+    floors : (n,) float, optional
+        Shortest crease ruling of each vertex (length; default 0).
 
     Returns
     -------
@@ -581,10 +598,11 @@ def validate_apices(
     # the minima between samples: Newton from the smallest sample on the closed forms
     l_min, l_at = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
     nonint_min, nonint_at = _refined_min(sa, V, nonint, s, first, sigma=sigma[vert])
+    floor = np.zeros(n) if floors is None else np.asarray(floors, dtype=float).reshape(n)
     checks = np.stack(
         [
             dn,
-            np.where(valid, l_min, -np.inf),
+            np.where(valid, l_min - floor[vert], -np.inf),
             np.where(valid, np.minimum(lmax_start - l[first], lmax_end - l[last]), -np.inf),
             nonint_min,
         ],

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..mesh.polymesh import PolyMesh
 from ..rounding import EdgeRounding, round_edges, shrink_broken
-from .solve import VertexResult, classify_vertices, solve_apices
+from .solve import VertexResult, classify_vertices, mesh_size, solve_apices
 
 #: Halvings of an infeasible vertex's radii tried before it is left infeasible (1/16 at most).
 ROUNDS = 4
@@ -152,6 +152,7 @@ def rescue_vertices(
             new_centres,
             vertices=todo,
             thorough=round_ >= ROUNDS - 1,  # the hard cases' fallbacks at the last factor
+            size=mesh_size(mesh),
         )
         if apply:
             out.resolved.update(affected.tolist())

@@ -251,6 +251,9 @@ class ApexProblem:
         The safety margin ``m`` at scale 1.
     low : float
         The shortest ``l_max``: margins stay under a quarter of it.
+    floor : float
+        Shortest crease ruling (length): ``tol.ruling`` of the mesh's size, under a quarter of
+        ``low`` (0 without a size).
     shrink : (n_sides, 2) float or None
         Factors on ``l_max`` (shortened creases after a face-centre crossing; None: all 1).
     attempts : list of (int, float)
@@ -271,6 +274,7 @@ class ApexProblem:
     starts: np.ndarray
     margin: float
     low: float
+    floor: float
     shrink: np.ndarray | None
     attempts: list
     failing: list
@@ -284,10 +288,10 @@ class ApexProblem:
     def constraint_args(self, n_samples: int, scale: float) -> tuple:
         """The arguments of :func:`build_constraints` for the next attempt: frame, fixed
         developed apex (None when closed), sigma, samples, margin, crease factors, extra
-        samples."""
+        samples, shortest ruling."""
         m = min(self.margin * scale, 0.25 * self.low)
         v = None if self.closed else self.v
-        return self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra
+        return self.frame, v, self.sigma, n_samples, m, self.shrink, self.extra, self.floor
 
 
 #: Attempts per vertex: (samples per arc, margin scale), the next one after a failed dense
@@ -314,7 +318,14 @@ START_DEPTHS = np.array([0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5])
 ROUND_SLICE = 2048
 
 
-def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexProblem | None:
+def mesh_size(mesh: PolyMesh) -> float:
+    """The size crease rulings are measured against: the mesh's bounding-box diagonal."""
+    return float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))
+
+
+def apex_problem(
+    frame: VertexFrame, depth: float, res: VertexResult, size: float | None = None
+) -> ApexProblem | None:
     """Set up the apex problem of a cone vertex, or mark it infeasible and return None.
 
     Records the requested depth and the developed apex in ``res``. A vertex gets no problem
@@ -323,7 +334,7 @@ def apex_problem(frame: VertexFrame, depth: float, res: VertexResult) -> ApexPro
     :func:`_set_up`.
     """
     u = frame.vertex
-    return _set_up({u: frame}, {u: depth}, res, [u]).get(u)
+    return _set_up({u: frame}, {u: depth}, res, [u], size).get(u)
 
 
 def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) -> list[ApexProblem]:
@@ -339,10 +350,10 @@ def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) ->
     res = VertexResult.empty(mesh.n_vertices)
     frames = classify_vertices(mesh, rounding, res)
     vertices = [u for u in range(mesh.n_vertices) if res.status[u] == ""]
-    return list(_set_up(frames, depths, res, vertices).values())
+    return list(_set_up(frames, depths, res, vertices, mesh_size(mesh)).values())
 
 
-def _set_up(frames, depths, res: VertexResult, vertices) -> dict:
+def _set_up(frames, depths, res: VertexResult, vertices, size: float | None = None) -> dict:
     """The apex problems of ``vertices`` (vertex -> ApexProblem; those without one are
     marked in ``res`` and left out): :func:`apex_problem` of every vertex, computed together
     (each vertex's arithmetic is the one of :func:`apex_problem`)."""
@@ -424,6 +435,7 @@ def _set_up(frames, depths, res: VertexResult, vertices) -> dict:
             starts=st,
             margin=tol.margin * float(margin_length[j]),
             low=float(low[j]),
+            floor=0.0 if size is None else min(tol.ruling * size, 0.25 * float(low[j])),
             shrink=None,
             attempts=list(ATTEMPTS),
             failing=[],
@@ -441,6 +453,7 @@ def solve_apices(
     progress=None,
     vertices=None,
     thorough: bool = True,
+    size: float | None = None,
 ) -> dict:
     """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
 
@@ -472,6 +485,10 @@ def solve_apices(
         False skips what only decides a hard case (more feasibility starts and the SLSQP
         fallback of the last attempts): faster, and a vertex may be called infeasible that
         the thorough solve would solve (the vertex rescue's trial rounds use it).
+    size : float, optional
+        The mesh's size (:func:`mesh_size`): every crease stays ``tol.ruling`` of it above its
+        base curve (or a quarter of the vertex's shortest ``l_max``), so that no cylinder
+        ruling of the pattern is a sliver edge. Default: no such floor.
 
     Returns
     -------
@@ -483,7 +500,7 @@ def solve_apices(
         vertices = [u for u in range(len(res.status)) if res.status[u] == ""]
     vertices = list(vertices)
     out = dict.fromkeys(vertices, (None, None))
-    pending = _set_up(frames, depths, res, vertices)
+    pending = _set_up(frames, depths, res, vertices, size)
     if progress is not None and batch.kernel_pending(len(pending)):
         # the first large design after installing numba compiles the kernel: say so
         progress(KERNEL_STAGE, 0, 1)
@@ -559,6 +576,7 @@ def _solve_round(
         [v for _, _, v in solved],
         [pending[u].sigma for u, _, _ in solved],
         centres=centres,
+        floors=[pending[u].floor for u, _, _ in solved],
     )
     checked = {u: (v, c) for (u, _, v), c in zip(solved, checks, strict=True)}
     for u, attempt, sol in zip(order, tries, sols, strict=True):
