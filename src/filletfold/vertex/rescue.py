@@ -158,7 +158,8 @@ def rescue_vertices(
             out.resolved.update(affected.tolist())
             for u, frame in zip(affected.tolist(), new_frames, strict=True):
                 frames[u] = frame
-            apices.update(solved)
+            for u in affected.tolist():  # a vertex now without a cone (sharp) has no apex
+                apices[u] = solved.get(u, (None, None))
             rounding, centres = new_rounding, new_centres
         for u in list(bad):
             if target.status[u] == "ok":
