@@ -610,3 +610,15 @@ def test_repaired_mesh_is_manifold_oriented_planar_convex(seed, kind):
         mesh.vertex_ring(u)
     assert_convex_planar(mesh)
     assert signed_volume(mesh) > 0
+
+
+def test_faces_back_to_back_are_refused_naming_the_edge():
+    """A tetrahedron lying in a corner of a cube (trimesh's two_objects.obj): once their
+    shared vertices are welded, faces meet back to back; no repair can fold that."""
+    v, faces = cube()
+    t = np.array([[-0.5, -0.5, -0.5], [0.5, -0.5, -0.5], [-0.5, 0.5, -0.5], [-0.5, -0.5, 0.5]])
+    tri = [[0, 2, 1], [0, 3, 2], [1, 3, 0], [1, 2, 3]]
+    tris = [f[[0, 1, 2]] for f in faces] + [f[[0, 2, 3]] for f in faces]
+    with pytest.raises(MeshError, match=r"lie back to back along edge") as info:
+        clean_mesh(np.vstack([v, t]), tris + [np.array(x) + 8 for x in tri])
+    assert info.value.edge is not None

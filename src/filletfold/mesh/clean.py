@@ -188,6 +188,7 @@ def clean_mesh(
         face_list, flipped2, conflicts = _orient(he, face_list, v, face_origin, True)
         flipped += flipped2
     _check_not_soup(he, face_list, face_origin)
+    _check_not_folded_flat(he, face_list, v, face_origin, vert_orig)
 
     # 7. non-planar and non-convex polygons are triangulated (and regrouped by the merge)
     face_list, face_origin = _split_non_planar(face_list, face_origin, v, log)
@@ -597,6 +598,26 @@ def _orient(he: _HalfEdges, face_list, v, face_origin, strict: bool):
     parity = parity ^ invert[component].astype(np.int64)
     out = [_flip(f) if parity[i] else f for i, f in enumerate(face_list)]
     return out, int(parity.sum()), []
+
+
+def _check_not_folded_flat(he: _HalfEdges, face_list, v, face_origin, vert_orig) -> None:
+    """Raise when two faces meet back to back (their normals opposite within
+    ``tol.coplanar_deg``): the surface doubles back on itself along that edge (faces of two
+    objects lying on each other), which no fillet, crease or repair can make foldable."""
+    normal = _face_newell(_Flat.of(face_list), v)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    inner = np.flatnonzero(he.edge_count == 2)
+    fa, fb = he.face[he.edge_he0[inner]], he.face[he.edge_he1[inner]]
+    flat = np.einsum("ij,ij->i", normal[fa], normal[fb]) < -np.cos(np.radians(tol.coplanar_deg))
+    if flat.any():
+        k = int(np.flatnonzero(flat)[0])
+        a, b = (int(vert_orig[x]) for x in he.edge_ends[inner[k]])
+        f, g = int(face_origin[fa[k]]), int(face_origin[fb[k]])
+        raise MeshError(
+            f"faces {f} and {g} lie back to back along edge ({a}, {b}) (folded by 180 deg): the "
+            "surface doubles back on itself there (two objects on each other?)",
+            edge=(a, b),
+        )
 
 
 def _check_not_soup(he: _HalfEdges, face_list, face_origin) -> None:
