@@ -153,3 +153,29 @@ def test_tangent_lines_lie_on_both_faces_at_half_the_strip_width(name):
             assert_allclose(np.linalg.norm(t - mid), rd.strip_width[e] / 2, rtol=1e-12)
             q = t - rd.axis_point[e]
             assert_allclose(np.linalg.norm(q), rd.radius[e], rtol=1e-12)
+
+
+def test_unrounded_edges_keep_their_face_pieces():
+    """Along an edge left unrounded (sharp, flat or boundary) the rounded neighbours' tangent
+    lines must cross before its midpoint too: on the floor of a CAD pocket (a 40-gon of short
+    edges at 171 degree corners) with every other rim edge left sharp, the fitted radii leave
+    every face piece a simple polygon (the pieces' centres exist)."""
+    from filletfold.mesh import clean_mesh
+    from filletfold.module import face_piece_centres
+    from filletfold.rounding import shrink_broken
+
+    n = 40
+    t = 2 * np.pi * np.arange(n) / n
+    ring = np.c_[np.cos(t), np.sin(t)]
+    v = np.vstack([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, 0.2)]])
+    faces = [np.arange(n)[::-1], np.arange(n, 2 * n)]
+    faces += [np.array([i, (i + 1) % n, n + (i + 1) % n, n + i]) for i in range(n)]
+    m, _ = clean_mesh(v, faces, strict=True)
+    rim = (m.edges >= n).all(axis=1)  # the top 40-gon's edges
+    r = np.full(m.n_edges, 0.05)
+    r[np.flatnonzero(rim)[::2]] = 0.0  # every other rim edge sharp
+    gamma = edge_dihedral(m)[0]
+    r = shrink_broken(m, r, gamma)
+    rd = round_edges(m, r)
+    assert rim.sum() == n and rd.sharp[rim].sum() == n // 2
+    assert np.isfinite(face_piece_centres(m, rd)).all()

@@ -154,8 +154,10 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
                 r_uni = np.where(rounded[e] & (ku > 0), half / ku, np.inf)
                 np.minimum.at(limit, e, r_uni)
             x_e = (offset[g] + offset[e] * cos) / sin
-            over = rounded[e] & (x_e > 0.5 * length[e] * (1 + 1e-12))
-            broken[e[over]] = True
+            # an unrounded edge (boundary, flat, sharp) keeps a face piece only if its rounded
+            # neighbours' tangent lines cross it before its midpoint too
+            over = (rounded[e] | rounded[g]) & (x_e > 0.5 * length[e] * (1 + 1e-12))
+            broken[e[over & rounded[e]]] = True
             broken[g[over & rounded[g]]] = True
     return limit, given, broken, float(limit.min(initial=np.inf))
 
