@@ -179,3 +179,14 @@ def test_unrounded_edges_keep_their_face_pieces():
     rd = round_edges(m, r)
     assert rim.sum() == n and rd.sharp[rim].sum() == n // 2
     assert np.isfinite(face_piece_centres(m, rd)).all()
+
+
+def test_tiny_fillets_in_a_large_design_are_left_sharp_and_tiny_arcs_sampled_coarsely():
+    m = mesh("cube")
+    r = np.full(m.n_edges, 0.1)
+    r[0] = 1e-7
+    rd = round_edges(m, r, min_width=1e-6)
+    assert rd.sharp.tolist() == [True] + [False] * (m.n_edges - 1)
+    # an arc of length 0.157 sampled no finer than 0.05: 4 points
+    assert rd.arc_points(24, 0.0, min_chord=0.05)[1:].tolist() == [4] * (m.n_edges - 1)
+    assert rd.arc_points(24, 0.0)[1:].tolist() == [24] * (m.n_edges - 1)

@@ -397,7 +397,7 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
     res.apex_2d[us[near]] = pattern.vertices_2d[k[near]]
 
 
-def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg, floor):
+def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg, floor, min_width):
     """Radii (given, fitted to their limits, or from the material-loss programme) and the edge
     rounding.
 
@@ -436,8 +436,10 @@ def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg, f
         r = parse_length(radius, ref, "radius", count=pm.n_edges)
         if clamp:
             r = clamp_radii(pm, r, flat_deg=coplanar_deg)
-    floor = 0.0 if material_loss else floor  # consistent losses need every edge rounded
-    return loss, round_edges(pm, r, flat_deg=coplanar_deg, floor=floor), conical, requested
+    if material_loss:  # consistent losses need every edge rounded
+        floor = min_width = 0.0
+    rounding = round_edges(pm, r, flat_deg=coplanar_deg, floor=floor, min_width=min_width)
+    return loss, rounding, conical, requested
 
 
 @named_stages("reading the mesh")
@@ -598,6 +600,8 @@ def round_mesh(
         strict=strict,
     )
     ref = pm.mean_edge_length
+    size = mesh_size(pm)
+    min_width = 0.0 if strict else tol.min_fillet * size
 
     key = _stage_key(pm, radius, clamp, material_loss, max_loss, coplanar_deg)
     st = reuse.stages if reuse is not None and reuse.stages is not None else None
@@ -611,7 +615,7 @@ def round_mesh(
         requested = st.requested
     else:
         loss, rounding, conical, requested = _round(
-            pm, radius, clamp, material_loss, max_loss, coplanar_deg, floor
+            pm, radius, clamp, material_loss, max_loss, coplanar_deg, floor, min_width
         )
         centres = face_piece_centres(pm, rounding)
     fitted_radius = rounding.radius.copy()
@@ -640,7 +644,7 @@ def round_mesh(
     _stage("apices")
     # with the rescue to come, the hard cases' fallbacks wait for its last, smallest radii
     thorough = material_loss or not fit_vertices
-    apices = _solve_apices(frames, depths, res, centres, progress, pending, mesh_size(pm), thorough)
+    apices = _solve_apices(frames, depths, res, centres, progress, pending, size, thorough)
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
         frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
@@ -656,6 +660,7 @@ def round_mesh(
             apply=fit_vertices,
             flat_deg=coplanar_deg,
             floor=floor,
+            min_width=min_width,
             apices=apices,
             classified=classified,
             vertices=pending,
@@ -669,7 +674,9 @@ def round_mesh(
 
     t = time.perf_counter()
     _stage("vertex modules")
-    points = rounding.arc_points(int(samples), float(arc_step))
+    points = rounding.arc_points(
+        int(samples), float(arc_step), min_chord=0.0 if strict else 2 * tol.ruling * size
+    )
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]

@@ -262,7 +262,7 @@ class EdgeRounding:
     uniform_limit: float
     sharp: np.ndarray | None = None
 
-    def arc_points(self, samples: int, step_deg: float = 0.0) -> np.ndarray:
+    def arc_points(self, samples: int, step_deg: float = 0.0, min_chord: float = 0.0) -> np.ndarray:
         """Points to sample on each edge's arc (both ends included).
 
         An arc gets ``samples`` points, or fewer when it turns little: one point per
@@ -275,6 +275,9 @@ class EdgeRounding:
             Most points per arc (>= 2).
         step_deg : float
             Largest turn between two samples (degrees); 0 for no limit.
+        min_chord : float
+            Shortest step along an arc (length): a tiny arc gets fewer points, at least 2, so
+            that its steps are no pattern slivers. 0 for no limit.
 
         Returns
         -------
@@ -285,11 +288,19 @@ class EdgeRounding:
             turn = np.degrees(2 * self.half_angle)
             steps = np.ceil(turn / step_deg - 1e-9)  # an exact multiple of the step gains none
             n = np.minimum(n, np.maximum(2, steps + 1).astype(int))
+        if min_chord > 0:
+            fit = np.floor(self.arc_length / min_chord) + 1
+            n = np.minimum(n, np.maximum(2, fit).astype(int))
         return np.where(self.arc_length > 0, n, 1)
 
 
 def round_edges(
-    mesh: PolyMesh, radius, *, flat_deg: float = tol.coplanar_deg, floor: float = 0.0
+    mesh: PolyMesh,
+    radius,
+    *,
+    flat_deg: float = tol.coplanar_deg,
+    floor: float = 0.0,
+    min_width: float = 0.0,
 ) -> EdgeRounding:
     """Round every interior edge with a cylinder tangent to both faces.
 
@@ -306,6 +317,9 @@ def round_edges(
         An edge whose fillet would be narrower than ``floor`` times the edge's length
         (strip width ``A = 2 r tan(gamma)``) is left sharp: radius 0, its faces meet at a
         straight crease folded by the dihedral angle (half angle and kappa kept). 0: none.
+    min_width : float
+        An edge whose fillet would be narrower than this (a length) is left sharp too: a
+        fillet of a short edge in a large design. 0: none.
 
     Returns
     -------
@@ -336,7 +350,8 @@ def round_edges(
         )
     r[~inner | flat] = 0.0
     kappa[flat] = 0
-    sharp = rounded & ((r == 0) | (2 * r * np.tan(gamma) < floor * mesh.edge_length))
+    width = 2 * r * np.tan(gamma)
+    sharp = rounded & ((r == 0) | (width < np.maximum(floor * mesh.edge_length, min_width)))
     r[sharp] = 0.0
     rounded &= ~sharp
     limit, given, broken, uniform = radius_limits(mesh, r, gamma)

@@ -53,6 +53,11 @@ class Tolerances:
     fillet_floor : float
         An edge whose fillet would be narrower than this share of the edge's length is left
         sharp (not rounded): a narrower strip only makes slivers.
+    min_fillet : float
+        Nor may a fillet be narrower than this share of the mesh's size (its bounding-box
+        diagonal): a short edge's fillet in a large design would give pattern edges below the
+        certificate's smallest edge (1e-7 of the design); arcs are also sampled no finer than
+        ``2 * ruling`` of the size.
     fold : float
         Smallest angle (radians; 0.6 degrees) between a straight crease's cone triangle and
         its face: the apex stays above each face's plane by at least ``sin(fold)`` times its
@@ -87,6 +92,7 @@ class Tolerances:
     closure: float = 1e-9
     validate: float = 1e-9
     fillet_floor: float = 1e-3
+    min_fillet: float = 1e-6
     fold: float = 0.0105
     ruling: float = 2e-7
     coincide: float = 1e-14

@@ -66,6 +66,7 @@ def rescue_vertices(
     apply: bool,
     flat_deg: float,
     floor: float = 0.0,
+    min_width: float = 0.0,
     apices: dict,
     classified: VertexResult | None = None,
     vertices=None,
@@ -88,7 +89,7 @@ def rescue_vertices(
         ``face_centres(mesh, rounding) -> (n_faces, 3)`` (:func:`~filletfold.module.
         face_piece_centres`).
     apply : bool
-    flat_deg, floor : float
+    flat_deg, floor, min_width : float
         Passed to :func:`~filletfold.rounding.round_edges`.
     apices : dict
         Vertex -> (apex, developed apex) of :func:`solve_apices`; updated in place
@@ -129,7 +130,9 @@ def rescue_vertices(
         radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
         for u in bad:
             factor[u] *= step
-        new_rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor)
+        new_rounding = round_edges(
+            mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width
+        )
         new_centres = face_centres(mesh, new_rounding)
         if apply:
             faces = np.unique(edge_face[edges])
