@@ -1,0 +1,47 @@
+"""The default command on real meshes (tests/data/corpus, see its SOURCES.md): what a user gets.
+
+Every mesh gives a design whose certificate holds, or a one-line error that names a defect no
+tool could repair; never a traceback. ``benchmarks/corpus.py`` prints the same corpus as a table
+(repairs, radii fitted, vertices per status, time).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from filletfold.cli import main
+
+CORPUS = Path(__file__).parent / "data" / "corpus"
+MESHES = sorted(p.name for p in CORPUS.iterdir() if p.suffix.lower() in (".obj", ".ply", ".stl"))
+#: Meshes no tool could make a surface of, and what the error says.
+REFUSED = {"compas-saddle.obj": "the file has 96 vertices but no faces"}
+
+
+def test_the_corpus_has_its_sources_and_licences():
+    sources = (CORPUS / "SOURCES.md").read_text()
+    assert len(MESHES) >= 14
+    for name in MESHES:
+        assert f"`{name}`" in sources, f"{name} is not in SOURCES.md"
+    assert (CORPUS / "LICENSE-compas.txt").is_file() and (CORPUS / "LICENSE-pyvista.txt").is_file()
+
+
+@pytest.mark.parametrize("name", MESHES)
+def test_default_command_gives_a_valid_design_or_one_line(name, tmp_path, capsys):
+    out = tmp_path / "out"
+    code = main(["round", str(CORPUS / name), "-o", str(out), "-q"])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if name in REFUSED:
+        assert code == 2 and not out.exists()
+        assert err.strip().splitlines() == [f"error: {CORPUS / name}: {REFUSED[name]}"]
+        return
+    assert code == 0, err
+    report = json.loads((out / "report.json").read_text())
+    failed = [k for k, v in report["certificate"]["checks"].items() if not v["ok"]]
+    assert report["certificate"]["ok"], f"{name}: certificate fails {failed}"
+    assert main(["check", str(out)]) == 0  # from the files alone, too
+    counts = report["status_counts"]
+    assert counts["ok"] + counts["boundary"] + counts["sharp"] > 0
