@@ -180,6 +180,10 @@ def classify_vertices(
                 "no edge at this vertex is rounded (each is flat, or left sharp because its "
                 "fillet would be a sliver): its faces meet at the vertex itself"
             )
+        elif developable[j] and _opens_with_a_near_apex(frames[k]) and b > tol.normal_bound:
+            # an angle sum only near 2 pi (float32 coordinates): rho turns a little about a
+            # point near the vertex, which is the developed apex of an ordinary cone
+            res.kind[u] = "cone"
         elif developable[j]:
             frame = frames[k]
             res.kind[u] = "developable"
@@ -202,6 +206,24 @@ def classify_vertices(
         else:
             res.kind[u] = "cone"
     return frames
+
+
+def _opens_with_a_near_apex(frame: VertexFrame) -> bool:
+    """Whether a closed ring whose angle sum is within ``tol.developable`` of 2 pi still does
+    not close: ``rho`` moves its points by more than ``tol.closure`` of its sides (the turn
+    included, not only the translation), while turning about a point within ten times its
+    longest side (a well-placed developed apex). Treating such a vertex as closed would leave
+    its rulings unequal by the development's gap."""
+    q, t = frame.rho[:2, :2], frame.rho[:2, 2]
+    turn = abs(float(np.arctan2(q[1, 0], q[0, 0])))
+    length = frame.arrays.length
+    reach = float(length.max())
+    if float(np.linalg.norm(t)) + turn * reach <= tol.closure * float(length.mean()):
+        return False  # closed: a developable vertex
+    a = np.eye(2) - q
+    if abs(np.linalg.det(a)) < 1e-300:
+        return False
+    return float(np.linalg.norm(np.linalg.solve(a, t))) <= 10 * reach
 
 
 def classify_vertex(
