@@ -354,3 +354,20 @@ def test_errors_of_a_file_name_the_file(tmp_path):
     with pytest.raises(MeshError, match=rf"^{re.escape(str(bad))}: ") as info:
         load_mesh(str(bad))
     assert "vertex 7" in str(info.value) or "face 0" in str(info.value)
+
+
+def test_a_ply_cut_short_is_refused(tmp_path):
+    """trimesh reads a PLY whose face list stops early without complaint: the header's counts
+    show it, and the file is refused rather than rounded incomplete."""
+    text = (
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n"
+    )
+    cut = tmp_path / "cut.ply"
+    cut.write_text(text)
+    with pytest.raises(MeshReadError, match=r"cut\.ply: the file ends early: its header declares"):
+        read_mesh(cut)
+    whole = tmp_path / "whole.ply"
+    whole.write_text(text + "3 1 2 3\n3 0 3 2\n")
+    assert len(read_mesh(whole)[1]) == 4

@@ -270,7 +270,31 @@ def _read_trimesh(p: Path, name: str, ext: str) -> tuple[np.ndarray, list[np.nda
                 f"{name}: no vertices or faces found (empty or unreadable {ext[1:].upper()} file)"
             )
         raise MeshReadError(f"{name}: the file has {len(vertices)} vertices but no faces")
+    if ext == ".ply":
+        _check_ply_counts(p, name, len(vertices), len(faces))
     return vertices.reshape(-1, 3), list(faces)
+
+
+def _check_ply_counts(p: Path, name: str, n_vertices: int, n_faces: int) -> None:
+    """Refuse a PLY file that holds fewer vertices or faces than its header declares (a file
+    cut short, which trimesh reads without a word): the mesh would be silently incomplete.
+    Polygons come back as triangles, so there may be more faces, not fewer."""
+    with p.open("rb") as fh:
+        head = fh.read(1 << 16)
+    end = head.find(b"end_header")
+    if end < 0:
+        return
+    declared = {}
+    for line in head[:end].decode("ascii", "replace").splitlines():
+        words = line.split()
+        if len(words) == 3 and words[0] == "element" and words[2].isdigit():
+            declared[words[1]] = int(words[2])
+    want_v, want_f = declared.get("vertex"), declared.get("face")
+    if (want_v is not None and n_vertices < want_v) or (want_f is not None and n_faces < want_f):
+        raise MeshReadError(
+            f"{name}: the file ends early: its header declares {want_v} vertices and {want_f} "
+            f"faces, {n_vertices} and {n_faces} were read"
+        )
 
 
 # ---------------------------------------------------------------------------------- writers
