@@ -993,7 +993,9 @@ class Outcome:
     traceback : str
         The formatted traceback of a ``"traceback"`` (or ``"timeout"``); empty otherwise.
     where : str
-        ``file:line in function`` of the innermost frame of a ``"traceback"``.
+        Where a ``"traceback"`` was raised: ``file:line in function`` of the innermost
+        filletfold frame, then ``-> file:line in function`` of the raising frame when that is
+        in another package.
     stage : str
         ``"round"`` or, for an exception raised while certifying a design, ``"certify"``.
     certified : bool or None
@@ -1090,17 +1092,31 @@ def failed_checks(certificate) -> tuple[str, ...]:
 
 
 def _innermost(exc: BaseException) -> str:
-    tb = traceback.extract_tb(exc.__traceback__)
-    if not tb:
+    """``file:line in function`` of the innermost filletfold frame of a traceback, followed by
+    ``-> file:line in function`` of the frame that raised when that is another one (numpy's,
+    shapely's...); paths from the package or ``site-packages`` on."""
+
+    def where(frame) -> str:
+        path = frame.filename.replace("\\", "/")
+        for marker in ("site-packages/", "/src/"):
+            if marker in path:
+                path = path[path.rfind(marker) + len(marker) :]
+                break
+        return f"{path}:{frame.lineno} in {frame.name}"
+
+    frames = traceback.extract_tb(exc.__traceback__)
+    if not frames:
         return ""
-    frame = tb[-1]
-    path = frame.filename
-    cut = path.rfind("filletfold/")
-    if cut >= 0:
-        path = path[cut:]
-    elif "site-packages/" in path:
-        path = path[path.rfind("site-packages/") + len("site-packages/") :]
-    return f"{path}:{frame.lineno} in {frame.name}"
+    ours = [
+        f
+        for f in frames
+        if "filletfold" in f.filename.replace("\\", "/").split("/site-packages/")[-1]
+        and "/testing/" not in f.filename.replace("\\", "/")
+    ]
+    raised = where(frames[-1])
+    if not ours or ours[-1] is frames[-1]:
+        return raised
+    return f"{where(ours[-1])} -> {raised}"
 
 
 def run_case(case: FuzzCase, tmpdir=None, *, timeout: float | None = None, **round_kwargs):
