@@ -203,12 +203,13 @@ def main(argv=None) -> int:
             if o.certified is False:
                 print(f"{o.name}: failing {', '.join(o.failed_checks) or '(no check named)'}")
             else:
-                print(f"{o.name}: {o.error_type or o.outcome}: {o.message.splitlines()[0]!s}")
+                first = (o.message.splitlines() or [""])[0]
+                print(f"{o.name}: {o.error_type or o.outcome}: {first}")
 
     refusals = [o for o in outcomes if o.outcome in ("error", "error-multiline")]
     groups = collections.defaultdict(list)
     for o in refusals:
-        groups[(o.error_type, normalise(o.message.splitlines()[0], o.file))].append(o)
+        groups[(o.error_type, normalise((o.message.splitlines() or [""])[0], o.file))].append(o)
     ranked = sorted(groups.items(), key=lambda g: -len(g[1]))
     print(f"\n## refusals: {len(refusals)} in {len(groups)} groups; the {args.show} largest")
     for (etype, text), os_ in ranked[: args.show]:
