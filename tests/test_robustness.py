@@ -1,4 +1,4 @@
-"""Robustness of ``round_mesh`` on the first 300 fuzz cases of seed 0 (filletfold.testing).
+"""Robustness of ``round_mesh`` on the first 200 fuzz cases of seed 0 (filletfold.testing).
 
 Meshes as users bring them (scaled, far away, flipped, soups, holes, duplicates, zero-area and
 non-manifold pieces, non-planar quads, float32, integer grids) must give a design or one
@@ -16,14 +16,14 @@ from filletfold.testing import KINDS, case_by_name, fuzz_cases, run_case
 from filletfold.testing.fuzz import certifier
 from filletfold.vertex import batch
 
-N_CASES = 300
+N_CASES = 200
 #: Seconds one case may take before it counts as a time-out (they take well under one).
 TIMEOUT = 60.0
 
 
 @pytest.fixture(scope="module")
 def outcomes(tmp_path_factory):
-    """The outcomes of the first 300 cases of seed 0, run once for this file (the numpy
+    """The outcomes of the first 200 cases of seed 0, run once for this file (the numpy
     interior-point method, as in every other test: see conftest.py)."""
     folder = tmp_path_factory.mktemp("fuzz")
     with pytest.MonkeyPatch.context() as mp:
