@@ -622,3 +622,13 @@ def test_faces_back_to_back_are_refused_naming_the_edge():
     with pytest.raises(MeshError, match=r"lie back to back along edge") as info:
         clean_mesh(np.vstack([v, t]), tris + [np.array(x) + 8 for x in tri])
     assert info.value.edge is not None
+
+
+def test_a_mesh_too_small_for_where_it_lies_is_refused():
+    """Scaled by 1e-6 and moved by 1e6, a cube's coordinates are resolved to 1.2e-10, 1e-4 of
+    its size: no tolerance of the pipeline could hold; moved by 1e6 only, it is fine."""
+    v, faces = cube()
+    with pytest.raises(MeshError, match=r"double precision resolves its coordinates only"):
+        clean_mesh(v * 1e-6 + 1e6, faces)
+    mesh, _ = clean_mesh(v + 1e6, faces)
+    assert mesh.n_faces == 6

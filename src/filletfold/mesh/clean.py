@@ -144,6 +144,8 @@ def clean_mesh(
     # 2. faces on vertices with a non-finite coordinate
     face_list, face_origin = _drop_non_finite(v, face_list, face_origin, log)
 
+    _check_resolution(v, face_list)
+
     # 3. weld close vertices, then fix face loops and zero-area faces
     rep = _close_vertex_representatives(v, face_list, log)
     merged_vertices = n_input - len(np.unique(rep))
@@ -337,6 +339,24 @@ def _drop_non_finite(v: np.ndarray, face_list, face_origin, log: RepairLog):
         )
     face_list = [f for f, k in zip(face_list, keep, strict=True) if k]
     return face_list, face_origin[np.asarray(keep)]
+
+
+def _check_resolution(v: np.ndarray, face_list) -> None:
+    """Refuse a mesh that double precision cannot resolve where it lies: one so small for its
+    distance from the origin that its coordinates resolve less than ``tol.planar`` of its size
+    (a millimetre model at a thousand kilometres), or whose used vertices all coincide."""
+    used = v[np.unique(np.concatenate(face_list))]
+    size = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    far = float(np.abs(used).max())
+    step = np.spacing(far) if far > 0 else 0.0
+    if size == 0:
+        raise MeshError(f"all the vertices of the mesh's faces are at one point {used[0].tolist()}")
+    if step > tol.planar * size:
+        raise MeshError(
+            f"the mesh is {size:.3g} across at {far:.3g} from the origin: double precision "
+            f"resolves its coordinates only to {step:.2g} there ({step / size:.2g} of its "
+            "size); move it nearer the origin or scale it up"
+        )
 
 
 def _close_vertex_representatives(v: np.ndarray, face_list, log: RepairLog) -> np.ndarray:
