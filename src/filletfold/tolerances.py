@@ -21,7 +21,8 @@ class Tolerances:
         Vertices closer than ``weld * bbox_diagonal`` are welded on input (a reported repair).
     degenerate : float
         A face whose height over its longest edge is below ``degenerate`` times that edge has
-        (almost) zero area: it is removed on input.
+        (almost) zero area (a corner under 1e-6 rad, or within it of straight): it is removed
+        on input, its middle vertex put into the face across that edge.
     collinear : float
         A polygon corner within this angle (radians) of straight is straight on input: the
         coordinates' own noise (float32 in an STL is 6e-8 of the size) bends a straight
@@ -79,7 +80,7 @@ class Tolerances:
 
     merge: float = 1e-9
     weld: float = 1e-6
-    degenerate: float = 1e-9
+    degenerate: float = 1e-6
     collinear: float = 1e-6
     straight: float = 0.0175  # 1 degree
     planar: float = 1e-6
