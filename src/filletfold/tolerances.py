@@ -33,6 +33,11 @@ class Tolerances:
         removable.
     planar : float
         A polygon face is planar when every vertex is within ``planar * face_size`` of its plane.
+    flat : float
+        A polygon is planar to round-off once its corners are within ``flat`` of its diameter
+        from its plane after its vertices were moved onto the planes (a polygon that stays
+        further out is triangulated): planes off by more part a development's 2D and 3D
+        lengths by as much (9e-13 on a float32 quad torus).
     area : float
         A face with area below ``area * mean_edge_length**2`` is degenerate.
     coplanar_deg : float
@@ -84,6 +89,7 @@ class Tolerances:
     collinear: float = 1e-6
     straight: float = 0.0175  # 1 degree
     planar: float = 1e-6
+    flat: float = 1e-14
     area: float = 1e-12
     coplanar_deg: float = 1e-3
     angle: float = 1e-9

@@ -228,7 +228,7 @@ def clean_mesh(
     # 9. planarity: exact (to round-off) where the polygons are planar within the tolerance
     if not strict:
         v, residual = planarize(face_list, v, log)
-        rest = np.flatnonzero(residual > 1e-12)
+        rest = np.flatnonzero(residual > tol.flat)
         if len(rest):  # polygons the planes of their neighbours do not let be planar
             face_list, face_origin = triangulate_faces(
                 face_list,

@@ -601,7 +601,7 @@ def triangulate_faces(faces, origin, v, which, log: RepairLog, why, error):
 
 
 # ------------------------------------------------------------------------- exact planes
-def planarize(faces, v, log: RepairLog, *, rounds: int = 60, rel: float = 1e-13):
+def planarize(faces, v, log: RepairLog, *, rounds: int = 8, rel: float = 1e-15):
     """Move vertices onto the planes of their polygons, so every polygon of more than three
     corners is planar to round-off (not only within ``tol.planar``).
 
@@ -609,8 +609,11 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 60, rel: float = 1e-13)
     leaves its edges a little out of its plane, and the development's gluing maps are then
     not rigid at the square of that angle: ruling lengths in 2D and 3D part by ~1e-11 where
     1e-16 is due. Each round fits every polygon's plane (Newell normal through the centroid)
-    and moves every vertex by the least-squares step onto the planes of its polygons, until
-    every corner is within ``rel`` of its polygon's diameter from the plane.
+    and moves the vertices by the smallest joint step that puts every corner on its polygon's
+    plane, the normals held (:func:`_plane_step`; a vertex's own least-squares step, round by
+    round, converged too slowly on a quad torus in float32); the step is first order in the
+    deviation, so two or three rounds bring every corner within ``rel`` of its polygon's
+    diameter from the plane.
 
     Parameters
     ----------
@@ -626,7 +629,7 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 60, rel: float = 1e-13)
         The moved vertices (a copy; ``v`` itself when nothing moved).
     residual : (n_faces,) float
         Each polygon's largest corner distance from its plane over its diameter, afterwards
-        (0 for triangles).
+        (0 for triangles, and where it is within the rounding of the coordinates).
     """
     poly = np.flatnonzero(np.fromiter(map(len, faces), dtype=np.int64, count=len(faces)) > 3)
     residual = np.zeros(len(faces))
@@ -640,38 +643,29 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 60, rel: float = 1e-13)
     nxt[start[1:] - 1] = start[:-1]
     x = v.copy()
     diam = np.maximum.reduceat(np.linalg.norm(x[idx] - x[idx[nxt]], axis=1), start[:-1])
-    cap = None  # how far each vertex may move: 4 x its polygons' largest initial deviation
-    for _ in range(rounds):
+    def deviation(x):
         p = x[idx]
         c = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
         q = p - c[face]
         n = np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)
         n /= np.linalg.norm(n, axis=1)[:, None]
         d = np.einsum("ij,ij->i", q, n[face])  # signed distance of each corner
-        dev = np.maximum.reduceat(np.abs(d), start[:-1]) / diam
-        if cap is None:
-            cap = np.zeros(len(x))
-            np.maximum.at(cap, idx, 4 * (dev * diam)[face])
-        if dev.max() <= rel:
+        return n, d, np.maximum.reduceat(np.abs(d), start[:-1]) / diam
+
+    n, d, dev = deviation(x)
+    cap = 16.0 * float((dev * diam).max())  # how far a vertex may move
+    # what the coordinates' own rounding leaves (a mesh far from the origin)
+    floor = 8.0 * np.finfo(float).eps * float(np.abs(x[idx]).max()) / diam
+    for _ in range(rounds):
+        if (dev <= np.maximum(rel, floor)).all():
             break
-        nf = n[face]
-        a = np.zeros((len(x), 3, 3))
-        b = np.zeros((len(x), 3))
-        np.add.at(a, idx, nf[:, :, None] * nf[:, None, :])
-        np.add.at(b, idx, -d[:, None] * nf)
-        used = np.unique(idx)
-        step = np.linalg.solve(a[used] + 1e-9 * np.eye(3), b[used][..., None])[..., 0]
-        x[used] += step
+        x = x + _plane_step(idx, face, n, d, len(x), len(poly))
+        n, d, dev = deviation(x)
     far = np.linalg.norm(x - v, axis=1) > cap  # not a small correction: leave those be
     if far.any():
         x[far] = v[far]
-        p = x[idx]
-        c = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
-        q = p - c[face]
-        n = np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)
-        n /= np.linalg.norm(n, axis=1)[:, None]
-        dev = np.maximum.reduceat(np.abs(np.einsum("ij,ij->i", q, n[face])), start[:-1]) / diam
-    residual[poly] = dev
+        dev = deviation(x)[2]
+    residual[poly] = np.where(dev <= floor, 0.0, dev)
     moved = np.linalg.norm(x - v, axis=1)
     if moved.max() > 0:
         box = np.ptp(v[np.unique(idx)], axis=0)
@@ -685,3 +679,19 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 60, rel: float = 1e-13)
         )
         return x, residual
     return v, residual
+
+
+def _plane_step(idx, face, n, d, n_vertices: int, n_faces: int) -> np.ndarray:
+    """(n_vertices, 3) float: the least-norm moves ``dx`` of the vertices, with a shift ``dh``
+    of each plane along its normal, such that ``n_f . dx_i - dh_f = -d`` at every corner
+    ``(i, f)`` (corner ``idx``, polygon ``face``, unit normals ``n``, signed distances ``d``)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import lsqr
+
+    m = len(idx)
+    rows = np.repeat(np.arange(m), 4)
+    cols = np.stack([3 * idx, 3 * idx + 1, 3 * idx + 2, 3 * n_vertices + face], axis=1).ravel()
+    vals = np.concatenate([n[face], -np.ones((m, 1))], axis=1).ravel()
+    a = sp.csr_matrix((vals, (rows, cols)), shape=(m, 3 * n_vertices + n_faces))
+    sol = lsqr(a, -d, atol=1e-16, btol=1e-16, iter_lim=20 * (3 * n_vertices + n_faces))[0]
+    return sol[: 3 * n_vertices].reshape(-1, 3)
