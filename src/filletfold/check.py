@@ -741,7 +741,8 @@ def _overlap(g: _Data) -> list[Check]:
     valid = convex.copy()
     valid[~convex] = shapely.is_valid(polys[~convex])
     n_pairs = n_measured = n_over = 0
-    value, worst_pair = 0.0, None
+    value, value_limit, worst_pair = 0.0, OVERLAP_TOL, None
+    perimeter = np.add.reduceat(np.linalg.norm(g.v2[g.flat[g.nxt]] - p, axis=1), g.start[:-1])
     for first in range(0, n_faces, QUERY_CHUNK):
         i, j = tree.query(boxes[first : first + QUERY_CHUNK])
         i += first
@@ -765,11 +766,18 @@ def _overlap(g: _Data) -> list[Check]:
         with np.errstate(invalid="ignore", divide="ignore"):
             ratio = np.where(smaller > 0, shared / smaller, np.where(shared > 0, np.inf, 0.0))
         ratio = np.where(np.isnan(ratio), np.inf, ratio)
+        # moving every corner by up to sqrt(2) q moves each border by as much: the shared
+        # area grows by at most that times the two perimeters
+        with np.errstate(invalid="ignore", divide="ignore"):
+            allowed = OVERLAP_TOL + np.where(
+                smaller > 0, math.sqrt(2.0) * g.q * (perimeter[i] + perimeter[j]) / smaller, 0.0
+            )
         n_measured += len(ratio)
-        n_over += int(np.count_nonzero(ratio > OVERLAP_TOL))
-        k = int(np.argmax(ratio))
-        if ratio[k] > value:
-            value, worst_pair = float(ratio[k]), (int(i[k]), int(j[k]))
+        n_over += int(np.count_nonzero(ratio > allowed))
+        k = int(np.argmax(ratio / allowed))
+        if worst_pair is None or ratio[k] / allowed[k] > value / value_limit:
+            value, value_limit = float(ratio[k]), float(allowed[k])
+            worst_pair = (int(i[k]), int(j[k]))
     detail = f"{n_pairs} touching or close face pairs, {n_measured} measured"
     worst = {}
     if worst_pair is not None:
@@ -787,8 +795,10 @@ def _overlap(g: _Data) -> list[Check]:
         "no overlap",
         bool(not n_over and not len(invalid)),
         value,
-        OVERLAP_TOL,
-        detail + f"; shared area / smaller face {OVERLAP_TOL:g}",
+        value_limit,
+        detail
+        + f"; shared area / smaller face {OVERLAP_TOL:g}"
+        + _quantum_note(g.q, f"{OVERLAP_TOL:g} + sqrt(2) q (P_a + P_b) / A", g.q_source),
         "<=",
         worst,
     )
