@@ -96,7 +96,9 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
 
     A radius is valid when, at every face corner, the two tangent lines cross before the
     midpoint cross-sections of both edges (``l_max > 0`` on both), so that every face keeps a
-    flat piece and every cylinder keeps its midpoint base curve. At a corner with angle
+    flat piece and every cylinder keeps its midpoint base curve; on an unrounded edge they
+    cross ``4 tol.ruling`` of the mesh's size before it (a quarter of the edge at most), or its
+    line on the face would be a sliver of the pattern. At a corner with angle
     ``alpha`` and tangent-line offsets ``d_e = r_e tan(gamma_e)``, the crossing T lies at
     ``x_e = (d_g + d_e cos(alpha)) / sin(alpha)`` along edge ``e`` from the corner.
 
@@ -121,6 +123,7 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
         Largest radius that is valid when used on every rounded edge.
     """
     e_out, e_in, alpha = _corner_table(mesh)
+    sliver = 4.0 * tol.ruling * float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))
     tan_g = np.tan(half_angle)
     rounded = edge_radius > 0
     length = mesh.edge_length
@@ -155,8 +158,10 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
                 np.minimum.at(limit, e, r_uni)
             x_e = (offset[g] + offset[e] * cos) / sin
             # an unrounded edge (boundary, flat, sharp) keeps a face piece only if its rounded
-            # neighbours' tangent lines cross it before its midpoint too
-            over = (rounded[e] | rounded[g]) & (x_e > 0.5 * length[e] * (1 + 1e-12))
+            # neighbours' tangent lines cross it before its midpoint too, and far enough
+            # before it that its line there is no sliver edge of the pattern
+            room = np.where(rounded[e], -1e-12 * length[e], np.minimum(sliver, 0.25 * length[e]))
+            over = (rounded[e] | rounded[g]) & (x_e > 0.5 * length[e] - room)
             broken[e[over & rounded[e]]] = True
             broken[g[over & rounded[g]]] = True
     return limit, given, broken, float(limit.min(initial=np.inf))
