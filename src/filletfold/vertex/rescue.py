@@ -116,20 +116,26 @@ def rescue_vertices(
     radius = rounding.radius.copy()
     start = radius.copy()
     factor = {u: 1.0 for u in bad}
+    tries = {u: 0 for u in bad}  # each vertex is halved ROUNDS times, then left sharp (apply)
     trial = VertexResult.empty(mesh.n_vertices) if not apply else None
     edge_face = mesh.edge_faces
-    steps = [0.5] * ROUNDS + ([0.0] if apply else [])  # halve; at last leave them sharp
-    for round_, step in enumerate(steps):
+    for _ in range(2 * ROUNDS + 2):  # vertices made infeasible by a change join later rounds
+        if not apply:
+            bad = [u for u in bad if tries[u] < ROUNDS]
         if not bad:
             break
-        edges = np.unique(np.concatenate([frames[u].ring.edges for u in bad]))
-        edges = edges[radius[edges] > 0]
+        scale = np.ones(len(radius))
+        for u in bad:
+            step = 0.5 if tries[u] < ROUNDS else 0.0  # halve; at last leave them sharp
+            e = frames[u].ring.edges
+            scale[e] = np.minimum(scale[e], step)
+            factor[u] *= step
+            tries[u] += 1
+        edges = np.flatnonzero((scale < 1) & (radius > 0))
         if not len(edges):
             break
-        radius[edges] *= step
+        radius[edges] *= scale[edges]
         radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
-        for u in bad:
-            factor[u] *= step
         new_rounding = round_edges(
             mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width
         )
@@ -154,7 +160,7 @@ def rescue_vertices(
             target,
             new_centres,
             vertices=todo,
-            thorough=round_ >= ROUNDS - 1,  # the hard cases' fallbacks at the last factor
+            thorough=max(tries[u] for u in bad) >= ROUNDS,  # the fallbacks at the last factor
             size=mesh_size(mesh),
         )
         if apply:
@@ -176,11 +182,16 @@ def rescue_vertices(
                     "and its faces meet at the vertex itself"
                 )
                 bad.remove(u)
-        if apply:  # neighbours made infeasible by the change join the next round
+        if apply:  # vertices made infeasible by the change (rescued ones too) join again
             for u in _infeasible(res):
-                if u not in out.rescued and u not in factor:
-                    factor[u] = 1.0
-                    bad.append(u)
+                if u in bad:
+                    continue
+                if u in out.rescued:
+                    del out.rescued[u]
+                else:
+                    factor.setdefault(u, 1.0)
+                    tries.setdefault(u, 0)
+                bad.append(u)
     factor_of = {u: f for u, f in factor.items() if u not in out.rescued}
     for u, f in factor_of.items():
         if res.status[u] == "infeasible":
