@@ -1049,9 +1049,7 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     start = np.concatenate([[0], np.cumsum(size)])
     faces = FaceRows(flat, start)  # (k,) int64 rows made when asked for
     patches = list(itertools.chain.from_iterable(piece.patches for piece in pieces))
-    apex = np.array(
-        [-1 if p.apex_index is None else p.apex_index for p in pieces], dtype=np.int64
-    )
+    apex = np.array([-1 if p.apex_index is None else p.apex_index for p in pieces], dtype=np.int64)
     apex = np.where(apex >= 0, apex + base, -1) if pieces else apex
     true_rulings(v2, v3, flat, size, np.repeat(apex, n_faces), patches)
     return CreasePattern(

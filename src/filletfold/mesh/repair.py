@@ -643,6 +643,7 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 8, rel: float = 1e-15):
     nxt[start[1:] - 1] = start[:-1]
     x = v.copy()
     diam = np.maximum.reduceat(np.linalg.norm(x[idx] - x[idx[nxt]], axis=1), start[:-1])
+
     def deviation(x):
         p = x[idx]
         c = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
