@@ -41,8 +41,9 @@ from filletfold.export.paths import (
     simplify_polyline,
     tab_cut_paths,
 )
-from filletfold.export.pdf import MAX_PAGES, REGION_PAD_MM, page_size_mm, pdf_tiles
+from filletfold.export.pdf import MAX_PAGES, REGION_PAD_MM, pdf_tiles
 from filletfold.pattern import Annotations, CreasePattern, Label
+from filletfold.units import sheet_size_mm
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -414,14 +415,14 @@ def test_pdf_of_the_cube_design(cube):
     ],
 )
 def test_page_sizes(page, size):
-    assert page_size_mm(page) == size
+    assert sheet_size_mm(page, name="page") == size
 
 
 @pytest.mark.parametrize(
     ("kw", "match"),
     [
         ({"page": "B5"}, "page must be one of"),
-        ({"page": "0x100"}, "page must be one of"),
+        ({"page": "0x100"}, "page size must be positive"),
         ({"page": 4}, "page must be a string"),
         ({"units": ""}, "units must be one of"),
         ({"scale": 0}, "scale must be a positive number"),
@@ -734,7 +735,7 @@ def test_cli_export_writes_the_cut_files(cube, tmp_path, capsys):
         (["--format", "json"], "cannot be written from design.fold"),
         (["--units", "ft"], "units must be one of"),
         (["--scale", "0"], "scale must be a positive number"),
-        (["--sheet", "B5"], "page must be one of"),
+        (["--sheet", "B5"], "sheet must be one of"),
     ],
 )
 def test_cli_export_bad_options(args, match, tmp_path, capsys):

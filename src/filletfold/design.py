@@ -548,7 +548,8 @@ def round_mesh(
     MeshError
         Unreadable or invalid mesh.
     ParameterError
-        Invalid radius, depth, samples or arc step (a radius over an edge's limit names the edge).
+        Invalid radius, depth, samples, arc step or sheet (a radius over an edge's limit names
+        the edge).
     SolverError
         With ``material_loss``: the programme has no solution with positive losses (the
         message names the binding vertices and edges); with ``layout="sheet"``: the modules do
@@ -575,6 +576,8 @@ def round_mesh(
             f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
             name="coplanar_deg",
         )
+    if sheet is not None:
+        sheet_in_pattern_units(sheet, units, scale)  # refuse a bad sheet before the solve
     progress = callers_progress(progress)
     strict = bool(strict)
     clamp = (not strict) if clamp is None else bool(clamp)

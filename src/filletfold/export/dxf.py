@@ -38,12 +38,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..pattern import CreasePattern
+from ..units import check_units
 from .fold import validate_pattern
 from .paths import chain_runs, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 
 __all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
 
-#: ``$INSUNITS`` code of each drawing unit ("" = unitless).
+#: ``$INSUNITS`` code of each drawing unit ("" = unitless): of every cut-file unit.
 DXF_INSUNITS = {"": 0, "in": 1, "mm": 4, "cm": 5, "m": 6}
 #: ACI colour of each layer, in the order the layers are created.
 LAYER_COLOR = {"CUT": 7, "MOUNTAIN": 1, "VALLEY": 5, "TAB": 3, "LABEL": 8, "FLAT": 9}
@@ -93,11 +94,7 @@ def pattern_dxf(
     """
     import ezdxf
 
-    if units not in DXF_INSUNITS:
-        raise ParameterError(
-            f"units must be one of {', '.join(u for u in DXF_INSUNITS if u)} or '', got {units!r}",
-            name="units",
-        )
+    check_units(units, unitless=True)
     scale = check_scale(scale)
     validate_pattern(pattern)
 

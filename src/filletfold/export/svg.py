@@ -22,13 +22,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..pattern import CreasePattern
+from ..units import MM_PER_UNIT, check_units
 from .fold import validate_pattern
 from .paths import pattern_extent, tab_cut_paths
 
 __all__ = [
     "ASSIGNMENT_COLOR",
     "LABEL_COLOR",
-    "MM_PER_UNIT",
     "SHEET_COLOR",
     "TAB_HINGE_COLOR",
     "nice_length",
@@ -44,8 +44,6 @@ _GROUPS = (
     ("V", "valley", "valley"),
     ("M", "mountain", "mountain"),
 )
-#: Millimetres per pattern length unit, for the units :func:`pattern_svg` accepts.
-MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "pt": 25.4 / 72.0}
 #: Printed size (mm) of the larger side of the drawing when no unit is given.
 _UNITLESS_MM = 200.0
 _MARGIN_MM = 10.0
@@ -140,10 +138,7 @@ def pattern_svg(
     ExportError
         When the pattern is inconsistent.
     """
-    if units and units not in MM_PER_UNIT:
-        raise ParameterError(
-            f"units must be one of {', '.join(MM_PER_UNIT)} or '', got {units!r}", name="units"
-        )
+    check_units(units, MM_PER_UNIT, unitless=True)
     if not (isinstance(stroke_mm, int | float) and math.isfinite(stroke_mm) and stroke_mm > 0):
         raise ParameterError(
             f"stroke_mm must be a positive number, got {stroke_mm!r}", name="stroke_mm"
