@@ -9,6 +9,7 @@ import json
 import math
 import re
 import xml.etree.ElementTree as ET
+import zlib
 
 import ezdxf
 import numpy as np
@@ -33,6 +34,7 @@ from filletfold.export import (
 )
 from filletfold.export.cutfiles import ALL_FORMATS, fit_page_scale, scaled_pattern
 from filletfold.export.dxf import LAYER_COLOR
+from filletfold.export.palette import ASSIGNMENT_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
 from filletfold.export.paths import (
     SPLINE_MIN_POINTS,
     chain_is_smooth,
@@ -769,3 +771,33 @@ def test_cli_round_bad_format_fails_before_solving(tmp_path, capsys):
     assert main(["round", "cube", "-o", str(tmp_path / "x"), "--format", "fold,stl"]) == 2
     assert "unknown format 'stl'" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+# ---------------------------------------------------------------- one palette
+
+
+def pdf_stroke_colors(data: bytes) -> set[str]:
+    """Stroke colours (``#rrggbb``) set in the content streams of a PDF."""
+    colors = set()
+    for raw in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, flags=re.S):
+        try:
+            text = zlib.decompress(raw).decode("latin-1")
+        except zlib.error:
+            continue
+        for rgb in re.findall(r"(?:([\d.]+) ([\d.]+) )?([\d.]+) (?:RG|G)\b", text):
+            rgb = rgb if rgb[0] else (rgb[2],) * 3  # "x G" is grey x
+            colors.add("#" + "".join(f"{round(float(c) * 255):02x}" for c in rgb))
+    return colors
+
+
+def test_svg_and_pdf_draw_with_one_palette(cube):
+    svg = pattern_svg(cube.pattern)
+    pdf = pattern_pdf(cube.pattern, scale=20.0)
+    present = set(cube.pattern.edge_assignment) - {"F"}
+    assert {"M", "B"} <= present
+    used = {ASSIGNMENT_COLOR[a] for a in present} | {TAB_HINGE_COLOR}
+    assert used <= pdf_stroke_colors(pdf)
+    for a in present:
+        assert f'stroke="{ASSIGNMENT_COLOR[a]}"' in svg, a
+    assert f'stroke="{TAB_HINGE_COLOR}"' in svg
+    assert f'fill="{LABEL_COLOR}"' in svg

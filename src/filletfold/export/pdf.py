@@ -29,6 +29,7 @@ from ..pattern import CreasePattern
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
 from .fold import validate_pattern
+from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 from .svg import nice_length
 
@@ -42,10 +43,6 @@ _PT_PER_MM = 72.0 / 25.4
 _LINE_MM = 0.25
 _MARK_MM = 5.0
 _FONT_PT = 8.0
-_COLORS = {"CUT": "#000000", "MOUNTAIN": "#ff0000", "VALLEY": "#0000ff", "FLAT": "#cccccc"}
-_HINGE = "#00a000"
-_SHEET = "#999999"
-_LABEL = "#404040"
 _FRAME = "#b0b0b0"
 
 
@@ -273,11 +270,11 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
     clip = Rectangle((margin, margin), tw, th, transform=ax.transData, fill=False)
     lw = _LINE_MM * _PT_PER_MM
     styles = [
-        ("SHEET", _SHEET, 0.5 * lw, "solid"),
-        ("CUT", _COLORS["CUT"], lw, "solid"),
-        ("VALLEY", _COLORS["VALLEY"], lw, "solid"),
-        ("MOUNTAIN", _COLORS["MOUNTAIN"], lw, "solid"),
-        ("TAB", _HINGE, lw, (0, (4, 3))),
+        ("SHEET", SHEET_COLOR, 0.5 * lw, "solid"),
+        ("CUT", ASSIGNMENT_COLOR["B"], lw, "solid"),
+        ("VALLEY", ASSIGNMENT_COLOR["V"], lw, "solid"),
+        ("MOUNTAIN", ASSIGNMENT_COLOR["M"], lw, "solid"),
+        ("TAB", TAB_HINGE_COLOR, lw, (0, (4, 3))),
     ]
     for layer, color, width_pt, style in styles:
         lines = _in_box(layers.get(layer, []), tile.box)
@@ -301,7 +298,7 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
             ha="center",
             va="center",
             fontsize=max(h * _PT_PER_MM / 0.72, 1.0),
-            color=_LABEL,
+            color=LABEL_COLOR,
         )
         t.set_clip_path(clip)
     ax.add_patch(

@@ -24,19 +24,11 @@ from ..errors import ParameterError
 from ..pattern import CreasePattern
 from ..units import MM_PER_UNIT, check_units
 from .fold import validate_pattern
+from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import pattern_extent, tab_cut_paths
 
-__all__ = [
-    "ASSIGNMENT_COLOR",
-    "LABEL_COLOR",
-    "SHEET_COLOR",
-    "TAB_HINGE_COLOR",
-    "nice_length",
-    "pattern_svg",
-]
+__all__ = ["nice_length", "pattern_svg"]
 
-#: Stroke colour of each edge assignment.
-ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
 #: Group id and legend label of each edge assignment, in drawing order (bottom first).
 _GROUPS = (
     ("F", "flat", "flat"),
@@ -49,10 +41,6 @@ _UNITLESS_MM = 200.0
 _MARGIN_MM = 10.0
 _FONT_MM = 3.5
 _SWATCH_MM = 8.0
-#: Colours of the annotations.
-TAB_HINGE_COLOR = "#00a000"
-SHEET_COLOR = "#999999"
-LABEL_COLOR = "#404040"
 
 
 def nice_length(target: float) -> float:
