@@ -701,9 +701,17 @@ def test_export_design_all_formats(cube, tmp_path):
         "pattern.png",
         "preview.png",
         "assembly.txt",
+        "timings.json",
     ]
     written = export_design(cube, tmp_path / "some", formats="dxf,json")
-    assert [p.name for p in written] == ["report.json", "pattern.dxf", "assembly.txt"]
+    assert [p.name for p in written] == [
+        "report.json",
+        "pattern.dxf",
+        "assembly.txt",
+        "timings.json",
+    ]
+    written = export_design(cube, tmp_path / "dxf", formats="dxf")
+    assert [p.name for p in written] == ["pattern.dxf", "assembly.txt"]
 
 
 # ---------------------------------------------------------------- CLI
@@ -762,7 +770,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 9 files" in capsys.readouterr().out
+    assert "wrote 10 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 
@@ -801,3 +809,4 @@ def test_svg_and_pdf_draw_with_one_palette(cube):
         assert f'stroke="{ASSIGNMENT_COLOR[a]}"' in svg, a
     assert f'stroke="{TAB_HINGE_COLOR}"' in svg
     assert f'fill="{LABEL_COLOR}"' in svg
+

@@ -233,7 +233,7 @@ class Design:
     pattern : CreasePattern
     pieces : list of Piece
     timings : dict of str to float
-        Seconds per stage.
+        Seconds per stage (written to ``timings.json``, not to the report).
     source : str
         What the mesh came from (path or example name).
     material_loss : MaterialLoss or None
@@ -315,7 +315,8 @@ class Design:
         folder : str or Path
         title : str, optional
         formats : sequence of str or str
-            Any of ``fold`` (design.fold), ``json`` (report.json), ``obj`` (folded.obj),
+            Any of ``fold`` (design.fold), ``json`` (report.json and timings.json), ``obj``
+            (folded.obj),
             ``svg`` (pattern.svg), ``dxf`` (pattern.dxf), ``pdf`` (pattern.pdf), ``png``
             (pattern.png and preview.png), or ``"all"``.
         units, scale, page : str, float, str
