@@ -810,3 +810,12 @@ def test_svg_and_pdf_draw_with_one_palette(cube):
     assert f'stroke="{TAB_HINGE_COLOR}"' in svg
     assert f'fill="{LABEL_COLOR}"' in svg
 
+
+def test_dxf_classes_are_sorted(cube):
+    """ezdxf takes the classes from a set (ordered by the hash seed); the DXF sorts them."""
+    text = pattern_dxf(cube.pattern, units="mm")
+    section = text.split("\nCLASSES\n", 1)[1].split("\nENDSEC\n", 1)[0]
+    names = re.findall(r"\n  0\nCLASS\n  1\n(\S+)\n  2\n(\S+)", "\n" + section)
+    assert len(names) > 10
+    assert names == sorted(names)
+    assert {"LAYOUT", "ACDBPLACEHOLDER"} <= {n for n, _ in names}
