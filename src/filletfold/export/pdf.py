@@ -39,7 +39,7 @@ __all__ = ["MAX_PAGES", "REGION_PAD_MM", "Tile", "pattern_pdf"]
 REGION_PAD_MM = 2.0
 #: Most pages one PDF may have (a guard against a mistyped scale).
 MAX_PAGES = 400
-_PT_PER_MM = 72.0 / 25.4
+_PT_PER_MM = 1.0 / MM_PER_UNIT["pt"]
 _LINE_MM = 0.25
 _MARK_MM = 5.0
 _FONT_PT = 8.0
@@ -259,7 +259,7 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
     from matplotlib.figure import Figure
     from matplotlib.patches import Rectangle
 
-    fig = Figure(figsize=(width / 25.4, height / 25.4))
+    fig = Figure(figsize=(width / MM_PER_UNIT["in"], height / MM_PER_UNIT["in"]))
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
     ax.set_xlim(0.0, width)
     ax.set_ylim(0.0, height)
