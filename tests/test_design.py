@@ -311,6 +311,7 @@ def test_export_writes_the_four_files(tmp_path):
         "folded.obj",
         "pattern.svg",
         "report.json",
+        "timings.json",
     ]
     fold = json.loads((tmp_path / "out" / "design.fold").read_text())
     report = json.loads((tmp_path / "out" / "report.json").read_text())
@@ -342,7 +343,7 @@ def test_export_writes_the_four_files(tmp_path):
     for f in files:
         assert (
             tmp_path / "again" / f.name
-        ).read_bytes() == f.read_bytes() or f.name == "report.json"
+        ).read_bytes() == f.read_bytes() or f.name == "timings.json"
 
 
 @pytest.mark.parametrize(

@@ -9,6 +9,7 @@ import json
 import math
 import re
 import xml.etree.ElementTree as ET
+import zlib
 
 import ezdxf
 import numpy as np
@@ -33,6 +34,7 @@ from filletfold.export import (
 )
 from filletfold.export.cutfiles import ALL_FORMATS, fit_page_scale, scaled_pattern
 from filletfold.export.dxf import LAYER_COLOR
+from filletfold.export.palette import ASSIGNMENT_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
 from filletfold.export.paths import (
     SPLINE_MIN_POINTS,
     chain_is_smooth,
@@ -41,8 +43,9 @@ from filletfold.export.paths import (
     simplify_polyline,
     tab_cut_paths,
 )
-from filletfold.export.pdf import MAX_PAGES, REGION_PAD_MM, page_size_mm, pdf_tiles
+from filletfold.export.pdf import MAX_PAGES, REGION_PAD_MM, pdf_tiles
 from filletfold.pattern import Annotations, CreasePattern, Label
+from filletfold.units import sheet_size_mm
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -414,14 +417,14 @@ def test_pdf_of_the_cube_design(cube):
     ],
 )
 def test_page_sizes(page, size):
-    assert page_size_mm(page) == size
+    assert sheet_size_mm(page, name="page") == size
 
 
 @pytest.mark.parametrize(
     ("kw", "match"),
     [
         ({"page": "B5"}, "page must be one of"),
-        ({"page": "0x100"}, "page must be one of"),
+        ({"page": "0x100"}, "page size must be positive"),
         ({"page": 4}, "page must be a string"),
         ({"units": ""}, "units must be one of"),
         ({"scale": 0}, "scale must be a positive number"),
@@ -698,9 +701,17 @@ def test_export_design_all_formats(cube, tmp_path):
         "pattern.png",
         "preview.png",
         "assembly.txt",
+        "timings.json",
     ]
     written = export_design(cube, tmp_path / "some", formats="dxf,json")
-    assert [p.name for p in written] == ["report.json", "pattern.dxf", "assembly.txt"]
+    assert [p.name for p in written] == [
+        "report.json",
+        "pattern.dxf",
+        "assembly.txt",
+        "timings.json",
+    ]
+    written = export_design(cube, tmp_path / "dxf", formats="dxf")
+    assert [p.name for p in written] == ["pattern.dxf", "assembly.txt"]
 
 
 # ---------------------------------------------------------------- CLI
@@ -734,7 +745,7 @@ def test_cli_export_writes_the_cut_files(cube, tmp_path, capsys):
         (["--format", "json"], "cannot be written from design.fold"),
         (["--units", "ft"], "units must be one of"),
         (["--scale", "0"], "scale must be a positive number"),
-        (["--sheet", "B5"], "page must be one of"),
+        (["--sheet", "B5"], "sheet must be one of"),
     ],
 )
 def test_cli_export_bad_options(args, match, tmp_path, capsys):
@@ -759,7 +770,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 9 files" in capsys.readouterr().out
+    assert "wrote 10 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 
@@ -768,3 +779,43 @@ def test_cli_round_bad_format_fails_before_solving(tmp_path, capsys):
     assert main(["round", "cube", "-o", str(tmp_path / "x"), "--format", "fold,stl"]) == 2
     assert "unknown format 'stl'" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+# ---------------------------------------------------------------- one palette
+
+
+def pdf_stroke_colors(data: bytes) -> set[str]:
+    """Stroke colours (``#rrggbb``) set in the content streams of a PDF."""
+    colors = set()
+    for raw in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, flags=re.S):
+        try:
+            text = zlib.decompress(raw).decode("latin-1")
+        except zlib.error:
+            continue
+        for rgb in re.findall(r"(?:([\d.]+) ([\d.]+) )?([\d.]+) (?:RG|G)\b", text):
+            rgb = rgb if rgb[0] else (rgb[2],) * 3  # "x G" is grey x
+            colors.add("#" + "".join(f"{round(float(c) * 255):02x}" for c in rgb))
+    return colors
+
+
+def test_svg_and_pdf_draw_with_one_palette(cube):
+    svg = pattern_svg(cube.pattern)
+    pdf = pattern_pdf(cube.pattern, scale=20.0)
+    present = set(cube.pattern.edge_assignment) - {"F"}
+    assert {"M", "B"} <= present
+    used = {ASSIGNMENT_COLOR[a] for a in present} | {TAB_HINGE_COLOR}
+    assert used <= pdf_stroke_colors(pdf)
+    for a in present:
+        assert f'stroke="{ASSIGNMENT_COLOR[a]}"' in svg, a
+    assert f'stroke="{TAB_HINGE_COLOR}"' in svg
+    assert f'fill="{LABEL_COLOR}"' in svg
+
+
+def test_dxf_classes_are_sorted(cube):
+    """ezdxf takes the classes from a set (ordered by the hash seed); the DXF sorts them."""
+    text = pattern_dxf(cube.pattern, units="mm")
+    section = text.split("\nCLASSES\n", 1)[1].split("\nENDSEC\n", 1)[0]
+    names = re.findall(r"\n  0\nCLASS\n  1\n(\S+)\n  2\n(\S+)", "\n" + section)
+    assert len(names) > 10
+    assert names == sorted(names)
+    assert {"LAYOUT", "ACDBPLACEHOLDER"} <= {n for n, _ in names}

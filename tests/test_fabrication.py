@@ -10,7 +10,7 @@ import shapely
 
 import filletfold
 from filletfold.errors import ParameterError
-from filletfold.fabrication import sheet_size_mm
+from filletfold.units import sheet_size_mm
 
 from .test_design import CHECKS
 

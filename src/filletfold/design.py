@@ -233,7 +233,7 @@ class Design:
     pattern : CreasePattern
     pieces : list of Piece
     timings : dict of str to float
-        Seconds per stage.
+        Seconds per stage (written to ``timings.json``, not to the report).
     source : str
         What the mesh came from (path or example name).
     material_loss : MaterialLoss or None
@@ -315,7 +315,8 @@ class Design:
         folder : str or Path
         title : str, optional
         formats : sequence of str or str
-            Any of ``fold`` (design.fold), ``json`` (report.json), ``obj`` (folded.obj),
+            Any of ``fold`` (design.fold), ``json`` (report.json and timings.json), ``obj``
+            (folded.obj),
             ``svg`` (pattern.svg), ``dxf`` (pattern.dxf), ``pdf`` (pattern.pdf), ``png``
             (pattern.png and preview.png), or ``"all"``.
         units, scale, page : str, float, str
@@ -548,7 +549,8 @@ def round_mesh(
     MeshError
         Unreadable or invalid mesh.
     ParameterError
-        Invalid radius, depth, samples or arc step (a radius over an edge's limit names the edge).
+        Invalid radius, depth, samples, arc step or sheet (a radius over an edge's limit names
+        the edge).
     SolverError
         With ``material_loss``: the programme has no solution with positive losses (the
         message names the binding vertices and edges); with ``layout="sheet"``: the modules do
@@ -575,6 +577,8 @@ def round_mesh(
             f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
             name="coplanar_deg",
         )
+    if sheet is not None:
+        sheet_in_pattern_units(sheet, units, scale)  # refuse a bad sheet before the solve
     progress = callers_progress(progress)
     strict = bool(strict)
     clamp = (not strict) if clamp is None else bool(clamp)

@@ -14,44 +14,33 @@ import shapely
 from .errors import ParameterError
 from .module import Piece, build_module, face_polygons
 from .net import build_nets, cut_edges_for_nets
+from .units import MM_PER_UNIT, check_units, sheet_size_mm
 from .vertex.frame import apply, invert, vertex_frames
-
-#: Sheet sizes in millimetres (width, height), portrait.
-SHEETS_MM = {
-    "A4": (210.0, 297.0),
-    "A3": (297.0, 420.0),
-    "A2": (420.0, 594.0),
-    "A1": (594.0, 841.0),
-    "LETTER": (215.9, 279.4),
-    "LEGAL": (215.9, 355.6),
-}
-#: Millimetres per drawing unit.
-MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
-
-
-def sheet_size_mm(sheet: str) -> tuple[float, float]:
-    """(width, height) in mm of a named sheet (A4, A3, A2, A1, Letter, Legal) or ``"WxH"``."""
-    key = sheet.strip().upper()
-    if key in SHEETS_MM:
-        return SHEETS_MM[key]
-    try:
-        w, h = (float(x) for x in key.split("X"))
-    except ValueError:
-        raise ParameterError(
-            f"sheet must be one of {', '.join(SHEETS_MM)} or 'WIDTHxHEIGHT' in mm, got {sheet!r}",
-            name="sheet",
-        ) from None
-    if not (w > 0 and h > 0 and np.isfinite(w) and np.isfinite(h)):
-        raise ParameterError(f"sheet size must be positive, got {sheet!r}", name="sheet")
-    return w, h
 
 
 def sheet_in_pattern_units(sheet: str, units: str, scale: float) -> tuple[float, float]:
-    """Sheet size in pattern units, when one pattern unit is drawn as ``scale`` ``units``."""
-    if units not in MM_PER_UNIT:
-        raise ParameterError(
-            f"units must be one of {', '.join(MM_PER_UNIT)}, got {units!r}", name="units"
-        )
+    """Sheet size in pattern units, when one pattern unit is drawn as ``scale`` ``units``.
+
+    Parameters
+    ----------
+    sheet : str
+        See :func:`~filletfold.units.sheet_size_mm`.
+    units : str
+        One of :data:`~filletfold.units.CUT_FILE_UNITS`.
+    scale : float
+        Positive.
+
+    Returns
+    -------
+    (float, float)
+        Width and height of the sheet in pattern length units.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``sheet``, ``units`` or ``scale``.
+    """
+    check_units(units, unitless=False)
     if not (np.isfinite(scale) and scale > 0):
         raise ParameterError(f"scale must be positive, got {scale!r}", name="scale")
     w, h = sheet_size_mm(sheet)

@@ -16,8 +16,8 @@ from .rounding import loss_from_radius
 from .tabs import assembly_text
 from .tolerances import tol
 
-#: The files :func:`export_design` writes by default.
-OUTPUT_FILES = output_names(DEFAULT_FORMATS)
+#: The files :func:`export_design` writes by default (and ``assembly.txt`` with glue tabs).
+OUTPUT_FILES = (*output_names(DEFAULT_FORMATS), "timings.json")
 
 
 def _num(x):
@@ -97,8 +97,26 @@ def report_records(design) -> dict:
         "layout": {"kind": design.layout, "note": design.layout_note or None},
         "fabrication": _fabrication_report(design),
         "material_loss": _loss_report(design.material_loss),
-        "timings": {k: float(v) for k, v in design.timings.items()},
     }
+
+
+def timings_json(design) -> str:
+    """The content of ``timings.json``: seconds per stage of ``design``, as JSON text.
+
+    Kept out of ``report.json`` so that the report, like every other output file, has the
+    same bytes for the same input and parameters.
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    str
+        ``{"read": s, "rounding": s, ..., "total": s, "export": s}`` (the stages that ran, in
+        order), indented by 2, ending with a newline.
+    """
+    return report_json({k: float(v) for k, v in design.timings.items()})
 
 
 def _fitting_report(design) -> dict:
@@ -401,7 +419,9 @@ def export_design(
         Output formats (see :mod:`filletfold.export.cutfiles`): by default ``fold``, ``json``,
         ``obj`` and ``svg``, i.e. ``design.fold``, ``report.json``, ``folded.obj`` and
         ``pattern.svg``; ``"all"`` adds ``pattern.dxf``, ``pattern.pdf``, ``pattern.png`` and
-        ``preview.png``. With glue tabs, ``assembly.txt`` (the assembly sheet) is written too.
+        ``preview.png``. With glue tabs, ``assembly.txt`` (the assembly sheet) is written too;
+        with ``json``, ``timings.json`` (:func:`timings_json`), the one file that differs
+        between two runs on the same input.
     units, scale, page
         Real size of the cut files and PDF page (see
         :func:`~filletfold.export.cutfiles.cut_files`).
@@ -429,16 +449,19 @@ def export_design(
         )
     if "json" in formats:
 
-        def report() -> str:
-            design.timings["export"] = time.perf_counter() - t  # the files written before it
-            return report_json(report_records(design))
+        def timings() -> str:
+            design.timings["export"] = time.perf_counter() - t  # the files built before it
+            return timings_json(design)
 
-        files["report.json"] = report
+        files["report.json"] = lambda: report_json(report_records(design))
+        files["timings.json"] = timings
     names = list(output_names(formats))
     seams = design.fabrication.get("seams")
     if seams:
         files["assembly.txt"] = assembly_text(seams)
         names.append("assembly.txt")
+    if "json" in formats:
+        names.append("timings.json")  # last: its export time covers the other files
     written = write_outputs(folder, {k: files[k] for k in names})
     design.timings["export"] = time.perf_counter() - t
     return written

@@ -40,6 +40,8 @@ log = logging.getLogger(__name__)
 
 #: Largest mesh file the app accepts, in bytes (50 MB).
 UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
+#: Date and time of every entry of the zip (the earliest a zip can hold).
+ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 #: Files in the zip from :meth:`AppSession.export_zip`, besides ``report.json``.
 ZIP_FORMATS = ("fold", "obj", "svg", "dxf")
 #: Parameters :meth:`AppSession.set_params` accepts.
@@ -430,11 +432,17 @@ class AppSession:
 
     def export_zip(self) -> bytes:
         """A zip of ``design.fold``, ``report.json``, ``folded.obj``, ``pattern.svg`` and
-        ``pattern.dxf`` (and ``assembly.txt`` with glue tabs), built in memory."""
+        ``pattern.dxf`` (and ``assembly.txt`` with glue tabs), built in memory.
+
+        Every entry is dated :data:`ZIP_DATE` (not the time of the export), so the same
+        design gives the same bytes."""
         buf = io.BytesIO()
-        with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        with zipfile.ZipFile(buf, "w") as zf:
             for name, data in self.export_files().items():
-                zf.writestr(name, data)
+                info = zipfile.ZipInfo(name, date_time=ZIP_DATE)
+                info.compress_type = zipfile.ZIP_DEFLATED
+                info.external_attr = 0o644 << 16  # rw-r--r--
+                zf.writestr(info, data)
         return buf.getvalue()
 
 

@@ -32,11 +32,12 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..pattern import Annotations, CreasePattern, Label
-from .dxf import DXF_INSUNITS, check_scale, pattern_dxf
+from ..units import check_units, sheet_size_mm
+from .dxf import check_scale, pattern_dxf
 from .fold import _fold_document, fold_json, validated_faces
 from .obj import _folded_obj
 from .paths import pattern_extent
-from .pdf import REGION_PAD_MM, page_size_mm, pattern_pdf
+from .pdf import REGION_PAD_MM, pattern_pdf
 from .png import pattern_png, preview_png
 from .svg import _pattern_svg
 
@@ -44,7 +45,6 @@ __all__ = [
     "ALL_FORMATS",
     "DEFAULT_FORMATS",
     "FORMAT_FILES",
-    "UNITS",
     "cut_files",
     "fit_page_scale",
     "output_names",
@@ -66,8 +66,6 @@ FORMAT_FILES = {
 ALL_FORMATS = tuple(FORMAT_FILES)
 #: What ``filletfold round`` and :meth:`Design.export` write by default.
 DEFAULT_FORMATS = ("fold", "json", "obj", "svg")
-#: Drawing units of the cut files ("" = unitless).
-UNITS = tuple(DXF_INSUNITS)
 
 
 def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
@@ -172,7 +170,7 @@ def fit_page_scale(pattern: CreasePattern, page: str = "A4", margin_mm: float = 
     ----------
     pattern : CreasePattern
     page : str
-        See :func:`~filletfold.export.pdf.page_size_mm`.
+        See :func:`~filletfold.units.sheet_size_mm`.
     margin_mm : float
         The page margin of :func:`~filletfold.export.pdf.pattern_pdf`.
 
@@ -182,7 +180,7 @@ def fit_page_scale(pattern: CreasePattern, page: str = "A4", margin_mm: float = 
         The largest round-down scale (3 significant digits) at which the drawing, its tabs,
         labels and the region padding fit the printable area (with sheets: the largest sheet).
     """
-    width, height = page_size_mm(page)
+    width, height = sheet_size_mm(page, name="page")
     room = np.array([width, height]) - 2 * margin_mm - 2 * REGION_PAD_MM
     sheets = np.asarray(pattern.annotations.sheets, dtype=np.float64).reshape(-1, 4)
     if len(sheets):
@@ -221,7 +219,7 @@ def cut_files(
     scale : float, optional
         Drawing units per pattern unit (default 1; see the module docstring for the PDF).
     page : str
-        PDF page size (see :func:`~filletfold.export.pdf.page_size_mm`).
+        PDF page size (see :func:`~filletfold.units.sheet_size_mm`).
     title, description : str
         FOLD ``file_title`` and ``file_description``.
     report : mapping or str, optional
@@ -245,15 +243,11 @@ def cut_files(
         When the pattern is inconsistent.
     """
     formats = parse_formats(formats)
-    if units not in DXF_INSUNITS:
-        raise ParameterError(
-            f"units must be one of {', '.join(u for u in UNITS if u)} or '', got {units!r}",
-            name="units",
-        )
+    check_units(units, unitless=True)
     scale_given = scale is not None
     scale = 1.0 if scale is None else check_scale(scale)
     if "pdf" in formats:
-        page_size_mm(page)
+        sheet_size_mm(page, name="page")
     if "json" in formats and report is None:
         raise ParameterError(
             "report.json needs the whole design, not only its crease pattern "

@@ -25,8 +25,9 @@ interpolation); everything else is an ``LWPOLYLINE``. Sheet outlines are not wri
 holds every sheet). Besides these, the file has the standard layers ``0`` and ``Defpoints``
 (empty).
 
-The output is deterministic: entities are written in a fixed order with sequential handles and
-the DXF's dates and GUIDs are fixed.
+The output is deterministic: entities are written in a fixed order with sequential handles, the
+DXF's dates and GUIDs are fixed and its CLASSES section is sorted (ezdxf's own order depends on
+the process's string hash seed).
 """
 
 from __future__ import annotations
@@ -38,12 +39,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..pattern import CreasePattern
+from ..units import check_units
 from .fold import validate_pattern
 from .paths import chain_runs, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 
 __all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
 
-#: ``$INSUNITS`` code of each drawing unit ("" = unitless).
+#: ``$INSUNITS`` code of each drawing unit ("" = unitless): of every cut-file unit.
 DXF_INSUNITS = {"": 0, "in": 1, "mm": 4, "cm": 5, "m": 6}
 #: ACI colour of each layer, in the order the layers are created.
 LAYER_COLOR = {"CUT": 7, "MOUNTAIN": 1, "VALLEY": 5, "TAB": 3, "LABEL": 8, "FLAT": 9}
@@ -93,11 +95,7 @@ def pattern_dxf(
     """
     import ezdxf
 
-    if units not in DXF_INSUNITS:
-        raise ParameterError(
-            f"units must be one of {', '.join(u for u in DXF_INSUNITS if u)} or '', got {units!r}",
-            name="units",
-        )
+    check_units(units, unitless=True)
     scale = check_scale(scale)
     validate_pattern(pattern)
 
@@ -106,11 +104,27 @@ def pattern_dxf(
     try:
         doc = ezdxf.new("R2010", setup=False)
         _fill(doc, pattern, units, scale, flat_edges)
+        _sort_classes(doc)
         stream = io.StringIO()
         doc.write(stream)
     finally:
         ezdxf.options.write_fixed_meta_data_for_testing = fixed
     return stream.getvalue()
+
+
+def _sort_classes(doc) -> None:
+    """Register the DXF's ``CLASS`` entries now, in sorted order.
+
+    On writing, ezdxf adds a class for each entity type in use, taken from a ``set`` of type
+    names: in an order that changes with Python's string hash seed, i.e. from one process to
+    the next. Registered and sorted here, the CLASSES section is the same in every run (writing
+    adds none).
+    """
+    from collections import OrderedDict
+
+    doc.commit_pending_changes()
+    doc.classes.add_required_classes(doc.dxfversion)
+    doc.classes.classes = OrderedDict(sorted(doc.classes.classes.items()))
 
 
 def _fill(doc, pattern: CreasePattern, units: str, scale: float, flat_edges: bool) -> None:

@@ -20,40 +20,29 @@ from __future__ import annotations
 
 import io
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..pattern import CreasePattern
+from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
 from .fold import validate_pattern
+from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
-from .svg import MM_PER_UNIT, nice_length
+from .svg import nice_length
 
-__all__ = ["MAX_PAGES", "PAGE_SIZES_MM", "REGION_PAD_MM", "Tile", "page_size_mm", "pattern_pdf"]
+__all__ = ["MAX_PAGES", "REGION_PAD_MM", "Tile", "pattern_pdf"]
 
-#: Portrait paper sizes (width, height) in millimetres.
-PAGE_SIZES_MM = {
-    "A4": (210.0, 297.0),
-    "A3": (297.0, 420.0),
-    "A2": (420.0, 594.0),
-    "Letter": (215.9, 279.4),
-    "Legal": (215.9, 355.6),
-}
 #: Blank border (mm) added around each region before it is tiled.
 REGION_PAD_MM = 2.0
 #: Most pages one PDF may have (a guard against a mistyped scale).
 MAX_PAGES = 400
-_PT_PER_MM = 72.0 / 25.4
+_PT_PER_MM = 1.0 / MM_PER_UNIT["pt"]
 _LINE_MM = 0.25
 _MARK_MM = 5.0
 _FONT_PT = 8.0
-_COLORS = {"CUT": "#000000", "MOUNTAIN": "#ff0000", "VALLEY": "#0000ff", "FLAT": "#cccccc"}
-_HINGE = "#00a000"
-_SHEET = "#999999"
-_LABEL = "#404040"
 _FRAME = "#b0b0b0"
 
 
@@ -81,36 +70,9 @@ class Tile:
     box: tuple
 
 
-def page_size_mm(page: str) -> tuple[float, float]:
-    """Width and height (mm) of a page: a name of :data:`PAGE_SIZES_MM` (any case) or ``"WxH"``.
-
-    Raises
-    ------
-    ParameterError
-        For an unknown name or a malformed or non-positive custom size.
-    """
-    if not isinstance(page, str):
-        raise ParameterError(f"page must be a string, got {type(page).__name__}", name="page")
-    for name, size in PAGE_SIZES_MM.items():
-        if page.strip().lower() == name.lower():
-            return size
-    m = re.fullmatch(r"\s*(\d+(?:\.\d*)?)\s*[xX×]\s*(\d+(?:\.\d*)?)\s*(?:mm)?\s*", page)
-    if not m or float(m.group(1)) <= 0 or float(m.group(2)) <= 0:
-        raise ParameterError(
-            f"page must be one of {', '.join(PAGE_SIZES_MM)} or 'WxH' in millimetres "
-            f"(e.g. '600x400'), got {page!r}",
-            name="page",
-        )
-    return float(m.group(1)), float(m.group(2))
-
-
 def _check_units(units: str) -> float:
-    if units not in MM_PER_UNIT:
-        raise ParameterError(
-            f"units must be one of {', '.join(MM_PER_UNIT)} for a printed PDF, got {units!r}",
-            name="units",
-        )
-    return MM_PER_UNIT[units]
+    """Millimetres per ``units``; a :class:`ParameterError` for a unit not printable."""
+    return MM_PER_UNIT[check_units(units, MM_PER_UNIT, unitless=False)]
 
 
 def pdf_tiles(
@@ -138,7 +100,7 @@ def pdf_tiles(
     ParameterError
         For an invalid page, unit, scale or margin, or more than :data:`MAX_PAGES` pages.
     """
-    width, height = page_size_mm(page)
+    width, height = sheet_size_mm(page, name="page")
     k = _check_units(units) * check_scale(scale)
     if isinstance(margin_mm, bool) or not isinstance(margin_mm, int | float):
         raise ParameterError(f"margin_mm must be a number, got {margin_mm!r}", name="margin_mm")
@@ -194,7 +156,8 @@ def pattern_pdf(
         Checked with :func:`~filletfold.export.fold.validate_pattern`; its annotations are
         drawn when present.
     page : str
-        ``"A4"``, ``"A3"``, ``"A2"``, ``"Letter"``, ``"Legal"`` (portrait) or ``"WxH"`` in mm.
+        A sheet of :func:`~filletfold.units.sheet_size_mm` (``"A4"``, ``"A1"``, ``"Letter"``,
+        ``"600x400"``, ...).
     units : str
         ``"mm"``, ``"cm"``, ``"m"``, ``"in"`` or ``"pt"``: the printed unit of
         ``scale`` pattern units (one pattern unit is printed ``scale`` ``units`` long).
@@ -220,7 +183,7 @@ def pattern_pdf(
 
     tiles = pdf_tiles(pattern, page=page, units=units, scale=scale, margin_mm=margin_mm)
     validate_pattern(pattern)
-    width, height = page_size_mm(page)
+    width, height = sheet_size_mm(page, name="page")
     k = MM_PER_UNIT[units] * float(scale)
     layers = _drawing_mm(pattern, k)
     n_regions = 1 + max(t.region for t in tiles)
@@ -296,7 +259,7 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
     from matplotlib.figure import Figure
     from matplotlib.patches import Rectangle
 
-    fig = Figure(figsize=(width / 25.4, height / 25.4))
+    fig = Figure(figsize=(width / MM_PER_UNIT["in"], height / MM_PER_UNIT["in"]))
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
     ax.set_xlim(0.0, width)
     ax.set_ylim(0.0, height)
@@ -307,11 +270,11 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
     clip = Rectangle((margin, margin), tw, th, transform=ax.transData, fill=False)
     lw = _LINE_MM * _PT_PER_MM
     styles = [
-        ("SHEET", _SHEET, 0.5 * lw, "solid"),
-        ("CUT", _COLORS["CUT"], lw, "solid"),
-        ("VALLEY", _COLORS["VALLEY"], lw, "solid"),
-        ("MOUNTAIN", _COLORS["MOUNTAIN"], lw, "solid"),
-        ("TAB", _HINGE, lw, (0, (4, 3))),
+        ("SHEET", SHEET_COLOR, 0.5 * lw, "solid"),
+        ("CUT", ASSIGNMENT_COLOR["B"], lw, "solid"),
+        ("VALLEY", ASSIGNMENT_COLOR["V"], lw, "solid"),
+        ("MOUNTAIN", ASSIGNMENT_COLOR["M"], lw, "solid"),
+        ("TAB", TAB_HINGE_COLOR, lw, (0, (4, 3))),
     ]
     for layer, color, width_pt, style in styles:
         lines = _in_box(layers.get(layer, []), tile.box)
@@ -335,7 +298,7 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
             ha="center",
             va="center",
             fontsize=max(h * _PT_PER_MM / 0.72, 1.0),
-            color=_LABEL,
+            color=LABEL_COLOR,
         )
         t.set_clip_path(clip)
     ax.add_patch(

@@ -22,21 +22,13 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..pattern import CreasePattern
+from ..units import MM_PER_UNIT, check_units
 from .fold import validate_pattern
+from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import pattern_extent, tab_cut_paths
 
-__all__ = [
-    "ASSIGNMENT_COLOR",
-    "LABEL_COLOR",
-    "MM_PER_UNIT",
-    "SHEET_COLOR",
-    "TAB_HINGE_COLOR",
-    "nice_length",
-    "pattern_svg",
-]
+__all__ = ["nice_length", "pattern_svg"]
 
-#: Stroke colour of each edge assignment.
-ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
 #: Group id and legend label of each edge assignment, in drawing order (bottom first).
 _GROUPS = (
     ("F", "flat", "flat"),
@@ -44,17 +36,11 @@ _GROUPS = (
     ("V", "valley", "valley"),
     ("M", "mountain", "mountain"),
 )
-#: Millimetres per pattern length unit, for the units :func:`pattern_svg` accepts.
-MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "pt": 25.4 / 72.0}
 #: Printed size (mm) of the larger side of the drawing when no unit is given.
 _UNITLESS_MM = 200.0
 _MARGIN_MM = 10.0
 _FONT_MM = 3.5
 _SWATCH_MM = 8.0
-#: Colours of the annotations.
-TAB_HINGE_COLOR = "#00a000"
-SHEET_COLOR = "#999999"
-LABEL_COLOR = "#404040"
 
 
 def nice_length(target: float) -> float:
@@ -140,10 +126,7 @@ def pattern_svg(
     ExportError
         When the pattern is inconsistent.
     """
-    if units and units not in MM_PER_UNIT:
-        raise ParameterError(
-            f"units must be one of {', '.join(MM_PER_UNIT)} or '', got {units!r}", name="units"
-        )
+    check_units(units, MM_PER_UNIT, unitless=True)
     if not (isinstance(stroke_mm, int | float) and math.isfinite(stroke_mm) and stroke_mm > 0):
         raise ParameterError(
             f"stroke_mm must be a positive number, got {stroke_mm!r}", name="stroke_mm"

@@ -1,0 +1,19 @@
+"""Colours of the drawn layouts, the one table shared by the SVG, PDF and PNG writers.
+
+The edge colours are the ones Origami Simulator reads from an SVG (mountain red, valley blue,
+border/cut black); the tab-hinge green is not Origami Simulator's cut green ``#00ff00``. The
+DXF's layers carry AutoCAD colour indices instead (:data:`~filletfold.export.dxf.LAYER_COLOR`).
+"""
+
+from __future__ import annotations
+
+__all__ = ["ASSIGNMENT_COLOR", "LABEL_COLOR", "SHEET_COLOR", "TAB_HINGE_COLOR"]
+
+#: Stroke colour of each edge assignment.
+ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
+#: Tab hinges (the fold between a glue tab and its piece), drawn dashed.
+TAB_HINGE_COLOR = "#00a000"
+#: Outlines of the sheets of material.
+SHEET_COLOR = "#999999"
+#: Labels (part numbers, seam labels).
+LABEL_COLOR = "#404040"
