@@ -1,6 +1,6 @@
 """Vertex classification, normals, developed and spatial apices (sec. 2.4, 2.5, 3.1, 3.2).
 
-Reference figures are the METHOD-NOTES' (edge length 1).
+Reference figures are those of docs/method.md, 'Reference figures' (edge length 1).
 """
 
 from __future__ import annotations
@@ -220,9 +220,10 @@ def test_developable_vertex_is_detected_and_reported():
 
 
 def test_crease_through_T_gives_a_clean_module():
-    """At l = l_max the straight crease on a face has zero length (METHOD-NOTES 11): the
-    apex on the icosahedron vertex's axis at the depth where the creases run through every T
-    (to round-off: the two ends of each straight crease are then merged)."""
+    """At l = l_max the straight crease on a face has zero length (docs/method.md,
+    'Corrections to the paper', 11): the apex on the icosahedron vertex's axis at the depth
+    where the creases run through every T (to round-off: the two ends of each straight crease
+    are then merged)."""
     from scipy.optimize import brentq
 
     from filletfold.module import build_module, face_piece_centres, face_polygons

@@ -1,7 +1,8 @@
 """The spatial apex of a vertex cone: constrained optimisation (paper sec. 3.2).
 
 Given the developed apex ``v`` (fixed point of ``rho``), the spatial apex ``V`` minimises
-``|V - P|^2`` (``P = U + d D``, METHOD-NOTES 4) subject to, on every incident cylinder ``i``:
+``|V - P|^2`` (``P = U + d D``, not the paper's ``V + d D``: docs/method.md,
+'Corrections to the paper', 4) subject to, on every incident cylinder ``i``:
 
 * valid patch: ``Dn_i = (v - c(s)) . r - (V - C(s)) . R > 0`` (constant along the arc);
 * valid range: ``0 <= l_i(s)`` along the arc and ``l_i <= l_max`` at both ends, where
@@ -10,17 +11,17 @@ Given the developed apex ``v`` (fixed point of ``rho``), the spatial apex ``V`` 
   ``2 Dn (l_max - m) - num >= 0`` with a safety margin ``m``;
 * non-intersection (eq. 2): ``sigma (V - C(s)) . N(s) > 0`` along the arc (sampled; the paper's
   chord-plane linearisation ``sigma (V - T_0) . N_e > 0`` is kept as well);
-* every incident face: ``sigma (V - T) . N_f > 0`` (METHOD-NOTES 3), and the apex above
-  three planes through T tilted from the face by a little more than ``tol.fold``, so that
-  the straight crease on the face folds by less than 180 degrees minus ``tol.fold`` (see
-  :func:`fold_planes`).
+* every incident face: ``sigma (V - T) . N_f > 0`` (the paper omits ``sigma``: docs/method.md,
+  'Corrections to the paper', 3), and the apex above three planes through T tilted from the
+  face by a little more than ``tol.fold``, so that the straight crease on the face folds by
+  less than 180 degrees minus ``tol.fold`` (see :func:`fold_planes`).
 
 The quadratic range constraints are sampled at a few points per arc during the solve. The
 constraint ``l <= l_max`` is reverse-convex, so the solve starts with a feasibility phase
-(maximise the smallest slack) before the projection of ``P`` (METHOD-NOTES); the solver is
-:func:`filletfold.vertex.batch.solve_apex_batch`, which solves many vertices at once. Every
-result is then validated densely, without margin, by :func:`validate_apices` (all the
-vertices of a round at once).
+(maximise the smallest slack) before the projection of ``P`` (docs/method.md, 'Where an
+implementation trips'); the solver is :func:`filletfold.vertex.batch.solve_apex_batch`, which
+solves many vertices at once. Every result is then validated densely, without margin, by
+:func:`validate_apices` (all the vertices of a round at once).
 """
 
 from __future__ import annotations

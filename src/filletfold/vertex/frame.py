@@ -10,7 +10,8 @@ A boundary side is the unrounded edge line ``M + z R``.
 All pieces are developed into one common 2D frame: the chart of ``tau = f_{n-1}`` (origin U). Each
 cylinder and face gets a rigid 2D map (3x3 homogeneous) by chaining the tangent-plane gluings
 ``tau -> cylinder 0 -> f_0 -> ... -> cylinder n-1 -> tau'``. The last map ``rho`` turns by minus the
-angle defect; the developed apex is its fixed point (METHOD-NOTES, "one common 2D frame").
+angle defect; the developed apex is its fixed point, :func:`developed_apices` (docs/method.md,
+'Conventions', "One 2D frame per vertex").
 
 :func:`vertex_frames` builds the frames of many vertices at once, on flat arrays over all their
 (vertex, ring position) pairs; :func:`vertex_frame` is one vertex through it.
