@@ -54,7 +54,7 @@ def test_cylinders_are_tangent_to_both_faces(name):
         for i, side in enumerate(frame.sides):
             s = np.linspace(0, side.arc, 7)
             C, N, T = side.base(s), side.normal(s), side.tangent(s)
-            # orientation: C'(s) x R = N(s) (METHOD-NOTES conventions)
+            # orientation: C'(s) x R = N(s) (docs/method.md, 'Conventions')
             assert_allclose(np.cross(T, side.R), N, atol=1e-12)
             # every base point at distance r from the axis, in the midpoint cross-section
             d = C - side.O

@@ -1,6 +1,6 @@
 """Vertex classification, normals, developed and spatial apices (sec. 2.4, 2.5, 3.1, 3.2).
 
-Reference figures are the METHOD-NOTES' (edge length 1).
+Reference figures are those of docs/method.md, 'Reference figures' (edge length 1).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from filletfold.rounding import round_edges
 from filletfold.tolerances import tol
 from filletfold.vertex.apex import build_constraints, validate_apex
 from filletfold.vertex.batch import solve_apex
-from filletfold.vertex.frame import vertex_frame
+from filletfold.vertex.frame import developed_apices, vertex_frame, vertex_frames
 from filletfold.vertex.normal import max_min_direction, vertex_normal
 
 from .conftest import ALL, CLOSED_CONVEX, design_of, random_convex
@@ -62,6 +62,25 @@ def test_rho_turns_by_minus_the_defect(name):
         v = fr.developed_apex()
         if v is not None:  # v is the fixed point of rho
             assert_allclose(fr.rho[:2, :2] @ v + fr.rho[:2, 2], v, atol=1e-12)
+
+
+def test_one_developed_apex_for_pipeline_and_frame():
+    """The pipeline's developed apices (:func:`developed_apices` of all frames at once) are
+    :meth:`VertexFrame.developed_apex` of each frame, and the fixed points of rho."""
+    d = filletfold.round_mesh("random-convex")
+    frames = vertex_frames(d.mesh, d.rounding, range(d.mesh.n_vertices))
+    got = developed_apices(np.array([f.rho for f in frames]))
+    for u, fr in enumerate(frames):
+        one = fr.developed_apex()
+        assert one is not None
+        np.testing.assert_array_equal(one, got[u])
+        assert_allclose(fr.rho[:2, :2] @ one + fr.rho[:2, 2], one, atol=1e-13)
+        if d.vertices.status[u] == "ok":
+            np.testing.assert_array_equal(d.vertices.apex_developed[u], one)
+    # a translation has no fixed point
+    shift = np.eye(3)
+    shift[:2, 2] = (0.1, 0.2)
+    assert np.isnan(developed_apices(shift[None])).all()
 
 
 def test_icosahedron_depth_window_projects():
@@ -201,9 +220,10 @@ def test_developable_vertex_is_detected_and_reported():
 
 
 def test_crease_through_T_gives_a_clean_module():
-    """At l = l_max the straight crease on a face has zero length (METHOD-NOTES 11): the
-    apex on the icosahedron vertex's axis at the depth where the creases run through every T
-    (to round-off: the two ends of each straight crease are then merged)."""
+    """At l = l_max the straight crease on a face has zero length (docs/method.md,
+    'Corrections to the paper', 11): the apex on the icosahedron vertex's axis at the depth
+    where the creases run through every T (to round-off: the two ends of each straight crease
+    are then merged)."""
     from scipy.optimize import brentq
 
     from filletfold.module import build_module, face_piece_centres, face_polygons

@@ -13,10 +13,11 @@ perpendicular to ``e`` when both sectors beside ``e`` give the same ``x`` -- the
 ``(w_i^+ + w_i^- cos a_i) / sin a_i = (w_j^- + w_j^+ cos a_j) / sin a_j``, which checks out
 against the geometry of fig. 15.
 
-Correction to sec. 4.3 (METHOD-NOTES 10): the paper gives each sector its own ``w_i^{+/-}``, so a
-half-edge would have independent widths at its two ends and the region between the two cycles
-would be a trapezoid, not the rectangle of fig. 13. Here a half-edge has one width, shared by
-both of its ends, so every region is a rectangle and contracting it gives a consistent sheet.
+Correction to sec. 4.3 (docs/method.md, 'Corrections to the paper', 10): the paper gives each
+sector its own ``w_i^{+/-}``, so a half-edge would have independent widths at its two ends and
+the region between the two cycles would be a trapezoid, not the rectangle of fig. 13. Here a
+half-edge has one width, shared by both of its ends, so every region is a rectangle and
+contracting it gives a consistent sheet.
 
 The programme maximises ``b``; among its solutions the one with the smallest total loss is
 kept (a second linear programme), so the widths stay near ``b`` instead of at their caps.

@@ -167,7 +167,8 @@ class Piece:
         """Merge points that coincide in 2D and 3D (within ``eps``); drop faces that vanish.
 
         This happens where a crease runs exactly through a tangent-line crossing T
-        (``l = l_max``, METHOD-NOTES 11): the straight crease on the face has zero length.
+        (``l = l_max``, docs/method.md, 'Corrections to the paper', 11): the straight crease
+        on the face has zero length.
         """
         self._merge_coincident(eps)
 

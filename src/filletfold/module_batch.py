@@ -44,6 +44,7 @@ from .module import (
 from .parallel import thread_map
 from .tolerances import tol
 from .vertex.apex import _stack
+from .vertex.crease import chart_apex, crease_denominator, crease_height, crease_numerator
 from .vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
 
 #: Most vertices built together (bounds the flat arrays' size).
@@ -242,7 +243,7 @@ class _Chunk:
         dev = dev.reshape(-1, 2)
         n = np.asarray(n_samples)
         n = np.full(len(sv), n) if n.ndim == 0 else n[sa.edge]
-        vi = np.einsum("kij,kj->ki", sa.Q, dev[sv]) + sa.t
+        vi = chart_apex(sa.Q, sa.t, dev[sv])
         ring_face = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
         return cls(
             frames=frames,
@@ -263,7 +264,7 @@ class _Chunk:
             apex=apex,
             dev=dev,
             vi=vi,
-            dn=vi[:, 1] - np.einsum("ij,ij->i", apex[sv] - sa.M, sa.R),
+            dn=crease_denominator(apex[sv], vi, sa.M, sa.R),
             eps=tol.coincide
             * np.maximum(
                 np.minimum.reduceat(sa.length, side_first[:-1]),
@@ -283,10 +284,9 @@ class _Chunk:
         z = self.height[side]
         on = np.flatnonzero(self.cone[self.side_vertex[side]])
         if len(on):
-            i, vi = side[on], self.vi[side[on]]
-            VC = self.apex[self.side_vertex[i]] - C[on]
-            num = (vi[:, 0] - s[on]) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", VC, VC)
-            z[on] = 0.5 * num / self.dn[i]
+            i = side[on]
+            num = crease_numerator(self.apex[self.side_vertex[i]], self.vi[i], s[on], C[on])
+            z[on] = crease_height(num, self.dn[i])
         return C, z, C + z[:, None] * sa.R[side]
 
     def in_face_chart(self, p: np.ndarray, face: np.ndarray) -> np.ndarray:

@@ -74,6 +74,10 @@ class Tolerances:
         diagonal): the apex keeps every crease at least this far above its base curve (capped
         at a quarter of the vertex's shortest ``l_max``), so that no ruling of a cylinder is a
         sliver edge of the pattern (the certificate's shortest edge is 1e-7 of the design).
+    fixed_point : float
+        The development's map ``rho`` of a vertex has a fixed point (the developed apex) when
+        ``|det(I - Q)| = 4 sin^2(theta / 2)`` is at least this (a turn ``theta`` above about
+        1e-7 radians); below, it is a translation.
     coincide : float
         Two points of a vertex module are one point (merged) when they are this close in 2D
         and in 3D, relative to the larger of the module's shortest edge and the size of its
@@ -103,6 +107,7 @@ class Tolerances:
     fold: float = 0.0105
     ruling: float = 2e-7
     coincide: float = 1e-14
+    fixed_point: float = 1e-14
 
 
 tol = Tolerances()

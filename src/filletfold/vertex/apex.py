@@ -1,25 +1,27 @@
 """The spatial apex of a vertex cone: constrained optimisation (paper sec. 3.2).
 
 Given the developed apex ``v`` (fixed point of ``rho``), the spatial apex ``V`` minimises
-``|V - P|^2`` (``P = U + d D``, METHOD-NOTES 4) subject to, on every incident cylinder ``i``:
+``|V - P|^2`` (``P = U + d D``, not the paper's ``V + d D``: docs/method.md,
+'Corrections to the paper', 4) subject to, on every incident cylinder ``i``:
 
 * valid patch: ``Dn_i = (v - c(s)) . r - (V - C(s)) . R > 0`` (constant along the arc);
 * valid range: ``0 <= l_i(s)`` along the arc and ``l_i <= l_max`` at both ends, where
-  ``l = num / (2 Dn)`` and ``num = |v - c(s)|^2 - |V - C(s)|^2`` (eq. 1); written as
-  ``num - 2 m Dn >= 0`` and ``2 Dn (l_max - m) - num >= 0`` with a safety margin ``m``;
+  ``l = num / (2 Dn)`` and ``num = |v - c(s)|^2 - |V - C(s)|^2`` (eq. 1, computed by
+  :mod:`filletfold.vertex.crease`); written as ``num - 2 m Dn >= 0`` and
+  ``2 Dn (l_max - m) - num >= 0`` with a safety margin ``m``;
 * non-intersection (eq. 2): ``sigma (V - C(s)) . N(s) > 0`` along the arc (sampled; the paper's
   chord-plane linearisation ``sigma (V - T_0) . N_e > 0`` is kept as well);
-* every incident face: ``sigma (V - T) . N_f > 0`` (METHOD-NOTES 3), and the apex above
-  three planes through T tilted from the face by a little more than ``tol.fold``, so that
-  the straight crease on the face folds by less than 180 degrees minus ``tol.fold`` (see
-  :func:`fold_planes`).
+* every incident face: ``sigma (V - T) . N_f > 0`` (the paper omits ``sigma``: docs/method.md,
+  'Corrections to the paper', 3), and the apex above three planes through T tilted from the
+  face by a little more than ``tol.fold``, so that the straight crease on the face folds by
+  less than 180 degrees minus ``tol.fold`` (see :func:`fold_planes`).
 
 The quadratic range constraints are sampled at a few points per arc during the solve. The
 constraint ``l <= l_max`` is reverse-convex, so the solve starts with a feasibility phase
-(maximise the smallest slack) before the projection of ``P`` (METHOD-NOTES); the solver is
-:func:`filletfold.vertex.batch.solve_apex_batch`, which solves many vertices at once. Every
-result is then validated densely, without margin, by :func:`validate_apices` (all the
-vertices of a round at once).
+(maximise the smallest slack) before the projection of ``P`` (docs/method.md, 'Where an
+implementation trips'); the solver is :func:`filletfold.vertex.batch.solve_apex_batch`, which
+solves many vertices at once. Every result is then validated densely, without margin, by
+:func:`validate_apices` (all the vertices of a round at once).
 """
 
 from __future__ import annotations
@@ -30,6 +32,15 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from ..tolerances import tol
+from .crease import (
+    chart_apex,
+    crease_denominator,
+    crease_height,
+    crease_numerator,
+    denominator_gradients,
+    numerator_arc_derivatives,
+    numerator_gradients,
+)
 from .frame import SideArrays, VertexFrame
 from .runs import run_means
 
@@ -107,15 +118,13 @@ class ApexConstraints:
     def _split(self, x):
         V = x[:3]
         v = self.v_fixed if self.v_fixed is not None else x[3:5]
-        vi = np.einsum("qij,j->qi", self.quad_Q, v) + self.quad_t
-        return V, vi
+        return V, chart_apex(self.quad_Q, self.quad_t, v)
 
     def values(self, x: np.ndarray) -> np.ndarray:
         """(n_rows,) constraint values at ``x``."""
         V, vi = self._split(x)
-        d = V - self.quad_c
-        num = (vi[:, 0] - self.quad_s) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", d, d)
-        dn = vi[:, 1] - np.einsum("ij,ij->i", V - self.quad_M, self.quad_R)
+        num = crease_numerator(V, vi, self.quad_s, self.quad_c)
+        dn = crease_denominator(V, vi, self.quad_M, self.quad_R)
         quad = (self.quad_sign * num - self.quad_coef * dn) / self.scale + self.quad_const
         # einsum, not BLAS: the same sums as the rows of many problems together
         # (batch.pack_problems)
@@ -124,14 +133,13 @@ class ApexConstraints:
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """(n_rows, n_vars) derivative of :meth:`values`."""
         V, vi = self._split(x)
-        d = V - self.quad_c
-        gV = -2 * self.quad_sign[:, None] * d + self.quad_coef[:, None] * self.quad_R
+        sign, coef = self.quad_sign[:, None], self.quad_coef[:, None]
+        num_V, num_v = numerator_gradients(V, vi, self.quad_s, self.quad_c, self.quad_Q)
+        dn_V, dn_v = denominator_gradients(self.quad_R, self.quad_Q)
+        gV = sign * num_V - coef * dn_V
         lin = self.lin_a
         if self.v_fixed is None:
-            r = vi - np.stack([self.quad_s, np.zeros_like(self.quad_s)], axis=1)
-            gv = 2 * self.quad_sign[:, None] * np.einsum("qji,qj->qi", self.quad_Q, r)
-            gv -= self.quad_coef[:, None] * self.quad_Q[:, 1, :]
-            gV = np.hstack([gV, gv])
+            gV = np.hstack([gV, sign * num_v - coef * dn_v])
             lin = np.hstack([lin, np.zeros((len(lin), 2))])
         return np.vstack([gV / self.scale, lin])
 
@@ -456,6 +464,8 @@ def crease_length(
 ):
     """Eq. (1): ruling length ``l(s)`` of the crease on cylinder ``i``, or on several.
 
+    The crease functions of :mod:`filletfold.vertex.crease` on a vertex frame's sides.
+
     Parameters
     ----------
     frame : VertexFrame
@@ -479,20 +489,14 @@ def crease_length(
     """
     sa = frame.arrays
     s = np.asarray(s, dtype=float)
-    if np.ndim(i) == 0:
-        vi = sa.Q[i] @ v + sa.t[i]
-        side = np.full(len(s), i)
-        dn = vi[1] - (V - sa.M[i]) @ sa.R[i]
-        vx, vy, dn_out = vi[0], vi[1], float(dn)
-    else:
-        side = np.asarray(i)
-        vi = np.einsum("kij,j->ki", sa.Q, v) + sa.t  # per side of the ring
-        dn = vi[:, 1] - np.einsum("ij,ij->i", V - sa.M, sa.R)
-        vx, vy, dn, dn_out = vi[side, 0], vi[side, 1], dn[side], None
+    one = np.ndim(i) == 0
+    side = np.full(len(s), i) if one else np.asarray(i)
+    vi = chart_apex(sa.Q, sa.t, v)  # per side of the ring
+    dn = crease_denominator(V, vi, sa.M, sa.R)
     if C is None:
         C = sa.base(side, s)
-    num = (vx - s) ** 2 + vy**2 - np.einsum("ij,ij->i", V - C, V - C)
-    return 0.5 * num / dn, dn if dn_out is None else dn_out
+    l = crease_height(crease_numerator(V, vi[side], s, C), dn[side])
+    return l, float(dn[i]) if one else dn[side]
 
 
 def validate_apex(
@@ -588,12 +592,12 @@ def validate_apices(
     faces = np.concatenate([f.ring.faces for f in frames])  # (F,) mesh faces
     T_face = np.concatenate([f.T_end[:nf] for f, nf in zip(frames, n_faces, strict=True)])
     side, first, last, s, C, N = sa.samples(n_samples)
-    vi = np.einsum("kij,kj->ki", sa.Q, v) + sa.t  # developed apex in each cylinder's chart
+    vi = chart_apex(sa.Q, sa.t, v)  # developed apex in each cylinder's chart
     d = V[side] - C
-    num = (vi[side, 0] - s) ** 2 + vi[side, 1] ** 2 - np.einsum("ij,ij->i", d, d)
-    dn = vi[:, 1] - np.einsum("ij,ij->i", V - sa.M, sa.R)
+    num = crease_numerator(V[side], vi[side], s, C)
+    dn = crease_denominator(V, vi, sa.M, sa.R)
     valid = dn > 0
-    l = 0.5 * num / np.where(valid, dn, 1.0)[side]
+    l = crease_height(num, np.where(valid, dn, 1.0)[side])
     nonint = sigma[vert][side] * np.einsum("ij,ij->i", d, N)
     # the minima between samples: Newton from the smallest sample on the closed forms
     l_min, l_at = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
@@ -698,11 +702,10 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
     P = np.einsum("ij,ij->i", V - sa.O, sa.N0)
     Q = np.einsum("ij,ij->i", V - sa.O, sa.B)
     for _ in range(4):
-        c, sn = np.cos(t / rr), np.sin(t / rr)
         if vi is not None:  # derivatives of num(s)
-            d1 = -2 * (vi[:, 0] - t) + 2 * sa.kappa * (-P * sn + Q * c)
-            d2 = 2 + 2 * sa.kappa / rr * (-P * c - Q * sn)
+            d1, d2 = numerator_arc_derivatives(vi[:, 0], t, sa.kappa, rr, P, Q)
         else:
+            c, sn = np.cos(t / rr), np.sin(t / rr)
             d1 = sigma / rr * (-P * sn + Q * c)
             d2 = sigma / rr**2 * (-P * c - Q * sn)
         step = np.where(d2 > 0, d1 / np.where(d2 > 0, d2, 1.0), 0.0)
@@ -710,9 +713,7 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
     i = np.arange(len(first))
     C, N = sa.base_normal(i, t)
     if vi is not None:
-        dv = V - C
-        num = (vi[:, 0] - t) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", dv, dv)
-        val = 0.5 * num / np.where(dn > 0, dn, 1.0)
+        val = crease_height(crease_numerator(V, vi, t, C), np.where(dn > 0, dn, 1.0))
     else:
         val = sigma * np.einsum("ij,ij->i", V - C, N)
     return np.where(ok, np.minimum(best, val), best), np.where(ok & (val < best), t, s[arg])

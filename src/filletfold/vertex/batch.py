@@ -36,6 +36,13 @@ from scipy.optimize import nnls
 
 from ..errors import FilletfoldError
 from .apex import ApexConstraints, ApexSolution
+from .crease import (
+    chart_apex,
+    crease_denominator,
+    crease_numerator,
+    denominator_gradients,
+    numerator_gradients,
+)
 from .reference import project_slsqp, solve_apex_slsqp
 
 #: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, about 6x
@@ -160,17 +167,16 @@ def pack_problems(problems: Sequence[ApexConstraints], targets: np.ndarray, n: i
     v = T[:, 3:5] if n == 5 else np.array([p.v_fixed for p in problems])
     Lq, Vq = L[qb], V[qb]
     # ApexConstraints.values and .jacobian, row by row
-    vi = np.einsum("qij,qj->qi", Q, v[qb]) + cat("quad_t")
-    d = Vq - c
-    num = (vi[:, 0] - s) ** 2 + vi[:, 1] ** 2 - np.einsum("ij,ij->i", d, d)
-    dn = vi[:, 1] - np.einsum("ij,ij->i", Vq - cat("quad_M"), R_q)
+    vi = chart_apex(Q, cat("quad_t"), v[qb])
+    num = crease_numerator(Vq, vi, s, c)
+    dn = crease_denominator(Vq, vi, cat("quad_M"), R_q)
     quad = (sign * num - coef * dn) / Lq + cat("quad_const")
     lin = np.einsum("ij,ij->i", lin_a, V[lb]) + cat("lin_b")
-    g_quad = -2 * sign[:, None] * d + coef[:, None] * R_q
+    num_V, num_v = numerator_gradients(Vq, vi, s, c, Q)
+    dn_V, dn_v = denominator_gradients(R_q, Q)
+    g_quad = sign[:, None] * num_V - coef[:, None] * dn_V
     if n == 5:
-        r = vi - np.stack([s, np.zeros_like(s)], axis=1)
-        g_v = 2 * sign[:, None] * np.einsum("qji,qj->qi", Q, r) - coef[:, None] * Q[:, 1, :]
-        g_quad = np.hstack([g_quad, g_v])
+        g_quad = np.hstack([g_quad, sign[:, None] * num_v - coef[:, None] * dn_v])
     R = int((nq + nl).max(initial=0))
     out = RowBlock(
         np.ones((B, R)),

@@ -10,7 +10,8 @@ A boundary side is the unrounded edge line ``M + z R``.
 All pieces are developed into one common 2D frame: the chart of ``tau = f_{n-1}`` (origin U). Each
 cylinder and face gets a rigid 2D map (3x3 homogeneous) by chaining the tangent-plane gluings
 ``tau -> cylinder 0 -> f_0 -> ... -> cylinder n-1 -> tau'``. The last map ``rho`` turns by minus the
-angle defect; the developed apex is its fixed point (METHOD-NOTES, "one common 2D frame").
+angle defect; the developed apex is its fixed point, :func:`developed_apices` (docs/method.md,
+'Conventions', "One 2D frame per vertex").
 
 :func:`vertex_frames` builds the frames of many vertices at once, on flat arrays over all their
 (vertex, ring position) pairs; :func:`vertex_frame` is one vertex through it.
@@ -27,6 +28,7 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
 from ..rounding import EdgeRounding
+from ..tolerances import tol
 
 
 @dataclass
@@ -404,17 +406,15 @@ class VertexFrame:
         return float(np.arctan2(self.rho[1, 0], self.rho[0, 0]))
 
     def developed_apex(self) -> np.ndarray | None:
-        """The fixed point of ``rho`` in the common frame, or None if ``rho`` is a translation.
+        """The fixed point of ``rho`` in the common frame, or None if ``rho`` is a translation
+        (:func:`developed_apices` of this vertex).
 
         Returns
         -------
         (2,) float or None
         """
-        q = self.rho[:2, :2]
-        a = np.eye(2) - q
-        if abs(np.linalg.det(a)) < 1e-14:
-            return None
-        return np.linalg.solve(a, self.rho[:2, 2])
+        v = developed_apices(self.rho[None])[0]
+        return None if np.isnan(v[0]) else v
 
     def gluing_start(self, i: int) -> np.ndarray:
         """Map from cylinder ``i``'s chart into the chart of face ``f_{i-1}``."""
@@ -437,6 +437,37 @@ class VertexFrame:
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
         s = np.array([s], dtype=float)
         return _gluing_maps(side.tangent(s), side.R[None], frame[None], side.base(s), s)[0]
+
+
+def developed_apices(rho: np.ndarray, min_det: float = tol.fixed_point) -> np.ndarray:
+    """The developed apices of many vertices (paper sec. 2.4): the fixed points of their maps
+    ``rho`` (``tau -> tau'``).
+
+    A crease point on ``tau`` and its copy on ``tau'`` must be equally far from the developed
+    apex ``v`` for the crease to close tangent continuously, so ``v`` is the centre of the
+    rotation ``rho = [Q, t]``: ``v = Q v + t``, i.e. ``(I - Q) v = t``. ``det(I - Q)`` is
+    ``4 sin^2(theta / 2)`` for a turn by ``theta`` (minus the angle defect): a map that turns
+    by (almost) nothing is a translation, with no fixed point.
+
+    Parameters
+    ----------
+    rho : (n, 3, 3) float
+        Rigid homogeneous 2D maps.
+    min_det : float
+        Below this ``|det(I - Q)|`` a map has no fixed point (default ``tol.fixed_point``).
+
+    Returns
+    -------
+    (n, 2) float
+        Fixed points in each vertex's common frame; NaN where there is none.
+    """
+    rho = np.asarray(rho, dtype=float).reshape(-1, 3, 3)
+    a = np.eye(2) - rho[:, :2, :2]
+    turns = np.abs(np.linalg.det(a)) >= min_det
+    v = np.full((len(rho), 2), np.nan)
+    if turns.any():
+        v[turns] = np.linalg.solve(a[turns], rho[turns, :2, 2, None])[..., 0]
+    return v
 
 
 def _gluing_maps(

@@ -1,4 +1,7 @@
-"""Vertex classification and the vertex normal (paper sec. 2.5, 3.1; METHOD-NOTES 1-2).
+"""Vertex classification and the vertex normal (paper sec. 2.5, 3.1).
+
+The sign of the edge rows and the choice of ``sigma`` correct the paper (docs/method.md,
+'Corrections to the paper', 1 and 2).
 
 The vertex normal ``D`` maximises ``b`` subject to ``D . (-R_i) >= b`` for every incident edge
 direction ``R_i`` (toward the vertex), ``D . (sigma N_f) >= b`` for every incident face and

@@ -22,7 +22,7 @@ from .apex import (
     validate_apices,
 )
 from .batch import solve_apex_batch
-from .frame import VertexFrame, vertex_frames
+from .frame import VertexFrame, developed_apices, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
 
@@ -220,10 +220,8 @@ def _opens_with_a_near_apex(frame: VertexFrame) -> bool:
     reach = float(length.max())
     if float(np.linalg.norm(t)) + turn * reach <= tol.closure * float(length.mean()):
         return False  # closed: a developable vertex
-    a = np.eye(2) - q
-    if abs(np.linalg.det(a)) < 1e-300:
-        return False
-    return float(np.linalg.norm(np.linalg.solve(a, t))) <= 10 * reach
+    v = developed_apices(frame.rho[None], min_det=1e-300)[0]  # any fixed point at all
+    return bool(np.isfinite(v[0])) and float(np.linalg.norm(v)) <= 10 * reach
 
 
 def classify_vertex(
@@ -389,11 +387,9 @@ def _set_up(frames, depths, res: VertexResult, vertices, size: float | None = No
     closed = np.array([res.kind[u] == "developable" for u in vertices])
     # developed apex: the fixed point of rho, or where central rulings cross (closed)
     rho = np.array([f.rho for f in fr])  # (n, 3, 3)
-    a = np.eye(2) - rho[:, :2, :2]
-    turns = ~closed & (np.abs(np.linalg.det(a)) >= 1e-14)
     v = np.full((len(fr), 2), np.nan)
-    if turns.any():
-        v[turns] = np.linalg.solve(a[turns], rho[turns, :2, 2, None])[..., 0]
+    v[~closed] = developed_apices(rho[~closed])
+    turns = ~closed & np.isfinite(v[:, 0])
     for j in np.flatnonzero(closed).tolist():
         crossing = central_rulings_crossing(fr[j])
         if crossing is not None:
