@@ -54,7 +54,7 @@ from scipy.spatial import ConvexHull
 
 from filletfold.design import parse_length
 from filletfold.mesh import load_mesh
-from filletfold.rounding import clamp_radii, round_edges
+from filletfold.rounding.edges import clamp_radii, round_edges
 from filletfold.vertex.batch import solve_apex_batch
 from filletfold.vertex.reference import solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems

@@ -16,7 +16,7 @@ import sys
 import numpy as np
 
 import filletfold
-from filletfold.module import face_piece_centres
+from filletfold.surface.centres import face_piece_centres
 from filletfold.vertex.apex import build_constraints, validate_apex
 from filletfold.vertex.frame import vertex_frame
 

@@ -59,7 +59,7 @@ def first_attempt_problems(spec: str, clamp: bool):
     """(constraints, targets, starts, thorough) of every cone vertex's first attempt, as
     :func:`filletfold.vertex.solve.solve_apices` sets up its first round."""
     from filletfold.mesh import load_mesh
-    from filletfold.rounding import clamp_radii, round_edges
+    from filletfold.rounding.edges import clamp_radii, round_edges
     from filletfold.vertex.solve import apex_problems
 
     pm, _ = load_mesh(case_mesh(spec))

@@ -18,9 +18,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from filletfold.material_loss import solve_material_loss
 from filletfold.mesh import load_mesh
-from filletfold.rounding import clamp_radii, round_edges
+from filletfold.rounding.edges import clamp_radii, round_edges
+from filletfold.rounding.material_loss import solve_material_loss
 from filletfold.vertex.batch import pack, pack_problems, rows_of, solve_apex, solve_apex_batch
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems

@@ -25,7 +25,7 @@ from filletfold.check import (
 from filletfold.cli import main
 from filletfold.errors import MeshReadError
 from filletfold.export.fold_read import read_fold
-from filletfold.pattern import CreasePattern
+from filletfold.surface.pattern import CreasePattern
 
 from .conftest import design_of
 

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from filletfold.mesh import load_mesh
-from filletfold.rounding import round_edges
+from filletfold.rounding.edges import round_edges
 from filletfold.vertex.apex import crease_length
 from filletfold.vertex.crease import (
     chart_apex,

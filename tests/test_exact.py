@@ -15,9 +15,10 @@ from hypothesis import strategies as st
 
 import filletfold
 from filletfold.mesh.polymesh import PolyMesh
-from filletfold.module import build_module, face_piece_centres
-from filletfold.module_batch import build_modules
-from filletfold.rounding import round_edges
+from filletfold.rounding.edges import round_edges
+from filletfold.surface.batch import build_modules
+from filletfold.surface.centres import face_piece_centres
+from filletfold.surface.module import build_module
 from filletfold.tolerances import tol
 from filletfold.vertex.apex import fold_planes
 from filletfold.vertex.frame import vertex_frame

@@ -24,7 +24,7 @@ from filletfold.export import (
     validate_pattern,
 )
 from filletfold.export.svg import nice_length
-from filletfold.pattern import CreasePattern
+from filletfold.surface.pattern import CreasePattern
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 ATOL = 1e-9

@@ -44,7 +44,7 @@ from filletfold.export.paths import (
     tab_cut_paths,
 )
 from filletfold.export.pdf import MAX_PAGES, REGION_PAD_MM, pdf_tiles
-from filletfold.pattern import Annotations, CreasePattern, Label
+from filletfold.surface.pattern import Annotations, CreasePattern, Label
 from filletfold.units import sheet_size_mm
 
 SVG_NS = "{http://www.w3.org/2000/svg}"

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from filletfold.errors import MeshError
 from filletfold.mesh import example_mesh, example_names, load_mesh
 from filletfold.mesh.polymesh import PolyMesh, VertexRing
-from filletfold.rounding import round_edges
+from filletfold.rounding.edges import round_edges
 from filletfold.vertex.frame import (
     Side,
     VertexFrame,

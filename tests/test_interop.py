@@ -17,7 +17,7 @@ import pytest
 
 import filletfold
 from filletfold.export import fold_document, fold_json
-from filletfold.pattern import Annotations, CreasePattern, Label
+from filletfold.surface.pattern import Annotations, CreasePattern, Label
 
 INTEROP = Path(__file__).parent / "interop"
 SCRIPT = INTEROP / "rabbit_ear_load.mjs"

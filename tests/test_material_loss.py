@@ -8,9 +8,9 @@ from numpy.testing import assert_allclose
 
 import filletfold
 from filletfold.errors import ParameterError, SolverError
-from filletfold.material_loss import cycle_equalities, solve_material_loss
 from filletfold.mesh import load_mesh
-from filletfold.rounding import edge_dihedral, loss_from_radius, round_edges
+from filletfold.rounding.edges import edge_dihedral, loss_from_radius, round_edges
+from filletfold.rounding.material_loss import cycle_equalities, solve_material_loss
 from filletfold.vertex.frame import vertex_frame
 
 from .test_design import CHECKS
@@ -103,7 +103,7 @@ def rotational_dome(n=8, rings=4, radius=2.0):
 
 
 def test_conical_mesh_is_detected_and_rounded_by_face_offset():
-    from filletfold.conical import is_conical, vertex_cone_axes
+    from filletfold.rounding.conical import is_conical, vertex_cone_axes
 
     m = load_mesh(rotational_dome())[0]
     assert is_conical(m)
@@ -127,8 +127,9 @@ def test_conical_mesh_is_detected_and_rounded_by_face_offset():
 
 
 def test_development_of_a_developable_mesh():
-    from filletfold.develop import develop_faces
     from filletfold.errors import MeshError
+
+    from .reference.develop import develop_faces
 
     m = load_mesh(folded_degree4_vertex())[0]
     flat = develop_faces(m)
@@ -149,8 +150,9 @@ def check_sheet_is_the_input_shrunk_by_the_losses(d):
     """
     from scipy.spatial import cKDTree
 
-    from filletfold.develop import develop_faces
-    from filletfold.module import face_piece_centres
+    from filletfold.surface.centres import face_piece_centres
+
+    from .reference.develop import develop_faces
 
     m, p = d.mesh, d.pattern
     flat = develop_faces(m)

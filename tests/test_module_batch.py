@@ -12,11 +12,13 @@ import numpy as np
 import pytest
 
 import filletfold
-from filletfold import module, module_batch
 from filletfold.mesh import example_names
-from filletfold.module import build_module, faces_interior_disjoint, faces_interior_disjoint_many
-from filletfold.module_batch import build_modules
-from filletfold.rounding import round_edges
+from filletfold.rounding.edges import round_edges
+from filletfold.surface import batch as module_batch
+from filletfold.surface import overlap
+from filletfold.surface.batch import build_modules
+from filletfold.surface.module import build_module
+from filletfold.surface.overlap import faces_interior_disjoint, faces_interior_disjoint_many
 
 from .conftest import CLOSED_CONVEX, design_of, jittered_grid, random_convex
 from .test_speed_module import annulus_strip
@@ -158,7 +160,7 @@ def test_overlapping_rings_are_split_without_the_union(monkeypatch):
         want = [build_module(d.mesh, f, st.centres, st.samples, a, v) for f, a, v in st.solved]
         frames, apices, developed = (list(c) for c in zip(*st.solved, strict=True))
         with monkeypatch.context() as m:
-            m.setattr(module.shapely, "union_all", refused)
+            m.setattr(overlap.shapely, "union_all", refused)
             m.setattr(module_batch, "build_module", refused)
             got = build_modules(d.mesh, frames, st.centres, st.samples, apices, developed)
         assert_same_modules(got, want)

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import filletfold
-from filletfold import module_batch, parallel
+from filletfold import parallel
+from filletfold.surface import batch as module_batch
 from filletfold.vertex import solve
 
 

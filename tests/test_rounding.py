@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose
 
 from filletfold.errors import ParameterError
 from filletfold.mesh import load_mesh
-from filletfold.rounding import (
+from filletfold.rounding.edges import (
     edge_dihedral,
     loss_from_radius,
     radius_from_loss,
@@ -161,8 +161,8 @@ def test_unrounded_edges_keep_their_face_pieces():
     edges at 171 degree corners) with every other rim edge left sharp, the fitted radii leave
     every face piece a simple polygon (the pieces' centres exist)."""
     from filletfold.mesh import clean_mesh
-    from filletfold.module import face_piece_centres
-    from filletfold.rounding import shrink_broken
+    from filletfold.rounding.edges import shrink_broken
+    from filletfold.surface.centres import face_piece_centres
 
     n = 40
     t = 2 * np.pi * np.arange(n) / n

@@ -25,7 +25,7 @@ from filletfold.export import (
 from filletfold.export.fold import _float_text, _round, validated_faces
 from filletfold.export.obj import obj_group_name
 from filletfold.export.report import to_json_data
-from filletfold.pattern import CreasePattern
+from filletfold.surface.pattern import CreasePattern
 
 from .conftest import design_of
 

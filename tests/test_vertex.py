@@ -13,7 +13,7 @@ from numpy.testing import assert_allclose
 
 import filletfold
 from filletfold.mesh import load_mesh
-from filletfold.rounding import round_edges
+from filletfold.rounding.edges import round_edges
 from filletfold.tolerances import tol
 from filletfold.vertex.apex import build_constraints, validate_apex
 from filletfold.vertex.batch import solve_apex
@@ -226,7 +226,9 @@ def test_crease_through_T_gives_a_clean_module():
     are then merged)."""
     from scipy.optimize import brentq
 
-    from filletfold.module import build_module, face_piece_centres, face_polygons
+    from filletfold.surface.centres import face_piece_centres
+    from filletfold.surface.faces import face_polygons
+    from filletfold.surface.module import build_module
     from filletfold.vertex.apex import crease_length
 
     m = load_mesh("icosahedron")[0]

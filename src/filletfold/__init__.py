@@ -22,7 +22,7 @@ from .errors import (
     SolverError,
 )
 from .mesh import PolyMesh, example_names, load_mesh
-from .pattern import CreasePattern
+from .surface.pattern import CreasePattern
 
 __all__ = [
     "CreasePattern",

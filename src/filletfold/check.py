@@ -50,7 +50,7 @@ import shapely
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
 from .export.fold_read import _edge_faces, read_fold
-from .pattern import CreasePattern, face_arrays
+from .surface.pattern import CreasePattern, face_arrays
 
 __all__ = [
     "ANGLE_TOL_DEG",

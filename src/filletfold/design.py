@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .conical import conical_material_loss, is_conical, vertex_cone_axes
 from .errors import (
     FilletfoldError,
     InternalError,
@@ -27,17 +26,20 @@ from .errors import (
     one_line,
 )
 from .errors import stage as _stage
-from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
-from .layout import shelf_layout
-from .material_loss import MaterialLoss, solve_material_loss
+from .layout.fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
+from .layout.sheet import glue_pieces
+from .layout.shelf import shelf_layout
+from .layout.tabs import add_tabs_and_labels
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
-from .module import Piece, assemble_pattern, face_piece_centres, piece_area
-from .module_batch import build_modules
-from .pattern import CreasePattern
-from .rounding import EdgeRounding, clamp_radii, round_edges
-from .sheet import glue_pieces
-from .tabs import add_tabs_and_labels
+from .rounding.conical import conical_material_loss, is_conical, vertex_cone_axes
+from .rounding.edges import EdgeRounding, clamp_radii, round_edges
+from .rounding.material_loss import MaterialLoss, solve_material_loss
+from .surface.assemble import assemble_pattern
+from .surface.batch import build_modules
+from .surface.centres import face_piece_centres
+from .surface.pattern import CreasePattern
+from .surface.piece import Piece, piece_area
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.solve import STATUSES, VertexResult, classify_vertices, mesh_size, solve_apices
@@ -184,7 +186,7 @@ class Stages:
         The final per-vertex results.
     solved : list of (VertexFrame, apex or None, developed apex or None)
     samples : (n_edges,) int
-        Points on each edge's arc (:meth:`~filletfold.rounding.EdgeRounding.arc_points`).
+        Points on each edge's arc (:meth:`~filletfold.rounding.edges.EdgeRounding.arc_points`).
     modules : list of list of Piece
         Each vertex's module pieces, before the layout.
     """
@@ -490,12 +492,12 @@ def round_mesh(
         1.5 degrees). 0 gives every arc ``samples`` points.
     clamp : bool, optional
         Reduce radii over their edge's limit to 90% of it (see
-        :func:`filletfold.rounding.clamp_radii`) instead of raising. Default: on, off with
+        :func:`filletfold.rounding.edges.clamp_radii`) instead of raising. Default: on, off with
         ``strict``.
     material_loss : bool
         Choose every edge's radius from the consistent-material-loss linear programme (sec. 4,
-        :func:`filletfold.material_loss.solve_material_loss`); ``radius`` is then the largest
-        radius any edge may get.
+        :func:`filletfold.rounding.material_loss.solve_material_loss`); ``radius`` is then the
+        largest radius any edge may get.
         On a developable input the rounded development of every interior vertex closes, so the
         design folds from one uncut sheet.
     max_loss : float or str, optional

@@ -12,8 +12,8 @@ from .errors import named_stages
 from .export import report_json, write_outputs
 from .export.cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .export.report import Records
-from .rounding import loss_from_radius
-from .tabs import assembly_text
+from .layout.tabs import assembly_text
+from .rounding.edges import loss_from_radius
 from .tolerances import tol
 
 #: The files :func:`export_design` writes by default (and ``assembly.txt`` with glue tabs).

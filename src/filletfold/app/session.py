@@ -32,9 +32,9 @@ from ..design import (
 from ..errors import MeshReadError, ParameterError
 from ..export.cutfiles import cut_files
 from ..export.report import report_json
+from ..layout.tabs import assembly_text
 from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
 from ..mesh.polymesh import PolyMesh
-from ..tabs import assembly_text
 
 log = logging.getLogger(__name__)
 

@@ -31,7 +31,7 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 
 from ..errors import ParameterError
-from ..pattern import Annotations, CreasePattern, Label
+from ..surface.pattern import Annotations, CreasePattern, Label
 from ..units import check_units, sheet_size_mm
 from .dxf import check_scale, pattern_dxf
 from .fold import _fold_document, fold_json, validated_faces

@@ -38,7 +38,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
-from ..pattern import CreasePattern
+from ..surface.pattern import CreasePattern
 from ..units import check_units
 from .fold import validate_pattern
 from .paths import chain_runs, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths

@@ -5,7 +5,7 @@ form, inheriting everything from the key frame except its 3D ``vertices_coords``
 https://github.com/edemaine/fold/blob/main/doc/spec.md
 
 Also home of :func:`validate_pattern`, the entry check every exporter runs on a
-:class:`~filletfold.pattern.CreasePattern`.
+:class:`~filletfold.surface.pattern.CreasePattern`.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ExportError, ParameterError
-from ..pattern import Annotations, CreasePattern, FlatFaces, face_arrays
+from ..surface.pattern import Annotations, CreasePattern, FlatFaces, face_arrays
 from ..tolerances import tol
 
 __all__ = [

@@ -1,7 +1,7 @@
 """Reading back a design written by :func:`~filletfold.export.fold.fold_document`.
 
-:func:`read_fold` rebuilds the :class:`~filletfold.pattern.CreasePattern` of a ``design.fold``:
-the key frame's 2D ``vertices_coords``, ``faces_vertices``, ``edges_vertices``,
+:func:`read_fold` rebuilds the :class:`~filletfold.surface.pattern.CreasePattern` of a
+``design.fold``: the key frame's 2D ``vertices_coords``, ``faces_vertices``, ``edges_vertices``,
 ``edges_assignment`` and ``edges_foldAngle`` (kept as written, not derived again),
 ``filletfold:faces_patch``, ``filletfold:faces_piece``, ``filletfold:pieces_vertex`` and, from the
 folded frame, the 3D ``vertices_coords``. The annotations come from ``filletfold:annotations``
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ExportError, MeshReadError
-from ..pattern import Annotations, CreasePattern, Label
+from ..surface.pattern import Annotations, CreasePattern, Label
 from .fold import NAMESPACE, validate_pattern
 
 __all__ = ["pattern_from_fold", "read_fold"]

@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 
-from ..pattern import CreasePattern
+from ..surface.pattern import CreasePattern
 from ..tolerances import tol
 from .fold import face_arrays, file_creator, validated_faces
 

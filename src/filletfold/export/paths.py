@@ -13,7 +13,7 @@ import itertools
 
 import numpy as np
 
-from ..pattern import Annotations, CreasePattern
+from ..surface.pattern import Annotations, CreasePattern
 
 __all__ = [
     "SPLINE_MAX_SPACING_RATIO",

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..pattern import CreasePattern
+from ..surface.pattern import CreasePattern
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
 from .fold import validate_pattern

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
-from ..pattern import CreasePattern
+from ..surface.pattern import CreasePattern
 from .fold import validate_pattern
 from .palette import LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths

@@ -21,7 +21,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from ..errors import ParameterError
-from ..pattern import CreasePattern
+from ..surface.pattern import CreasePattern
 from ..units import MM_PER_UNIT, check_units
 from .fold import validate_pattern
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR

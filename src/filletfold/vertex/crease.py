@@ -20,7 +20,8 @@ with ``M``. A valid patch has ``dn > 0`` (sec. 2.2), and then ``l >= 0`` exactly
 ``num`` is evaluated as written: a difference of two squared distances, each a sum of squares
 of coordinate differences taken first, so no large coordinates are squared and subtracted.
 (It still loses the digits of ``|v_i - c|^2`` against ``l^2`` on a short ruling far from the
-chart origin; :func:`filletfold.module.true_rulings` restores the pattern's ruling lengths.)
+chart origin; :func:`filletfold.surface.assemble.true_rulings` restores the pattern's ruling
+lengths.)
 
 Every function works on arrays of rows ``(m, ...)``: one row per (side, arc parameter) pair.
 The solvers write their constraints as ``sign * num - coef * dn`` and need the derivatives with

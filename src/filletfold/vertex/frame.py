@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
-from ..rounding import EdgeRounding
+from ..rounding.edges import EdgeRounding
 from ..tolerances import tol
 
 

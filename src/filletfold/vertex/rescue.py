@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..mesh.polymesh import PolyMesh
-from ..rounding import EdgeRounding, round_edges, shrink_broken
+from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
 from .solve import VertexResult, classify_vertices, mesh_size, solve_apices
 
 #: Halvings of an infeasible vertex's radii tried before it is left infeasible (1/16 at most).
@@ -86,11 +86,11 @@ def rescue_vertices(
     centres : (n_faces, 3) float
         Face piece centres of ``rounding``.
     face_centres : callable
-        ``face_centres(mesh, rounding) -> (n_faces, 3)`` (:func:`~filletfold.module.
+        ``face_centres(mesh, rounding) -> (n_faces, 3)`` (:func:`~filletfold.surface.module.
         face_piece_centres`).
     apply : bool
     flat_deg, floor, min_width : float
-        Passed to :func:`~filletfold.rounding.round_edges`.
+        Passed to :func:`~filletfold.rounding.edges.round_edges`.
     apices : dict
         Vertex -> (apex, developed apex) of :func:`solve_apices`; updated in place
         (``apply``).

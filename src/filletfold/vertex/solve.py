@@ -12,7 +12,7 @@ import numpy as np
 
 from ..mesh.polymesh import PolyMesh
 from ..parallel import thread_map
-from ..rounding import EdgeRounding
+from ..rounding.edges import EdgeRounding
 from ..tolerances import tol
 from . import batch
 from .apex import (

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from .pattern import Annotations, CreasePattern, Label
+from ..surface.pattern import Annotations, CreasePattern, Label
 
 
 def _seam_pairs(p: CreasePattern, decimals: int = 9) -> list[tuple[int, int]]:

@@ -20,9 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterError
-from .mesh.polymesh import PolyMesh
-from .tolerances import tol
+from ..errors import ParameterError
+from ..mesh.polymesh import PolyMesh
+from ..tolerances import tol
 
 
 def edge_dihedral(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:

@@ -24,7 +24,7 @@ kept (a second linear programme), so the widths stay near ``b`` instead of at th
 
 The paper leaves the "maximal rounding width" undefined. Here every face corner must keep its
 tangent-line crossing T within ``share`` of each edge's half length (the radius limit of
-:func:`filletfold.rounding.radius_limits`, with room left for the crease), and optionally
+:func:`filletfold.rounding.edges.radius_limits`, with room left for the crease), and optionally
 ``w_e <= max_loss``.
 """
 
@@ -37,10 +37,10 @@ from scipy import sparse
 from scipy.optimize import linprog
 from scipy.sparse.linalg import lsqr
 
-from .errors import ParameterError
-from .mesh.polymesh import PolyMesh
-from .rounding import edge_dihedral, radius_from_loss, tan_minus_angle
-from .tolerances import tol
+from ..errors import ParameterError
+from ..mesh.polymesh import PolyMesh
+from ..tolerances import tol
+from .edges import edge_dihedral, radius_from_loss, tan_minus_angle
 
 
 @dataclass

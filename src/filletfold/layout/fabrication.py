@@ -11,11 +11,13 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from .errors import ParameterError
-from .module import Piece, build_module, face_polygons
+from ..errors import ParameterError
+from ..surface.faces import face_polygons
+from ..surface.module import build_module
+from ..surface.piece import Piece
+from ..units import MM_PER_UNIT, check_units, sheet_size_mm
+from ..vertex.frame import apply, invert, vertex_frames
 from .net import build_nets, cut_edges_for_nets
-from .units import MM_PER_UNIT, check_units, sheet_size_mm
-from .vertex.frame import apply, invert, vertex_frames
 
 
 def sheet_in_pattern_units(sheet: str, units: str, scale: float) -> tuple[float, float]:
@@ -60,7 +62,7 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
         The frames the apices were solved in, and the apices.
     centres : (n_faces, 3) float
     samples : int or (n_edges,) int
-        Points per arc (see :func:`~filletfold.module.build_module`).
+        Points per arc (see :func:`~filletfold.surface.module.build_module`).
     eps : float
     sheet : (float, float), optional
         Every net must fit this (pattern units).

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..mesh.polymesh import PolyMesh
+from ..tolerances import tol
+from .edges import edge_dihedral, radius_from_loss, tan_minus_angle
 from .material_loss import MaterialLoss, cycle_equalities
-from .mesh.polymesh import PolyMesh
-from .rounding import edge_dihedral, radius_from_loss, tan_minus_angle
-from .tolerances import tol
 
 
 def vertex_cone_axes(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:

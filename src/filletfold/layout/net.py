@@ -15,7 +15,8 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 
-from .module import FaceLists, Piece, face_polygons, flat_faces
+from ..surface.faces import FaceLists, face_polygons, flat_faces
+from ..surface.piece import Piece
 
 
 def rigid_fit(src: np.ndarray, dst: np.ndarray) -> np.ndarray:

@@ -1,24 +1,26 @@
 """The vertex modules of many vertices at once (the surface stage).
 
-:func:`build_modules` returns, for every vertex, what :func:`~filletfold.module.build_module`
+:func:`build_modules` returns, for every vertex, what
+:func:`~filletfold.surface.module.build_module`
 returns. Cone modules and hole modules (saddle, developable, infeasible and boundary vertices,
 closed or open rings) are built on flat arrays over all those vertices, a round of *runs* at a
-time as :func:`~filletfold.module.build_module` builds them: first one run over each whole ring,
+time as :func:`~filletfold.surface.module.build_module` builds them: first one run over each whole
+ring,
 then the two halves of every run of more than one sector that overlaps itself. A round computes
 for all its runs together the arc samples, base curves and creases (or hole borders), their 2D
 images, the face shares' centres, the lines of unrounded boundary sides and the end copies of the
 side after each run, every face with its area, then the merge and overlap checks of all the
 pieces. Only a run that the overlap proof does not clear has its union measured on its own
-(:func:`~filletfold.module.run_overlaps`, the measure of ``build_module``). The points and
+(:func:`~filletfold.surface.overlap.run_overlaps`, the measure of ``build_module``). The points and
 faces come in the order ``build_module`` adds them, with the same arithmetic row by row, so the
 pieces are the same bit for bit.
 
-A vertex takes the per-vertex :func:`~filletfold.module.build_module` instead when
+A vertex takes the per-vertex :func:`~filletfold.surface.module.build_module` instead when
 
 * a face occurs twice in its ring, a corner is reflex, it has a cone on an open ring, or its
   hole border goes through a corner T;
-* :meth:`~filletfold.module.Piece.merge_coincident` could change one of its pieces: two points
-  coincide in 2D and 3D within the merge distance (with a margin), a point is not finite, a
+* :meth:`~filletfold.surface.piece.Piece.merge_coincident` could change one of its pieces: two
+  points coincide in 2D and 3D within the merge distance (with a margin), a point is not finite, a
   face has twice-area ``<= 2 eps**2`` or a point is in no face.
 """
 
@@ -29,23 +31,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .module import (
-    FaceLists,
-    Piece,
-    _arc_parameters,
-    apply_rows,
-    build_module,
-    faces_interior_disjoint_many,
-    hole_corners,
-    hole_heights,
-    polygon_area2,
-    run_overlaps,
-)
-from .parallel import thread_map
-from .tolerances import tol
-from .vertex.apex import _stack
-from .vertex.crease import chart_apex, crease_denominator, crease_height, crease_numerator
-from .vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
+from ..parallel import thread_map
+from ..tolerances import tol
+from ..vertex.apex import _stack
+from ..vertex.crease import chart_apex, crease_denominator, crease_height, crease_numerator
+from ..vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
+from .faces import FaceLists, polygon_area2
+from .module import _arc_parameters, apply_rows, build_module, hole_corners, hole_heights
+from .overlap import faces_interior_disjoint_many, run_overlaps
+from .piece import Piece
 
 #: Most vertices built together (bounds the flat arrays' size).
 CHUNK = 2048
@@ -66,7 +60,7 @@ def build_modules(
     frames : sequence of VertexFrame
         Any vertices, in any order.
     centres : (n_faces, 3) float
-        Face piece centres (:func:`~filletfold.module.face_piece_centres`).
+        Face piece centres (:func:`~filletfold.surface.centres.face_piece_centres`).
     n_samples : int or (n_edges,) int
         Points per arc, for all arcs or per edge.
     apices : sequence of ((3,) float or None)
@@ -125,7 +119,7 @@ def _batched_case(frame: VertexFrame, apex, v, centres) -> bool:
     """Whether the vertex may take the batched path: its ring's faces each once, its sides
     rounded (an open ring: all but the first and the last), no reflex corner (kept out although
     with a cone its faces are built alike), a cone only on a closed ring, and without a cone no
-    hole border through a corner T (:func:`~filletfold.module.hole_corners`)."""
+    hole border through a corner T (:func:`~filletfold.surface.module.hole_corners`)."""
     closed = frame.ring.closed
     if apex is not None and (v is None or not closed):
         return False
@@ -185,7 +179,7 @@ class _Chunk:
     lmax_start, lmax_end : (n_sides,) float
         As :class:`~filletfold.vertex.frame.VertexFrame` has them.
     height : (n_sides,) float
-        Hole border heights (:func:`~filletfold.module.hole_heights`).
+        Hole border heights (:func:`~filletfold.surface.module.hole_heights`).
     face_map, face_frame : (n_faces, 3, 3) float
         Each ring face's map into the common frame and its chart.
     centre : (n_faces, 3) float
@@ -199,8 +193,8 @@ class _Chunk:
     dn : (n_sides,) float
         The denominator of eq. (1) on each side.
     eps : (n_vert,) float
-        The merge distance of :meth:`~filletfold.module.Piece.merge_coincident`
-        (:func:`~filletfold.module.merge_distance`).
+        The merge distance of :meth:`~filletfold.surface.piece.Piece.merge_coincident`
+        (:func:`~filletfold.surface.module.merge_distance`).
     patch : list of str
         Patch names: the cylinder of each side, the cone of each vertex, each ring face.
     """
@@ -301,7 +295,7 @@ class _Chunk:
 
 def _chunk_modules(chunk: _Chunk) -> list:
     """The module of every vertex of a chunk (list of Piece, in ring order), or None where the
-    vertex must go through :func:`~filletfold.module.build_module`.
+    vertex must go through :func:`~filletfold.surface.module.build_module`.
 
     Runs ``(vertex, j0, j1)`` of sectors ``j0 .. j1`` are built a round at a time: a run of
     more than one sector whose piece is not proved free of overlap and measured to overlap
@@ -338,7 +332,7 @@ class _Layout:
 
     Share ``q`` is sector ``i`` of a run ``(vertex, j0, j1)``: the half-cylinder of side ``i``
     (when rounded), the share of ring face ``f_i`` and, with a cone, its triangle. A run's
-    points, in the order of :func:`~filletfold.module.build_module`: the apex (cones); side
+    points, in the order of :func:`~filletfold.surface.module.build_module`: the apex (cones); side
     ``j0``'s base curve and crease (or hole border), or the base and top of its line when it is
     unrounded; then per share the start of the next side (base, top) and the centre of face
     ``f_i``, followed, except after the last share, by the rest of the next side's base curve
@@ -445,9 +439,9 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
     Returns
     -------
     pieces : list of (Piece or None)
-        None where :meth:`~filletfold.module.Piece.merge_coincident` could change the piece.
+        None where :meth:`~filletfold.surface.piece.Piece.merge_coincident` could change the piece.
     proved : (n_runs,) bool
-        Proved free of overlap (:func:`~filletfold.module.faces_interior_disjoint_many`).
+        Proved free of overlap (:func:`~filletfold.surface.overlap.faces_interior_disjoint_many`).
     sectors : list of (n_faces,) int
         For each run, the sector (from 0 at ``j0``) of each face of its piece.
     """
@@ -597,8 +591,8 @@ def _run_faces(chunk: _Chunk, lay: _Layout):
 
 
 def _oriented(P2: np.ndarray, corners: np.ndarray, size: np.ndarray):
-    """:meth:`~filletfold.module.Piece.face` of every face: zero-area faces dropped, clockwise
-    ones reversed (``corners`` (n, 5) int, in place), NaN kept as is.
+    """:meth:`~filletfold.surface.piece.Piece.face` of every face: zero-area faces dropped,
+    clockwise ones reversed (``corners`` (n, 5) int, in place), NaN kept as is.
 
     Returns
     -------
@@ -623,7 +617,7 @@ def _nothing_merges(
 ) -> np.ndarray:
     """(n_pieces,) bool: no two points of a piece coincide within ``eps`` (per piece) in both
     2D and 3D, with a small margin, and all are finite: then
-    :meth:`~filletfold.module.Piece.merge_coincident` merges nothing.
+    :meth:`~filletfold.surface.piece.Piece.merge_coincident` merges nothing.
 
     Candidates are the points of a piece whose ``x`` lie in one chain of gaps ``<= eps`` (a
     piece with a chain longer than ``longest`` points is refused).

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .tolerances import tol
+from ..tolerances import tol
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
 NORMAL_CHUNK = 100_000
@@ -21,7 +21,7 @@ NORMAL_CHUNK = 100_000
 class FlatFaces(Sequence):
     """Polygons held as one flat index array and their offsets: no object per face until one
     is asked for. The base of :class:`FaceRows` (faces read as (k,) int64 arrays) and
-    :class:`~filletfold.module.FaceLists` (faces read as lists of int); :func:`face_arrays`
+    :class:`~filletfold.surface.faces.FaceLists` (faces read as lists of int); :func:`face_arrays`
     hands their arrays out as they are.
 
     Parameters
@@ -49,7 +49,7 @@ class FlatFaces(Sequence):
 
 class FaceRows(FlatFaces):
     """:class:`FlatFaces` read as (k,) int64 arrays (views of ``flat``): what
-    :func:`~filletfold.module.assemble_pattern` gives a pattern."""
+    :func:`~filletfold.surface.assemble.assemble_pattern` gives a pattern."""
 
     __slots__ = ()
 

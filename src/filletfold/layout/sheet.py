@@ -13,7 +13,7 @@ import collections
 
 import numpy as np
 
-from .module import Piece
+from ..surface.piece import Piece
 from .net import merge_pieces, rigid_fit, shared_points
 
 

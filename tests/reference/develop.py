@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import MeshError
-from .mesh.polymesh import PolyMesh
-from .vertex.frame import face_frame, to_chart
+from filletfold.errors import MeshError
+from filletfold.mesh.polymesh import PolyMesh
+from filletfold.vertex.frame import face_frame, to_chart
 
 
 def develop_faces(mesh: PolyMesh, *, check: bool = True, rtol: float = 1e-9) -> list[np.ndarray]:

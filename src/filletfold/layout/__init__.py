@@ -1,0 +1,4 @@
+"""Step 4, the layout: where the flat pieces go on the sheet — side by side on shelves
+(:mod:`.shelf`), glued into one sheet where the input is developable (:mod:`.sheet`), into nets
+packed on sheets of a size (:mod:`.net`, :mod:`.fabrication`), with glue tabs and labels on the
+cut borders (:mod:`.tabs`)."""
