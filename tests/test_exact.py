@@ -16,14 +16,14 @@ from hypothesis import strategies as st
 import filletfold
 from filletfold.mesh.polymesh import PolyMesh
 from filletfold.rounding.edges import round_edges
-from filletfold.surface.batch import build_modules
 from filletfold.surface.centres import face_piece_centres
-from filletfold.surface.module import build_module
+from filletfold.surface.module import build_modules
 from filletfold.tolerances import tol
 from filletfold.vertex.apex import fold_planes
 from filletfold.vertex.frame import vertex_frame
 
 from .conftest import design_of
+from .reference.module import build_module
 
 DATA = Path(__file__).parent / "data"
 

@@ -7,7 +7,7 @@ import pytest
 
 import filletfold
 from filletfold import parallel
-from filletfold.surface import batch as module_batch
+from filletfold.surface import module as module_batch
 from filletfold.vertex import solve
 
 

@@ -16,13 +16,14 @@ from filletfold.rounding.edges import round_edges
 from filletfold.surface.assemble import assemble_pattern
 from filletfold.surface.centres import face_piece_centres
 from filletfold.surface.faces import face_polygons
-from filletfold.surface.module import apply_rows, build_module
+from filletfold.surface.module import apply_rows
 from filletfold.surface.overlap import faces_interior_disjoint, faces_overlap, measured_overlap
 from filletfold.surface.pattern import CreasePattern
 from filletfold.surface.piece import Piece
 from filletfold.vertex.frame import apply, vertex_frame
 
 from .conftest import design_of, jittered_grid
+from .reference.module import build_module
 
 
 def reference_overlap(points_2d, faces, rel=1e-9) -> bool:

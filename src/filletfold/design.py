@@ -36,8 +36,8 @@ from .rounding.conical import conical_material_loss, is_conical, vertex_cone_axe
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
 from .surface.assemble import assemble_pattern
-from .surface.batch import build_modules
 from .surface.centres import face_piece_centres
+from .surface.module import build_modules
 from .surface.pattern import CreasePattern
 from .surface.piece import Piece, piece_area
 from .tolerances import tol

@@ -13,7 +13,7 @@ import shapely
 
 from ..errors import ParameterError
 from ..surface.faces import face_polygons
-from ..surface.module import build_module
+from ..surface.module import build_modules
 from ..surface.piece import Piece
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from ..vertex.frame import apply, invert, vertex_frames
@@ -62,7 +62,7 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
         The frames the apices were solved in, and the apices.
     centres : (n_faces, 3) float
     samples : int or (n_edges,) int
-        Points per arc (see :func:`~filletfold.surface.module.build_module`).
+        Points per arc (see :func:`~filletfold.surface.module.build_modules`).
     eps : float
     sheet : (float, float), optional
         Every net must fit this (pattern units).
@@ -91,6 +91,7 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
             cut_at = [u for u, (f, _, _) in enumerate(solved) if f.ring.closed and cut[u] >= 0]
             new_frames = vertex_frames(mesh, rounding, cut_at, [int(cut[u]) for u in cut_at])
             recut = dict(zip(cut_at, new_frames, strict=True))
+        batch = []  # (frame, apex, developed apex) of every vertex, its ring re-cut
         for u, (frame, apex, v) in enumerate(solved if cut is not None else []):
             if u in recut:
                 k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
@@ -98,7 +99,11 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
                 if v is not None and k:
                     v = apply(invert(frame.face_map[k - 1]), v)[0]
                 frame = new
-            pieces.extend(build_module(mesh, frame, centres, samples, apex, v))
+            batch.append((frame, apex, v))
+        if batch:
+            frames, apices, developed = (list(c) for c in zip(*batch, strict=True))
+            for module in build_modules(mesh, frames, centres, samples, apices, developed):
+                pieces.extend(module)
         nets, _ = build_nets(pieces, eps, sheet)
         if best is None or len(nets) < len(best):
             best = nets

@@ -1,5 +1,5 @@
 """Steps 3 and 4, the surface: each vertex's module (cone, half-cylinders, face shares; the
 curved creases of eq. (1) and the straight creases on the faces) as flat pieces with their
-folded positions (:mod:`.module` for one vertex, :mod:`.batch` for many at once; :mod:`.piece`,
-:mod:`.faces`, :mod:`.overlap`, :mod:`.centres`), and the crease pattern they assemble into
+folded positions, built for all vertices at once (:mod:`.module`; :mod:`.piece`, :mod:`.faces`,
+:mod:`.overlap`, :mod:`.centres`), and the crease pattern they assemble into
 (:mod:`.assemble`, :mod:`.pattern`)."""

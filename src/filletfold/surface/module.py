@@ -1,4 +1,5 @@
-"""Vertex modules: the flat piece(s) of one vertex, in 2D and folded in 3D (paper sec. 2).
+"""Vertex modules (paper sec. 2): the flat piece(s) of every vertex, in 2D and folded in 3D,
+built for all vertices at once; one vertex is a batch of one (:func:`build_module`).
 
 A vertex module is made of one *sector* per incident face ``f_i``: the half-cylinder of side
 ``i`` (from its midpoint base curve up to the crease), the vertex's share of face ``f_i`` (bounded
@@ -13,21 +14,36 @@ developable, boundary) end at a *hole border* instead: on each cylinder the cros
 
 A module whose development overlaps itself (cone angle above 2 pi, or a saddle's ring) is split
 into runs of consecutive sectors, each its own piece.
+
+All modules are built on flat arrays over all vertices (:func:`build_modules`), a round of
+*runs* at a time: first one run over each whole ring, then the two halves of every run of more
+than one sector that overlaps itself. A round computes for all its runs together the arc
+samples, base curves and creases (or hole borders), their 2D images, the face shares' centres
+(and the corner T where a hole border goes through it, :func:`hole_corners`), the lines of
+unrounded boundary sides and the end copies of the side after each run, every face with its
+area, then the overlap proof of all the pieces. Only a run that the proof does not clear has
+its union measured on its own (:func:`~filletfold.surface.overlap.run_overlaps`), and only a
+piece with points that coincide in 2D and 3D (a crease through T, an unrounded side) has them
+merged (:meth:`~filletfold.surface.piece.Piece.merge_coincident`). The per-vertex builder this
+replaced is kept as the tests' oracle (``tests/reference/module.py``): the pieces agree with it
+point for point and face for face.
 """
 
 from __future__ import annotations
 
-import itertools
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..mesh.polymesh import PolyMesh
+from ..parallel import thread_map
 from ..tolerances import tol
-from ..vertex.apex import crease_length
-from ..vertex.frame import VertexFrame, apply, stack_sides, to_chart
-from .faces import polygon_area2
-from .overlap import faces_interior_disjoint, run_overlaps
+from ..vertex.apex import _stack
+from ..vertex.crease import chart_apex, crease_denominator, crease_height, crease_numerator
+from ..vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
+from .faces import FaceLists, polygon_area2
+from .overlap import faces_interior_disjoint, faces_interior_disjoint_many, run_overlaps
 from .piece import Piece
 
 
@@ -120,107 +136,6 @@ def hole_corners(frame: VertexFrame, centres: np.ndarray) -> np.ndarray:
     return (np.asarray(frame.corner_angle) > np.pi) | ~beyond
 
 
-def build_module(
-    mesh: PolyMesh,
-    frame: VertexFrame,
-    centres: np.ndarray,
-    n_samples,
-    apex: np.ndarray | None = None,
-    dev_apex: np.ndarray | None = None,
-    runs=None,
-) -> list[Piece]:
-    """The flat piece(s) of one vertex.
-
-    Parameters
-    ----------
-    mesh : PolyMesh
-    frame : VertexFrame
-    centres : (n_faces, 3) float
-        Face piece centres (:func:`face_piece_centres`).
-    n_samples : int or (n_edges,) int
-        Points per cylinder arc (both ends included), for all arcs or per edge
-        (:meth:`~filletfold.rounding.edges.EdgeRounding.arc_points`).
-    apex : (3,) float, optional
-        Spatial apex; when given the module has a cone, otherwise a hole border.
-    dev_apex : (2,) float, optional
-        Developed apex (required with ``apex``).
-    runs : list of (int, int), optional
-        Sector ranges ``[j0, j1]`` (inclusive), each one piece; default one run over all
-        sectors, split in halves while a piece overlaps itself.
-
-    Returns
-    -------
-    list of Piece
-    """
-    nf = len(frame.ring.faces)
-    if runs is not None:
-        return [
-            _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)[0]
-            for j0, j1 in runs
-        ]
-    pending = [(0, nf - 1)]
-    pieces = []
-    while pending:
-        j0, j1 = pending.pop(0)
-        piece, p2, sector = _build_run(mesh, frame, centres, n_samples, apex, dev_apex, j0, j1)
-        if (
-            j1 > j0
-            and not faces_interior_disjoint(p2, piece.faces)
-            and run_overlaps(p2, piece.faces, sector)
-        ):
-            mid = (j0 + j1) // 2
-            pending[:0] = [(j0, mid), (mid + 1, j1)]
-            continue
-        pieces.append(piece.compact())
-    return pieces
-
-
-def _side_curves(frame: VertexFrame, sides: list, n_samples, apex, dev_apex, heights) -> dict:
-    """Base points and crease (or hole) points of the rounded sides ``sides``, all at once.
-
-    Parameters
-    ----------
-    frame : VertexFrame
-    sides : list of int
-        Rounded side indices.
-    n_samples : int or (n_edges,) int
-        Points per arc (one on a side without arc).
-    apex, dev_apex : (3,) float and (2,) float, or None
-        The cone's apices; without, the top is the hole border at ``heights``.
-    heights : (n_sides,) float
-
-    Returns
-    -------
-    dict
-        Side -> (s (k,), base_3d (k, 3), top_3d (k, 3), top_z (k,)), with ``top`` the crease
-        or the hole border and ``s = linspace(0, arc, k)``.
-    """
-    if not sides:
-        return {}
-    which = np.asarray(sides, dtype=np.int64)
-    if frame.ring.closed:
-        sa, idx = frame.arrays, which
-    else:  # an open ring has no SideArrays: stack the sides asked for
-        sa, idx = stack_sides([frame.sides[i] for i in sides]), np.arange(len(sides))
-    arc = sa.arc[idx]
-    n = np.full(len(idx), n_samples) if np.ndim(n_samples) == 0 else n_samples[sa.edge[idx]]
-    n = np.where(arc > 0, n, 1).astype(np.int64)
-    rep, _, s = _arc_parameters(arc, n)
-    first = np.cumsum(n) - n
-    side = idx[rep]
-    C = sa.base(side, s)
-    if apex is not None:
-        z, _ = crease_length(frame, side, apex, dev_apex, s, C=C)
-    else:
-        z = np.asarray(heights, dtype=float)[which][rep]
-    F = C + z[:, None] * sa.R[side]
-    bounds = np.append(first, len(rep)).tolist()
-    return {
-        i: (s[a:b], C[a:b], F[a:b], z[a:b])
-        for i, a, b in zip(sides, bounds[:-1], bounds[1:], strict=True)
-    }
-
-
 def apply_rows(m: np.ndarray, p: np.ndarray) -> np.ndarray:
     """:func:`~filletfold.vertex.frame.apply` row by row, in one call.
 
@@ -242,194 +157,638 @@ def apply_rows(m: np.ndarray, p: np.ndarray) -> np.ndarray:
     return (p[:, None, :] @ lin)[:, 0, :] + m[..., :2, 2]
 
 
+#: Most vertices built together (bounds the flat arrays' size).
+CHUNK = 2048
+
+#: Corners of the largest face of a module (a face share: crease, base, centre, base, crease,
+#: and the corner T where a hole border goes through it).
+_WIDTH = 6
+
+
+def build_modules(
+    mesh, frames, centres, n_samples, apices, developed, progress=None
+) -> list[list[Piece]]:
+    """The modules of many vertices: the flat piece(s) of every ``(frame, apex, v)``.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    frames : sequence of VertexFrame
+        Any vertices, in any order.
+    centres : (n_faces, 3) float
+        Face piece centres (:func:`~filletfold.surface.centres.face_piece_centres`).
+    n_samples : int or (n_edges,) int
+        Points per arc, for all arcs or per edge.
+    apices : sequence of ((3,) float or None)
+        Spatial apex of each frame's vertex (None: a hole border).
+    developed : sequence of ((2,) float or None)
+        Its developed apex.
+    progress : callable, optional
+        ``progress("surface", done, total)`` after every :data:`CHUNK` of vertices (chunks are
+        built in threads, :func:`~filletfold.parallel.thread_map`).
+
+    Returns
+    -------
+    list of list of Piece
+        One module per frame, in the order of ``frames``.
+    """
+    if not len(frames) == len(apices) == len(developed):
+        raise ValueError(
+            f"{len(frames)} frames, {len(apices)} apices and {len(developed)} developed apices"
+        )
+    if np.size(n_samples) == 0 or np.min(n_samples) < 1:
+        raise ValueError(f"every arc needs at least one sample, got {n_samples!r}")
+    for frame, apex, v in zip(frames, apices, developed, strict=True):
+        if apex is not None and (v is None or not frame.ring.closed):
+            why = "no developed apex" if v is None else "an open ring"
+            raise ValueError(
+                f"vertex {frame.vertex}: a cone needs a closed ring and both apices ({why})"
+            )
+    modules: list = [None] * len(frames)
+    chunks = [list(range(c, min(c + CHUNK, len(frames)))) for c in range(0, len(frames), CHUNK)]
+
+    def chunk_modules(which: list) -> list:
+        chunk = _Chunk.of(
+            [frames[j] for j in which],
+            centres,
+            n_samples,
+            [apices[j] for j in which],
+            [developed[j] for j in which],
+        )
+        return _chunk_modules(chunk)
+
+    done = 0
+    for which, built in zip(chunks, thread_map(chunk_modules, chunks), strict=True):
+        for j, module in zip(which, built, strict=True):
+            modules[j] = module
+        done += len(which)
+        if progress is not None:
+            progress("surface", done, len(frames))
+    if progress is not None:
+        progress("surface", len(frames), len(frames))
+    return modules
+
+
+def build_module(
+    mesh: PolyMesh,
+    frame: VertexFrame,
+    centres: np.ndarray,
+    n_samples,
+    apex: np.ndarray | None = None,
+    dev_apex: np.ndarray | None = None,
+) -> list[Piece]:
+    """The flat piece(s) of one vertex: :func:`build_modules` of a batch of one.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    frame : VertexFrame
+    centres : (n_faces, 3) float
+        Face piece centres (:func:`~filletfold.surface.centres.face_piece_centres`).
+    n_samples : int or (n_edges,) int
+        Points per cylinder arc (both ends included), for all arcs or per edge
+        (:meth:`~filletfold.rounding.edges.EdgeRounding.arc_points`).
+    apex : (3,) float, optional
+        Spatial apex; when given the module has a cone, otherwise a hole border.
+    dev_apex : (2,) float, optional
+        Developed apex (required with ``apex``).
+
+    Returns
+    -------
+    list of Piece
+    """
+    return build_modules(mesh, [frame], centres, n_samples, [apex], [dev_apex])[0]
+
+
+def _ring_arrays(frame: VertexFrame) -> SideArrays:
+    """The frame's sides as :class:`~filletfold.vertex.frame.SideArrays`: a closed ring's own;
+    an open ring's unrounded ends get ``O = M`` and zero ``N0, B`` (their base curve is the
+    point ``M``), as in :func:`~filletfold.vertex.frame.vertex_frames`, and NaN charts."""
+    if frame.ring.closed:
+        return frame.arrays
+    zero = np.zeros(3)
+    n = len(frame.sides)
+    return stack_sides(
+        [s if s.rounded else dataclasses.replace(s, O=s.M, N0=zero, B=zero) for s in frame.sides],
+        Q=np.full((n, 2, 2), np.nan),
+        t=np.full((n, 2), np.nan),
+        face_normal=np.full((len(frame.ring.faces), 3), np.nan),
+    )
+
+
+def _or_nan(values, shape) -> np.ndarray:
+    """The arrays ``values`` stacked, a NaN array of ``shape`` for each None."""
+    return np.array([np.full(shape, np.nan) if x is None else x for x in values], dtype=float)
+
+
 @dataclass
-class _Strip:
-    """One rounded side's half-cylinder in the run's 2D frame (see :func:`_strips`)."""
+class _Chunk:
+    """The frames of some vertices on flat arrays: their sides, vertex after vertex, and
+    likewise their ring faces.
 
-    base_2d: np.ndarray  # (n, 2) base curve
-    base_3d: np.ndarray  # (n, 3)
-    top_2d: np.ndarray  # (n, 2) crease or hole border
-    top_3d: np.ndarray  # (n, 3)
-    quad_area: list  # (n - 1,) twice the area of quad k
-    tri_area: list | None  # (n - 1,) twice the area of cone triangle k (cones only)
-
-
-def _strips(frame: VertexFrame, sides: list, curves: dict, dev_apex) -> dict:
-    """The half-cylinders of ``sides`` (rounded side indices), computed together.
-
-    ``curves`` maps each side to :func:`_side_curves`; ``dev_apex`` is the developed apex, or
-    None without a cone. Returns a dict side -> :class:`_Strip`.
+    Attributes
+    ----------
+    frames : list of VertexFrame
+        (n_vert,) frames.
+    sides : SideArrays
+        Their (n_sides,) sides.
+    side_first, face_first : (n_vert + 1,) int
+        First side and first ring face of each vertex, then the totals.
+    side_vertex : (n_sides,) int
+    rounded : (n_sides,) bool
+    samples : (n_sides,) int
+        Points per arc (1 on a side without arc).
+    cyl : (n_sides, 3, 3) float
+        Each cylinder chart's map into the common frame (NaN on an unrounded side).
+    lmax_start, lmax_end : (n_sides,) float
+        As :class:`~filletfold.vertex.frame.VertexFrame` has them.
+    height : (n_sides,) float
+        Hole border heights (:func:`~filletfold.surface.module.hole_heights`).
+    face_map, face_frame : (n_faces, 3, 3) float
+        Each ring face's map into the common frame and its chart.
+    centre : (n_faces, 3) float
+        The centre of each ring face's face piece.
+    cone : (n_vert,) bool
+    apex : (n_vert, 3) float
+    dev : (n_vert, 2) float
+        Spatial and developed apex (NaN without a cone).
+    vi : (n_sides, 2) float
+        The developed apex in each cylinder's chart.
+    dn : (n_sides,) float
+        The denominator of eq. (1) on each side.
+    eps : (n_vert,) float
+        The merge distance of :meth:`~filletfold.surface.piece.Piece.merge_coincident`
+        (:func:`~filletfold.surface.module.merge_distance`).
+    patch : list of str
+        Patch names: the cylinder of each side, the cone of each vertex, each ring face.
     """
-    if not sides:
-        return {}
-    count = np.array([len(curves[i][0]) for i in sides])
-    s = np.concatenate([curves[i][0] for i in sides])
-    z = np.concatenate([curves[i][3] for i in sides])
-    maps = np.repeat(np.stack([frame.cyl_map[i] for i in sides]), count, axis=0)
-    base_2d = apply_rows(maps, np.stack([s, np.zeros(len(s))], axis=1))
-    top_2d = apply_rows(maps, np.stack([s, z], axis=1))
-    k = np.arange(len(s) - 1)  # quad k joins samples k and k + 1 of one side
-    quad = polygon_area2(np.stack([base_2d[k], base_2d[k + 1], top_2d[k + 1], top_2d[k]], axis=1))
-    quad = quad.tolist()
-    tri = None
-    if dev_apex is not None:
-        apex = np.broadcast_to(np.asarray(dev_apex, dtype=float).reshape(1, 2), (len(k), 2))
-        tri = polygon_area2(np.stack([apex, top_2d[k], top_2d[k + 1]], axis=1)).tolist()
-    out = {}
-    start = 0
-    for i, n in zip(sides, count.tolist(), strict=True):
-        end = start + n
-        out[i] = _Strip(
-            base_2d[start:end],
-            curves[i][1],
-            top_2d[start:end],
-            curves[i][2],
-            quad[start : end - 1],
-            None if tri is None else tri[start : end - 1],
+
+    frames: list
+    sides: SideArrays
+    side_first: np.ndarray
+    face_first: np.ndarray
+    side_vertex: np.ndarray
+    rounded: np.ndarray
+    samples: np.ndarray
+    cyl: np.ndarray
+    lmax_start: np.ndarray
+    lmax_end: np.ndarray
+    height: np.ndarray
+    face_map: np.ndarray
+    face_frame: np.ndarray
+    centre: np.ndarray
+    cone: np.ndarray
+    apex: np.ndarray
+    dev: np.ndarray
+    vi: np.ndarray
+    dn: np.ndarray
+    eps: np.ndarray
+    patch: list
+    tee: np.ndarray
+    T: np.ndarray
+
+    @classmethod
+    def of(cls, frames: list, centres, n_samples, apices: list, developed: list) -> _Chunk:
+        """The chunk of ``frames`` with their apices (None: a hole border)."""
+        sa = _stack([_ring_arrays(f) for f in frames])
+        ne = np.array([f.n_sides for f in frames], dtype=np.int64)
+        nf = np.array([len(f.ring.faces) for f in frames], dtype=np.int64)
+        side_first = np.concatenate([[0], np.cumsum(ne)])
+        sv = np.repeat(np.arange(len(frames)), ne)
+        cone = np.array([a is not None for a in apices], dtype=bool)
+        apex = _or_nan(apices, 3).reshape(-1, 3)
+        dev = _or_nan(
+            [d if a is not None else None for a, d in zip(apices, developed, strict=True)], 2
         )
-        start = end
-    return out
+        dev = dev.reshape(-1, 2)
+        n = np.asarray(n_samples)
+        n = np.full(len(sv), n) if n.ndim == 0 else n[sa.edge]
+        vi = chart_apex(sa.Q, sa.t, dev[sv])
+        ring_face = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
+        return cls(
+            frames=frames,
+            sides=sa,
+            side_first=side_first,
+            face_first=np.concatenate([[0], np.cumsum(nf)]),
+            side_vertex=sv,
+            rounded=np.concatenate([f.rounded for f in frames]),
+            samples=np.where(sa.arc > 0, n, 1).astype(np.int64),
+            cyl=np.concatenate([f.cyl_maps for f in frames]),
+            lmax_start=np.concatenate([f.lmax_start for f in frames]),
+            lmax_end=np.concatenate([f.lmax_end for f in frames]),
+            height=np.concatenate([hole_heights(f) for f in frames]),
+            face_map=np.concatenate([np.reshape(f.face_map, (-1, 3, 3)) for f in frames]),
+            face_frame=np.concatenate([np.reshape(f.face_frames, (-1, 3, 3)) for f in frames]),
+            centre=np.asarray(centres)[ring_face],
+            cone=cone,
+            apex=apex,
+            dev=dev,
+            vi=vi,
+            dn=crease_denominator(apex[sv], vi, sa.M, sa.R),
+            eps=tol.coincide
+            * np.maximum(
+                np.minimum.reduceat(sa.length, side_first[:-1]),
+                np.abs(np.array([f.U for f in frames])).max(axis=1),
+            ),
+            patch=[f"cylinder {e}" for e in sa.edge.tolist()]
+            + [f"cone {f.vertex}" for f in frames]
+            + [f"face {f}" for f in ring_face.tolist()],
+            tee=np.concatenate(
+                [
+                    hole_corners(f, centres) if a is None else np.zeros(len(f.ring.faces), bool)
+                    for f, a in zip(frames, apices, strict=True)
+                ]
+            ),
+            T=np.concatenate([np.reshape(f.T_end, (-1, 3))[: len(f.ring.faces)] for f in frames]),
+        )
+
+    def curves(self, side: np.ndarray, s: np.ndarray):
+        """Base points ``C`` (m, 3), heights ``z`` (m,) and top points ``F`` (m, 3) at arc
+        parameters ``s`` (m,) of ``side`` (m,): the crease (eq. (1)) on a cone's sides, the hole
+        border elsewhere."""
+        sa = self.sides
+        C = sa.base(side, s)
+        z = self.height[side]
+        on = np.flatnonzero(self.cone[self.side_vertex[side]])
+        if len(on):
+            i = side[on]
+            num = crease_numerator(self.apex[self.side_vertex[i]], self.vi[i], s[on], C[on])
+            z[on] = crease_height(num, self.dn[i])
+        return C, z, C + z[:, None] * sa.R[side]
+
+    def in_face_chart(self, p: np.ndarray, face: np.ndarray) -> np.ndarray:
+        """(m, 2) common-frame images of points ``p`` (m, 3) on ring faces ``face`` (m,)
+        (``apply(face_map, to_chart(face_frame, p))`` row by row)."""
+        fr = self.face_frame[face]
+        rel = p - fr[:, 0]
+        return apply_rows(
+            self.face_map[face], np.stack([_dot(rel, fr[:, 1]), _dot(rel, fr[:, 2])], axis=1)
+        )
 
 
-def _curve_points(piece: Piece, key: tuple, p2: np.ndarray, p3: np.ndarray) -> list:
-    """Indices of the points ``k = 0 .. n-1`` of a sampled curve, added in order.
+def _chunk_modules(chunk: _Chunk) -> list:
+    """The module of every vertex of a chunk (list of Piece, in ring order).
 
-    Only the two ends are keyed (``(*key, 0)`` and ``(*key, n - 1)``), the points where other
-    faces join; the first may exist already (it is then reused, as :meth:`Piece.point` does).
+    Runs ``(vertex, j0, j1)`` of sectors ``j0 .. j1`` are built a round at a time: a run of
+    more than one sector whose piece is not proved free of overlap and measured to overlap
+    itself is replaced by its halves ``j0 .. mid`` and ``mid + 1 .. j1`` in the next round.
     """
-    known = piece._keys
-    first = known.get((*key, 0))
-    if first is None:
-        idx = piece.add_points(p2, p3).tolist()
-        known[(*key, 0)] = idx[0]
-    else:
-        idx = [first, *piece.add_points(p2[1:], p3[1:]).tolist()]
-    known.setdefault((*key, len(idx) - 1), idx[-1])
-    return idx
-
-
-def _add_strip(piece: Piece, bs: list, tp: list, strip: _Strip, patch: str, cone: str) -> None:
-    """The quads of one half-cylinder and, with a cone, its triangles from the apex.
-
-    The same faces, in the same order, as ``piece.face`` on ``[bs[k], bs[k+1], tp[k+1], tp[k]]``
-    then ``[apex, tp[k], tp[k+1]]`` for each ``k``: the corners are distinct points, so a face
-    is dropped only when its area is zero and reversed when it is clockwise (NaN: kept as is).
-    """
-    faces, patches = piece.faces, piece.patches
-    a = piece.apex_index
-    tri = strip.tri_area
-    quad = strip.quad_area
-    if quad and min(quad) > 0 and (tri is None or min(tri) > 0):  # all kept as they are
-        pairs = zip(itertools.pairwise(bs), itertools.pairwise(tp), strict=True)
-        quads = [[b0, b1, t1, t0] for (b0, b1), (t0, t1) in pairs]
-        if tri is None:
-            faces.extend(quads)
-            patches.extend([patch] * len(quads))
-        else:
-            tris = [[a, t0, t1] for t0, t1 in itertools.pairwise(tp)]
-            faces.extend(itertools.chain.from_iterable(zip(quads, tris, strict=True)))
-            patches.extend([patch, cone] * len(quads))
-        return
-    for k, area in enumerate(quad):
-        if area != 0:
-            if area < 0:
-                faces.append([tp[k], tp[k + 1], bs[k + 1], bs[k]])
+    n_vert = len(chunk.frames)
+    last = np.diff(chunk.face_first) - 1
+    runs = np.stack([np.arange(n_vert), np.zeros(n_vert, np.int64), last], axis=1)
+    done: list = [[] for _ in range(n_vert)]
+    while len(runs):
+        pieces, proved, sectors = _run_pieces(chunk, runs)
+        halves = []
+        for (j, j0, j1), piece, ok, sector in zip(
+            runs.tolist(), pieces, proved.tolist(), sectors, strict=True
+        ):
+            if j1 > j0 and not ok and run_overlaps(piece.points_2d, piece.faces, sector):
+                mid = (j0 + j1) // 2
+                halves += [(j, j0, mid), (j, mid + 1, j1)]
             else:
-                faces.append([bs[k], bs[k + 1], tp[k + 1], tp[k]])
-            patches.append(patch)
-        if tri is not None and tri[k] != 0:
-            faces.append([tp[k + 1], tp[k], a] if tri[k] < 0 else [a, tp[k], tp[k + 1]])
-            patches.append(cone)
+                done[j].append((j0, piece))
+        runs = np.array(halves, dtype=np.int64).reshape(-1, 3)
+    return [[piece for _, piece in sorted(module, key=lambda x: x[0])] for module in done]
 
 
-def _build_run(
-    mesh, frame: VertexFrame, centres, n_samples, apex, dev_apex, j0, j1
-) -> tuple[Piece, np.ndarray, np.ndarray]:
-    """The piece of sectors ``j0 .. j1``, its ``points_2d`` (k, 2) as an array and the sector
-    of each of its faces ((n_faces,) int, from 0 at ``j0``)."""
-    u = frame.vertex
-    ring = frame.ring
-    ne = len(frame.sides)
-    heights = hole_heights(frame)
-    piece = Piece(vertex=u)
-    top_name = "cr" if apex is not None else "hole"
-    cone = f"cone {u}"
-    if apex is not None:
-        piece.apex_index = piece.point(("apex",), dev_apex, apex)
-    rounded = [i for i in range(j0, j1 + 1) if frame.sides[i].rounded]
-    through_t = hole_corners(frame, centres) if apex is None else None
-    curves = _side_curves(frame, rounded, n_samples, apex, dev_apex, heights)
-    strips = _strips(frame, rounded, curves, dev_apex if apex is not None else None)
+@dataclass
+class _Layout:
+    """The face shares of some runs and where their points go in the runs' pieces.
 
-    def curves_of(i):
-        if i not in curves:
-            curves.update(_side_curves(frame, [i], n_samples, apex, dev_apex, heights))
-        return curves[i]
+    Share ``q`` is sector ``i`` of a run ``(vertex, j0, j1)``: the half-cylinder of side ``i``
+    (when rounded), the share of ring face ``f_i`` and, with a cone, its triangle. A run's
+    points, in the order of :func:`~filletfold.surface.module.build_module`: the apex (cones); side
+    ``j0``'s base curve and crease (or hole border), or the base and top of its line when it is
+    unrounded; then per share the start of the next side (base, top) and the centre of face
+    ``f_i``, followed, except after the last share, by the rest of the next side's base curve
+    and crease. The last share's next side starts with its end copy (its start as reached across
+    ``f_{j1}``), or its line when unrounded.
 
-    def line_points(i, face_i, start: bool, end_copy: bool = False):
-        """(base, top) point indices of side ``i`` where it meets ring face ``face_i``.
+    Attributes
+    ----------
+    vertex : (n_runs,) int
+        Chunk vertex of each run.
+    first : (n_runs + 1,) int
+        First point of each run's piece, then the number of points.
+    run, side, face, nxt : (n_shares,) int
+        Run, side ``i`` and face ``f_i`` (chunk indices) of each share; the next side.
+    tee : (n_shares,) bool
+        The share's hole border goes through the corner T (a point after the centre).
+    head, tail : (n_shares,) bool
+        First and last share of its run.
+    n : (n_shares,) int
+        Samples on side ``i`` (0 when unrounded).
+    at : (n_shares,) int
+        First point of the share's block (its side's curves, then the next side's start).
+    start : (n_shares,) int
+        Base point of the next side's start (its top follows, then the face centre).
+    end_base, end_top : (n_shares,) int
+        Base and top point of side ``i``'s end.
+    sample_share, k : (n_samples,) int
+        Share and sample number of each arc sample of the shares' sides.
+    s : (n_samples,) float
+        Their arc parameters.
+    base, top : (n_samples,) int
+        Their base and top points.
+    """
 
-        ``end_copy`` asks for the start of side ``i`` as reached from face ``face_i`` at the end
-        of the run (across the cut: same 3D points, the 2D chart after ``face_i``).
-        """
-        side = frame.sides[i]
-        if side.rounded:
-            s, C, F, z = curves_of(i)
-            k = 0 if start else len(s) - 1
-            if end_copy:
-                m = frame.face_map[face_i] @ frame.gluing_start(i)
-                b = piece.point(("end", i, "bs", k), apply(m, [s[k], 0.0]), C[k])
-                t = piece.point(("end", i, top_name, k), apply(m, [s[k], z[k]]), F[k])
-                return b, t
-            b = piece._keys.get(("side", i, "bs", k))
-            t = piece._keys.get(("side", i, top_name, k))
-            if b is None or t is None:
-                strip = strips.get(i)
-                m = frame.cyl_map[i]
-                b2 = apply(m, [s[k], 0.0]) if strip is None else strip.base_2d[k]
-                t2 = apply(m, [s[k], z[k]]) if strip is None else strip.top_2d[k]
-                b = piece.point(("side", i, "bs", k), b2, C[k])
-                t = piece.point(("side", i, top_name, k), t2, F[k])
-            return b, t
-        # unrounded boundary side: points on the edge line, in the chart of face_i
-        h = 0.5 * (frame.lmax_start[i] if start else frame.lmax_end[i])
-        m3 = side.M
-        t3 = side.M + h * side.R
-        fr = frame.face_frames[face_i]
-        mp = frame.face_map[face_i]
-        tag = "start" if start else "end"
-        b = piece.point(("line", i, tag, "bs"), apply(mp, to_chart(fr, m3)), m3)
-        t = piece.point(("line", i, tag, "top"), apply(mp, to_chart(fr, t3)), t3)
-        return b, t
+    vertex: np.ndarray
+    first: np.ndarray
+    run: np.ndarray
+    side: np.ndarray
+    face: np.ndarray
+    tee: np.ndarray
+    nxt: np.ndarray
+    head: np.ndarray
+    tail: np.ndarray
+    n: np.ndarray
+    at: np.ndarray
+    start: np.ndarray
+    end_base: np.ndarray
+    end_top: np.ndarray
+    sample_share: np.ndarray
+    k: np.ndarray
+    s: np.ndarray
+    base: np.ndarray
+    top: np.ndarray
 
-    sector = []
-    for i in range(j0, j1 + 1):
-        n_before = len(piece.faces)
-        side = frame.sides[i]
-        # the half-cylinder of side i and the cone over its crease
-        if side.rounded:
-            strip = strips[i]
-            bs = _curve_points(piece, ("side", i, "bs"), strip.base_2d, strip.base_3d)
-            tp = _curve_points(piece, ("side", i, top_name), strip.top_2d, strip.top_3d)
-            _add_strip(piece, bs, tp, strip, f"cylinder {side.edge}", cone)
-        # the share of face f_i, between side i (end) and side i + 1 (start)
-        face = int(ring.faces[i])
-        b0, t0 = line_points(i, i, start=False)
-        nxt = (i + 1) % ne
-        b1, t1 = line_points(nxt, i, start=True, end_copy=(i == j1))
-        fr = frame.face_frames[i]
-        c = piece.point(
-            ("centre", face), apply(frame.face_map[i], to_chart(fr, centres[face])), centres[face]
+    @classmethod
+    def of(cls, chunk: _Chunk, runs: np.ndarray) -> _Layout:
+        """The layout of ``runs`` (n_runs, 3) int: ``(vertex, j0, j1)`` rows."""
+        rv, j0, j1 = runs.T
+        count = j1 - j0 + 1
+        run = np.repeat(np.arange(len(rv)), count)
+        q0 = np.cumsum(count) - count
+        i = j0[run] + np.arange(len(run)) - q0[run]
+        v = rv[run]
+        side = chunk.side_first[v] + i
+        rounded = chunk.rounded[side]
+        head = i == j0[run]
+        n = np.where(rounded, chunk.samples[side], 0)
+        lead = np.where(head, np.where(rounded, 2 * n, 2), 2 * (n - 1))
+        face = chunk.face_first[v] + i
+        tee = chunk.tee[face]
+        block = lead + 3 + tee
+        size = chunk.cone[rv] + np.add.reduceat(block, q0)
+        first = np.concatenate([[0], np.cumsum(size)])
+        cb = np.cumsum(block) - block
+        at = first[run] + chunk.cone[v] + cb - cb[q0][run]
+        start = at + lead
+        sample_share, k, s = _arc_parameters(chunk.sides.arc[side], n)
+        hs, ns, g = head[sample_share], n[sample_share], at[sample_share]
+        prev = start[np.maximum(sample_share - 1, 0)]  # sample 0 of a later share's side
+        base = np.where(hs, g + k, np.where(k == 0, prev, g + k - 1))
+        top = np.where(hs, g + ns + k, np.where(k == 0, prev + 1, g + ns + k - 2))
+        last = np.maximum(np.cumsum(n) - 1, 0)  # each rounded share's last sample
+        has = n > 0  # (a 0 appended: no sample at all)
+        return cls(
+            vertex=rv,
+            first=first,
+            run=run,
+            side=side,
+            face=face,
+            tee=tee,
+            nxt=chunk.side_first[v] + (i + 1) % np.diff(chunk.side_first)[v],
+            head=head,
+            tail=i == j1[run],
+            n=n,
+            at=at,
+            start=start,
+            end_base=np.where(has, np.append(base, 0)[last], at),
+            end_top=np.where(has, np.append(top, 0)[last], at + 1),
+            sample_share=sample_share,
+            k=k,
+            s=s,
+            base=base,
+            top=top,
         )
-        corner = [t0, b0, c, b1, t1]
-        if apex is None and through_t[i]:
-            # a straight hole border would leave the face or cross the share: go through T
-            T3 = frame.T_end[i]
-            corner.append(piece.point(("T", i), apply(frame.face_map[i], to_chart(fr, T3)), T3))
-        piece.face(corner, f"face {face}")
-        if apex is not None:
-            piece.face([piece.apex_index, t0, t1], cone)
-        sector += [i - j0] * (len(piece.faces) - n_before)
-    p2, kept = piece._merge_coincident(merge_distance(frame))
-    sector = np.array(sector, dtype=np.int64)
-    return piece, p2, sector if kept is None else sector[kept]
+
+
+def _run_pieces(chunk: _Chunk, runs: np.ndarray):
+    """The pieces of runs ``(vertex, j0, j1)`` (n_runs, 3) int, all at once.
+
+    Returns
+    -------
+    pieces : list of Piece
+        Points that coincide in 2D and 3D merged
+        (:meth:`~filletfold.surface.piece.Piece.merge_coincident`), on the few pieces that
+        have any.
+    proved : (n_runs,) bool
+        Proved free of overlap (:func:`~filletfold.surface.overlap.faces_interior_disjoint_many`).
+    sectors : list of (n_faces,) int
+        For each run, the sector (from 0 at ``j0``) of each face of its piece.
+    """
+    lay = _Layout.of(chunk, runs)
+    P2, P3 = _run_points(chunk, lay)
+    corners, size, code, face_share = _run_faces(chunk, lay)
+    keep, area = _oriented(P2, corners, size)
+    corners, size, code, face_share, area = (
+        x[keep] for x in (corners, size, code, face_share, area)
+    )
+    face_run = lay.run[face_share]
+    # the checks of build_module: merge_coincident changes nothing (nothing merges, no face is
+    # too small, every point is used), and the proof that the piece does not overlap itself
+    n_runs = len(runs)
+    point_run = np.repeat(np.arange(n_runs), np.diff(lay.first))
+    eps = chunk.eps[lay.vertex]
+    good = _nothing_merges(P2, P3, point_run, eps)
+    good[face_run[~(area > 2 * (eps * eps)[face_run])]] = False
+    flat = corners[np.arange(_WIDTH) < size[:, None]]
+    unused = np.ones(len(P2), dtype=bool)
+    unused[flat] = False
+    good[point_run[unused]] = False
+    proved = faces_interior_disjoint_many(P2, flat, size, face_run, n_runs)
+    local = (corners - lay.first[face_run][:, None])[np.arange(_WIDTH) < size[:, None]]
+    patches = list(map(chunk.patch.__getitem__, code.tolist()))
+    fb = np.concatenate([[0], np.cumsum(np.bincount(face_run, minlength=n_runs))]).tolist()
+    cb = np.concatenate([[0], np.cumsum(size)])[fb].tolist()  # each run's first corner
+    pb = lay.first.tolist()
+    count = runs[:, 2] - runs[:, 1] + 1
+    sector = face_share - (np.cumsum(count) - count)[face_run]  # the share within its run
+    sectors = np.split(sector, fb[1:-1])
+    pieces = []
+    for r, v in enumerate(lay.vertex.tolist()):
+        a, b, fa, fz = pb[r], pb[r + 1], fb[r], fb[r + 1]
+        piece = Piece(
+            vertex=chunk.frames[v].vertex,
+            points_2d=P2[a:b].copy(),
+            points_3d=P3[a:b].copy(),
+            faces=FaceLists.of_sizes(local[cb[r] : cb[r + 1]], size[fa:fz]),
+            patches=patches[fa:fz],
+            apex_index=0 if chunk.cone[v] else None,
+        )
+        if not good[r]:  # points that coincide (a crease through T, an unrounded side, ...)
+            p2, kept = piece._merge_coincident(float(eps[r]))
+            if kept is not None:
+                sectors[r] = sectors[r][kept]
+                proved[r] = faces_interior_disjoint(p2, piece.faces)
+        pieces.append(piece)
+    return pieces, proved, sectors
+
+
+def _run_points(chunk: _Chunk, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
+    """(n_points, 2) and (n_points, 3) float: the points of the runs' pieces, piece after piece
+    (see :class:`_Layout`)."""
+    P2 = np.empty((int(lay.first[-1]), 2))
+    P3 = np.empty((len(P2), 3))
+    cones = np.flatnonzero(chunk.cone[lay.vertex])
+    P2[lay.first[cones]] = chunk.dev[lay.vertex[cones]]
+    P3[lay.first[cones]] = chunk.apex[lay.vertex[cones]]
+    # the half-cylinders: base curves and creases (module._side_curves, module._strips)
+    side = lay.side[lay.sample_share]
+    C, z, F = chunk.curves(side, lay.s)
+    maps = chunk.cyl[side]
+    P2[lay.base] = apply_rows(maps, np.stack([lay.s, np.zeros(len(side))], axis=1))
+    P2[lay.top] = apply_rows(maps, np.stack([lay.s, z], axis=1))
+    P3[lay.base], P3[lay.top] = C, F
+    # an unrounded first side: its line on the first face, up to half its lmax_end
+    q = np.flatnonzero(lay.head & (lay.n == 0))
+    _line(chunk, P2, P3, lay.at[q], lay.side[q], lay.face[q], chunk.lmax_end)
+    # the side after each run: its start across the run's last face, or its line
+    q = np.flatnonzero(lay.tail)
+    rounded = chunk.rounded[lay.nxt[q]]
+    e, o = q[rounded], q[~rounded]
+    _line(chunk, P2, P3, lay.start[o], lay.nxt[o], lay.face[o], chunk.lmax_start)
+    _end_copy(chunk, P2, P3, lay.start[e], lay.nxt[e], lay.face[e])
+    # the face share centres
+    c = lay.start + 2
+    P3[c] = chunk.centre[lay.face]
+    P2[c] = chunk.in_face_chart(P3[c], lay.face)
+    # a hole border through the corner T of the face (hole_corners)
+    t = np.flatnonzero(lay.tee)
+    P3[c[t] + 1] = chunk.T[lay.face[t]]
+    P2[c[t] + 1] = chunk.in_face_chart(P3[c[t] + 1], lay.face[t])
+    return P2, P3
+
+
+def _line(chunk: _Chunk, P2, P3, at: np.ndarray, side: np.ndarray, face: np.ndarray, lmax):
+    """Write the base (at ``at``) and top (at ``at + 1``) of unrounded sides (m,) on ring faces
+    ``face`` (m,): the midpoint ``M`` and ``M + (lmax / 2) R``."""
+    sa = chunk.sides
+    M = sa.M[side]
+    top = M + (0.5 * lmax[side])[:, None] * sa.R[side]
+    P3[at], P3[at + 1] = M, top
+    P2[at], P2[at + 1] = chunk.in_face_chart(M, face), chunk.in_face_chart(top, face)
+
+
+def _end_copy(chunk: _Chunk, P2, P3, at: np.ndarray, side: np.ndarray, face: np.ndarray):
+    """Write the start of rounded sides (m,) as reached across the ring faces ``face`` (m,)
+    before them (``face_map @ VertexFrame.gluing_start``): base at ``at``, top at ``at + 1``."""
+    sa = chunk.sides
+    s0 = np.zeros(len(side))
+    C, z, F = chunk.curves(side, s0)
+    glue = _gluing_maps(sa.tangent(side, s0), sa.R[side], chunk.face_frame[face], C, s0)
+    m = chunk.face_map[face] @ glue
+    P2[at] = apply_rows(m, np.stack([s0, s0], axis=1))
+    P2[at + 1] = apply_rows(m, np.stack([s0, z], axis=1))
+    P3[at], P3[at + 1] = C, F
+
+
+def _run_faces(chunk: _Chunk, lay: _Layout):
+    """The faces of the runs' pieces before orientation: per share the quad and, with a cone,
+    the triangle of every arc step, then the face share and its cone triangle.
+
+    Returns
+    -------
+    corners : (n_faces, 6) int
+        Point indices (into the points of all pieces), ``size`` of them used.
+    size : (n_faces,) int
+    code : (n_faces,) int
+        Index into :attr:`_Chunk.patch`.
+    face_share : (n_faces,) int
+    """
+    cone = chunk.cone[lay.vertex[lay.run]].astype(np.int64)
+    count = np.maximum(lay.n - 1, 0) * (1 + cone) + 1 + cone
+    fpos = np.cumsum(count) - count
+    corners = np.zeros((int(count.sum()), _WIDTH), dtype=np.int64)
+    size = np.empty(len(corners), dtype=np.int64)
+    code = np.empty(len(corners), dtype=np.int64)
+    n_sides, n_vert = len(chunk.side_vertex), len(chunk.frames)
+    apex = lay.first[lay.run]
+    vertex = lay.vertex[lay.run]
+    g = np.flatnonzero(lay.k < lay.n[lay.sample_share] - 1)  # arc steps: sample g to g + 1
+    q = lay.sample_share[g]
+    quad = fpos[q] + (1 + cone[q]) * lay.k[g]
+    base, top = lay.base, lay.top
+    corners[quad, :4] = np.stack([base[g], base[g + 1], top[g + 1], top[g]], axis=1)
+    size[quad] = 4
+    code[quad] = lay.side[q]
+    c = cone[q] == 1
+    g, q = g[c], q[c]
+    corners[quad[c] + 1, :3] = np.stack([apex[q], top[g], top[g + 1]], axis=1)
+    size[quad[c] + 1] = 3
+    code[quad[c] + 1] = n_sides + vertex[q]
+    share = fpos + count - 1 - cone
+    t0, b0, b1 = lay.end_top, lay.end_base, lay.start
+    corners[share, :5] = np.stack([t0, b0, b1 + 2, b1, b1 + 1], axis=1)
+    corners[share, 5] = b1 + 3  # T, used where the border goes through it
+    size[share] = 5 + lay.tee
+    code[share] = n_sides + n_vert + lay.face
+    c = np.flatnonzero(cone)
+    corners[share[c] + 1, :3] = np.stack([apex[c], t0[c], b1[c] + 1], axis=1)
+    size[share[c] + 1] = 3
+    code[share[c] + 1] = n_sides + vertex[c]
+    return corners, size, code, np.repeat(np.arange(len(count)), count)
+
+
+def _oriented(P2: np.ndarray, corners: np.ndarray, size: np.ndarray):
+    """:meth:`~filletfold.surface.piece.Piece.face` of every face: zero-area faces dropped,
+    clockwise ones reversed (``corners`` (n, 6) int, in place), NaN kept as is.
+
+    Returns
+    -------
+    keep : (n,) bool
+    area : (n,) float
+        Twice the area, after the reversal.
+    """
+    area = np.empty(len(size))
+    for w in range(3, _WIDTH + 1):
+        rows = np.flatnonzero(size == w)
+        area[rows] = polygon_area2(P2[corners[rows, :w]])
+    keep = area != 0
+    for w in range(3, _WIDTH + 1):
+        rows = np.flatnonzero((area < 0) & (size == w))
+        corners[rows, :w] = corners[rows, w - 1 :: -1]
+        area[rows] = polygon_area2(P2[corners[rows, :w]])
+    return keep, area
+
+
+def _nothing_merges(
+    p2: np.ndarray, p3: np.ndarray, piece: np.ndarray, eps: np.ndarray, longest: int = 64
+) -> np.ndarray:
+    """(n_pieces,) bool: no two points of a piece coincide within ``eps`` (per piece) in both
+    2D and 3D, with a small margin, and all are finite: then
+    :meth:`~filletfold.surface.piece.Piece.merge_coincident` merges nothing.
+
+    Candidates are the points of a piece whose ``x`` lie in one chain of gaps ``<= eps`` (a
+    piece with a chain longer than ``longest`` points is refused).
+
+    Parameters
+    ----------
+    p2 : (k, 2) float
+    p3 : (k, 3) float
+        The points, piece after piece.
+    piece : (k,) int
+        Piece of each point (non-decreasing).
+    eps : (n_pieces,) float
+    """
+    bad = np.zeros(len(eps), dtype=bool)
+    bad[piece[~(np.isfinite(p2).all(axis=1) & np.isfinite(p3).all(axis=1))]] = True
+    reach = eps * (1 + 1e-6)
+    order = np.lexsort((p2[:, 0], piece))
+    x, pc = p2[order, 0], piece[order]
+    link = (np.diff(x) <= reach[pc[1:]]) & (pc[1:] == pc[:-1])
+    chain = np.concatenate([[0], np.cumsum(~link)])  # chain of each sorted point
+    for d in range(1, len(x)):
+        same = np.flatnonzero(chain[d:] == chain[:-d])
+        if not len(same):
+            break
+        i, j = order[same], order[same + d]
+        if d >= longest:
+            bad[piece[i]] = True
+            break
+        r = reach[piece[i]]
+        near = (np.hypot(*(p2[i] - p2[j]).T) <= r) & (np.linalg.norm(p3[i] - p3[j], axis=1) < r)
+        bad[piece[i[near]]] = True
+    return ~bad
