@@ -117,7 +117,7 @@ def hole_corners(frame: VertexFrame, centres: np.ndarray) -> np.ndarray:
         start = sa.base(j, np.zeros(nf)) + h[j, None] * sa.R[j]
     else:  # the unrounded ends: their lines, up to half their lmax (as line_points has them)
         top = [
-            (s.end_point() + hh * s.R, s.start_point() + hh * s.R)
+            (s.base([s.arc])[0] + hh * s.R, s.base([0.0])[0] + hh * s.R)
             if s.rounded
             else (s.M + 0.5 * frame.lmax_end[k] * s.R, s.M + 0.5 * frame.lmax_start[k] * s.R)
             for k, (s, hh) in enumerate(zip(sides, h.tolist(), strict=True))

@@ -93,14 +93,6 @@ class Side:
         t = s / self.radius
         return self.kappa * (-np.sin(t) * self.N0 + np.cos(t) * self.B)
 
-    def start_point(self):
-        """Point of the side's line on face ``f_{i-1}`` in the midpoint cross-section."""
-        return self.base([0.0])[0] if self.rounded else self.M
-
-    def end_point(self):
-        """Point of the side's line on face ``f_i`` in the midpoint cross-section."""
-        return self.base([self.arc])[0] if self.rounded else self.M
-
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise dot products (...,) of vectors (..., 3); the same bits as ``a[k] @ b[k]``."""
@@ -422,18 +414,6 @@ class VertexFrame:
         frame = self.face_frames[(i - 1) % len(self.ring.faces)]
         return self._gluing(side, frame, 0.0)
 
-    def gluing_end(self, i: int) -> np.ndarray:
-        """Map from cylinder ``i``'s chart into the chart of face ``f_i`` (a side of radius 0
-        meets it along its own line: the chart's ``s`` axis turns into ``R x N`` of ``f_i``)."""
-        side = self.sides[i]
-        frame = self.face_frames[i]
-        if side.radius == 0:
-            s = np.zeros(1)
-            t = np.cross(side.R, np.cross(frame[1], frame[2]))[None]
-            return _gluing_maps(t, side.R[None], frame[None], side.base(s), s)[0]
-        return self._gluing(side, frame, side.arc)
-
-    @staticmethod
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
         s = np.array([s], dtype=float)
         return _gluing_maps(side.tangent(s), side.R[None], frame[None], side.base(s), s)[0]

@@ -224,13 +224,6 @@ def _opens_with_a_near_apex(frame: VertexFrame) -> bool:
     return bool(np.isfinite(v[0])) and float(np.linalg.norm(v)) <= 10 * reach
 
 
-def classify_vertex(
-    mesh: PolyMesh, rounding: EdgeRounding, u: int, res: VertexResult, start_edge: int | None = None
-) -> VertexFrame:
-    """One vertex through :func:`classify_vertices` (``start_edge``: where its module is cut)."""
-    return classify_vertices(mesh, rounding, res, [u], [start_edge])[0]
-
-
 def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
     """Where the central rulings of two consecutive developed cylinders cross (sec. 3.2).
 
