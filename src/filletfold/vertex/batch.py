@@ -44,6 +44,17 @@ from .crease import (
     numerator_gradients,
 )
 from .reference import project_slsqp, solve_apex_slsqp
+from .settings import (
+    CHUNK,
+    KKT_ACTIVE,
+    KKT_TOL,
+    PARALLEL_STARTS,
+    PROJECTION_TOL,
+    PROX,
+    ROW_BUDGET,
+    STAT_TOL,
+    T_CAP,
+)
 
 #: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, about 6x
 #: faster) when numba is installed (the ``fast`` extra); ``FILLETFOLD_NUMBA=0`` turns it off.
@@ -57,31 +68,6 @@ USE_KERNEL = (
     importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
 )
 KERNEL_MIN_PROBLEMS = 256
-
-#: :func:`kkt_point`: rows within this share of the scale are active, and the gradient must be
-#: matched to this share of its size. (Rows up to 1e-5 of the scale: an interior-point result
-#: that stops short of its stationarity test sits that close to rows it has not quite reached;
-#: on blob, SLSQP then improved such points by 3e-8 relative at most, mostly not at all.)
-KKT_ACTIVE = 1e-5
-KKT_TOL = 1e-6
-
-#: Most vertices per chunk, and most padded rows per chunk (keeps the arrays in cache).
-CHUNK = 2048
-ROW_BUDGET = 150_000
-#: Phase 1 stops once the smallest slack exceeds half of this (in units of the scale).
-T_CAP = 1e-3
-#: Stationarity (gradient of the Lagrangian over the size of its terms) at which a problem
-#: is done.
-STAT_TOL = 1e-8
-#: Mean complementarity at which phase 2 (the projection of ``P``) is done, relative to the
-#: squared length scale: its duality gap bounds the objective's error, so a target a hair
-#: from the feasible set (objective ~1e-7) still gets its optimum to ~1e-7 relative.
-PROJECTION_TOL = 1e-13
-#: Proximal weight of phase 1 (maximise t - PROX / 2 |y - y0|^2): keeps the search near its
-#: start, where the developed apex of a closed development would otherwise drift away.
-PROX = 1e-2
-#: Starts tried at once in phase 1 before the remaining ones.
-PARALLEL_STARTS = 1
 
 
 @dataclass

@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..parallel import thread_map, threads
+from .settings import STAT_TOL, T_CAP
 
 try:
     from numba import njit
@@ -96,8 +97,6 @@ def interior_point_numba(
     ``stop_slack``, ``groups``, ``give_up``, ``max_iter``, ``tol`` and the results ``y``
     (B, n) and ``converged`` (B,) are those of the numpy version.
     """
-    from . import batch  # late: batch may import this module
-
     B = rows.A.shape[0]
     if groups is not None and stop_slack is not None and B:
         _, dense = np.unique(np.asarray(groups), return_inverse=True)
@@ -115,7 +114,7 @@ def interior_point_numba(
         np.ascontiguousarray(y, dtype=f8),
     )
     e, q = np.ascontiguousarray(rows.e, dtype=f8), np.ascontiguousarray(q, dtype=f8)
-    rules = (bool(give_up), int(max_iter), float(tol), float(batch.T_CAP), float(batch.STAT_TOL))
+    rules = (bool(give_up), int(max_iter), float(tol), float(T_CAP), float(STAT_TOL))
     slack = -1 if stop_slack is None else int(stop_slack)
 
     def run(idx):
