@@ -414,6 +414,7 @@ class VertexFrame:
         frame = self.face_frames[(i - 1) % len(self.ring.faces)]
         return self._gluing(side, frame, 0.0)
 
+    @staticmethod
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
         s = np.array([s], dtype=float)
         return _gluing_maps(side.tangent(s), side.R[None], frame[None], side.base(s), s)[0]
