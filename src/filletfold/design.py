@@ -26,20 +26,17 @@ from .errors import (
     one_line,
 )
 from .errors import stage as _stage
-from .layout.fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
-from .layout.sheet import glue_pieces
-from .layout.shelf import shelf_layout
-from .layout.tabs import add_tabs_and_labels
+from .layout.arrange import arrange
+from .layout.fabrication import sheet_in_pattern_units
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh
-from .rounding.conical import conical_material_loss, is_conical, vertex_cone_axes
+from .rounding.conical import conical_material_loss, is_conical, use_cone_axes
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
-from .surface.assemble import assemble_pattern
+from .surface.assemble import locate_apices
 from .surface.centres import face_piece_centres
 from .surface.module import build_modules
 from .surface.pattern import CreasePattern
-from .surface.piece import Piece, piece_area
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.solve import STATUSES, VertexResult, classify_vertices, mesh_size, solve_apices
@@ -48,8 +45,6 @@ DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
 DEFAULT_ARC_STEP = 1.5  # degrees: see round_mesh(arc_step=...)
-#: Height of a glue tab, as a share of the mean edge length.
-TAB_HEIGHT = 0.04
 
 
 def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:
@@ -353,53 +348,6 @@ def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
 
 
-def use_cone_axes(mesh: PolyMesh, frames: list, res: VertexResult) -> None:
-    """Make each cone vertex's normal its cone axis (conical meshes, sec. 4.4)."""
-    axis, _ = vertex_cone_axes(mesh)
-    for u, frame in enumerate(frames):
-        if res.kind[u] != "cone" or not np.all(np.isfinite(axis[u])):
-            continue
-        D = res.sigma[u] * axis[u]
-        dirs = np.vstack(
-            [
-                -np.array([s.R for s in frame.sides]),
-                res.sigma[u] * mesh.face_normal[frame.ring.faces],
-            ]
-        )
-        bound = float((dirs @ D).min())
-        if bound > tol.normal_bound:
-            res.normal[u], res.normal_bound[u] = D, bound
-
-
-def shelf_offsets(pieces: list[Piece], gap: float) -> np.ndarray:
-    """(n_pieces, 2) translations laying pieces side by side in rows."""
-    points = [np.asarray(piece.points_2d, dtype=float).reshape(-1, 2) for piece in pieces]
-    if not points:
-        return shelf_layout(np.zeros((0, 4)), gap)
-    p2 = np.concatenate(points)
-    count = np.array([len(p) for p in points])
-    first = np.cumsum(count) - count
-    boxes = np.hstack([np.minimum.reduceat(p2, first), np.maximum.reduceat(p2, first)])
-    return shelf_layout(boxes, gap)
-
-
-def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
-    """Set ``res.apex_2d``: where each solved apex lies in the pattern's layout."""
-    from scipy.spatial import cKDTree
-
-    tree = cKDTree(pattern.vertices_3d)
-    cones = {int(s.split()[1]) for s in set(pattern.face_patch) if s.startswith("cone ")}
-    us = np.array(
-        [u for u in np.flatnonzero(np.isfinite(res.apex[:, 0])).tolist() if u in cones],
-        dtype=np.int64,
-    )
-    if not len(us):
-        return
-    dist, k = tree.query(res.apex[us])
-    near = dist < 1e-9 * (1 + np.abs(res.apex[us]).max(axis=1))
-    res.apex_2d[us[near]] = pattern.vertices_2d[k[near]]
-
-
 def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg, floor, min_width):
     """Radii (given, fitted to their limits, or from the material-loss programme) and the edge
     rounding.
@@ -560,27 +508,7 @@ def round_mesh(
     """
     timings = {}
     t0 = time.perf_counter()
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
-        raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
-    if isinstance(arc_step, bool) or not isinstance(arc_step, int | float | np.number):
-        raise ParameterError(
-            f"arc step must be a number of degrees, got {arc_step!r}", name="arc_step"
-        )
-    if not (np.isfinite(arc_step) and 0 <= arc_step <= 180):
-        raise ParameterError(
-            f"arc step must be in [0, 180] degrees (0: no limit), got {arc_step!r}", name="arc_step"
-        )
-    if layout not in ("auto", "modules", "net", "sheet"):
-        raise ParameterError(
-            f"layout must be 'auto', 'modules', 'net' or 'sheet', got {layout!r}", name="layout"
-        )
-    if not (np.isfinite(coplanar_deg) and 0 <= coplanar_deg < 90):
-        raise ParameterError(
-            f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
-            name="coplanar_deg",
-        )
-    if sheet is not None:
-        sheet_in_pattern_units(sheet, units, scale)  # refuse a bad sheet before the solve
+    _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale)
     progress = callers_progress(progress)
     strict = bool(strict)
     clamp = (not strict) if clamp is None else bool(clamp)
@@ -641,41 +569,22 @@ def round_mesh(
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
-    kept = set()
-    if st is not None:
-        kept = {u for u in range(pm.n_vertices) if st.depths[u] == depths[u]}
-        res.take(st.vertices, sorted(kept))
-        pending = [u for u in pending if u not in kept]
-    _stage("apices")
-    # with the rescue to come, the hard cases' fallbacks wait for its last, smallest radii
-    thorough = material_loss or not fit_vertices
-    apices = _solve_apices(frames, depths, res, centres, progress, pending, size, thorough)
-    rescue = Rescue()
-    if not material_loss and any(res.status[u] == "infeasible" for u in pending):
-        frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
-        classified = copy.deepcopy(classified)
-        rounding, centres, rescue = rescue_vertices(
-            pm,
-            rounding,
-            frames,
-            res,
-            depths,
-            centres,
-            face_piece_centres,
-            apply=fit_vertices,
-            flat_deg=coplanar_deg,
-            floor=floor,
-            min_width=min_width,
-            apices=apices,
-            classified=classified,
-            vertices=pending,
-        )
-        kept -= rescue.resolved
-    solved = [
-        st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
-        for u, frame in enumerate(frames)
-    ]
+    frames, classified, rounding, centres, solved, kept, rescue = _apices(
+        pm,
+        rounding,
+        frames,
+        classified,
+        res,
+        centres,
+        depths,
+        st,
+        progress,
+        material_loss=material_loss,
+        fit_vertices=fit_vertices,
+        coplanar_deg=coplanar_deg,
+        floor=floor,
+        min_width=min_width,
+    )
     timings["apices"] = time.perf_counter() - t
 
     t = time.perf_counter()
@@ -715,74 +624,23 @@ def round_mesh(
         del frames, classified
         solved = modules = built = None
     _stage("layout")
-    layout_used, layout_note = "modules", ""
-    eps = 1e-9 * ref
-    if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
-        not_closed = [
-            u for u, closed in enumerate(ring_closed) if closed and res.kind[u] != "developable"
-        ]
-        if not_closed:
-            listed = ", ".join(map(str, not_closed[:8])) + (", ..." if len(not_closed) > 8 else "")
-            glued, layout_note = (
-                None,
-                (
-                    f"the input is not developable at {len(not_closed)} vertices ({listed}): their "
-                    "developments do not close, so their modules keep a cut"
-                ),
-            )
-        else:
-            glued, _, layout_note = glue_pieces(pieces, eps)
-        if glued is not None:
-            pieces, layout_used = [glued], "sheet"
-        elif layout == "sheet":
-            raise SolverError(f"the modules do not form one sheet: {layout_note}")
-    tab_h = TAB_HEIGHT * ref if tabs else 0.0
-    gap = 0.1 * ref + 2.5 * tab_h
-    sheet_box = room = None
-    if sheet is not None:
-        sheet_box = sheet_in_pattern_units(sheet, units, scale)
-        margin = 2 * (gap + tab_h)
-        room = (sheet_box[0] - margin, sheet_box[1] - margin)
-        if min(room) <= 0:
-            raise ParameterError(
-                f"the sheet {sheet} at scale {scale:g} {units} per unit is too small for any piece",
-                name="sheet",
-            )
-    if layout == "net" or (layout == "auto" and layout_used == "modules" and sheet is not None):
-        pieces = net_pieces(
-            pm,
-            rounding,
-            pieces,
-            solved,
-            centres,
-            points,
-            eps,
-            sheet=room,
-        )
-        layout_used = "net"
-    if sheet is not None:
-        pieces = [orient(piece) for piece in pieces]
-        offsets, boxes, sheet_of = pack_on_sheets(pieces, sheet_box, gap)
-        pattern = assemble_pattern(pieces, offsets)
-        pattern.annotations.sheets = boxes
-        area = np.array([piece_area(piece) for piece in pieces])
-        sheet_area = sheet_box[0] * sheet_box[1]
-        sheet_stats = {
-            "sheets": len(boxes),
-            "sheet_size": [float(max(sheet_box)), float(min(sheet_box))],
-            "pieces_per_sheet": np.bincount(sheet_of, minlength=len(boxes)).tolist(),
-            "material_use": (
-                np.bincount(sheet_of, weights=area, minlength=len(boxes)) / sheet_area
-            ).tolist(),
-        }
-    else:
-        pattern = assemble_pattern(pieces, shelf_offsets(pieces, gap))
-    fab = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
-    if tabs:
-        _stage("glue tabs")
-        fab = add_tabs_and_labels(pattern, tab_h)
-    if sheet is not None:
-        fab.update(sheet_stats)
+    pattern, layout_used, layout_note, fab = arrange(
+        pm,
+        rounding,
+        pieces,
+        solved,
+        centres,
+        points,
+        res,
+        ring_closed,
+        layout=layout,
+        material_loss=material_loss,
+        sheet=sheet,
+        units=units,
+        scale=scale,
+        tabs=tabs,
+        stage=_stage,
+    )
     locate_apices(pattern, res)
     timings["surface"] = time.perf_counter() - t
     mesh_out, rounding_out, res_out, pieces = pm, rounding, res, pieces
@@ -815,6 +673,92 @@ def round_mesh(
         timings["certificate"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     return design
+
+
+def _apices(
+    pm,
+    rounding,
+    frames,
+    classified,
+    res,
+    centres,
+    depths,
+    st,
+    progress,
+    *,
+    material_loss,
+    fit_vertices,
+    coplanar_deg,
+    floor,
+    min_width,
+):
+    """The apex stage of :func:`round_mesh`: every pending vertex's apex (those of a reused
+    design's vertices whose depth did not change are kept), then the rescue of the infeasible
+    ones. Returns the frames, classification, rounding and face-piece centres afterwards (the
+    rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
+    kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
+    size = mesh_size(pm)
+    pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
+    kept = set()
+    if st is not None:
+        kept = {u for u in range(pm.n_vertices) if st.depths[u] == depths[u]}
+        res.take(st.vertices, sorted(kept))
+        pending = [u for u in pending if u not in kept]
+    _stage("apices")
+    # with the rescue to come, the hard cases' fallbacks wait for its last, smallest radii
+    thorough = material_loss or not fit_vertices
+    apices = _solve_apices(frames, depths, res, centres, progress, pending, size, thorough)
+    rescue = Rescue()
+    if not material_loss and any(res.status[u] == "infeasible" for u in pending):
+        frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
+        classified = copy.deepcopy(classified)
+        rounding, centres, rescue = rescue_vertices(
+            pm,
+            rounding,
+            frames,
+            res,
+            depths,
+            centres,
+            face_piece_centres,
+            apply=fit_vertices,
+            flat_deg=coplanar_deg,
+            floor=floor,
+            min_width=min_width,
+            apices=apices,
+            classified=classified,
+            vertices=pending,
+        )
+        kept -= rescue.resolved
+    solved = [
+        st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
+        for u, frame in enumerate(frames)
+    ]
+    return frames, classified, rounding, centres, solved, kept, rescue
+
+
+def _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale) -> None:
+    """Refuse a bad parameter of :func:`round_mesh` before any work, naming it."""
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
+        raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
+    if isinstance(arc_step, bool) or not isinstance(arc_step, int | float | np.number):
+        raise ParameterError(
+            f"arc step must be a number of degrees, got {arc_step!r}", name="arc_step"
+        )
+    if not (np.isfinite(arc_step) and 0 <= arc_step <= 180):
+        raise ParameterError(
+            f"arc step must be in [0, 180] degrees (0: no limit), got {arc_step!r}", name="arc_step"
+        )
+    if layout not in ("auto", "modules", "net", "sheet"):
+        raise ParameterError(
+            f"layout must be 'auto', 'modules', 'net' or 'sheet', got {layout!r}", name="layout"
+        )
+    if not (np.isfinite(coplanar_deg) and 0 <= coplanar_deg < 90):
+        raise ParameterError(
+            f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
+            name="coplanar_deg",
+        )
+    if sheet is not None:
+        sheet_in_pattern_units(sheet, units, scale)  # refuse a bad sheet before the solve
 
 
 def far_offset(vertices: np.ndarray) -> np.ndarray | None:

@@ -41,3 +41,15 @@ def shelf_layout(boxes: np.ndarray, gap: float, row_width: float | None = None) 
         x += w[i] + gap
         row_h = max(row_h, h[i])
     return out
+
+
+def shelf_offsets(pieces: list, gap: float) -> np.ndarray:
+    """(n_pieces, 2) translations laying pieces side by side in rows."""
+    points = [np.asarray(piece.points_2d, dtype=float).reshape(-1, 2) for piece in pieces]
+    if not points:
+        return shelf_layout(np.zeros((0, 4)), gap)
+    p2 = np.concatenate(points)
+    count = np.array([len(p) for p in points])
+    first = np.cumsum(count) - count
+    boxes = np.hstack([np.minimum.reduceat(p2, first), np.maximum.reduceat(p2, first)])
+    return shelf_layout(boxes, gap)

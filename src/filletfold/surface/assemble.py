@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import itertools
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .faces import flat_faces
 from .pattern import CreasePattern, FaceRows
 from .piece import Piece
+
+if TYPE_CHECKING:
+    from ..vertex.solve import VertexResult
 
 
 def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
@@ -92,3 +96,20 @@ def true_rulings(v2, v3, flat, size, face_apex, patches) -> None:
     l3 = np.linalg.norm(v3[p] - v3[a], axis=1)
     ok = l2 > 0
     v2[p[ok]] = v2[a[ok]] + d2[ok] * (l3[ok] / l2[ok])[:, None]
+
+
+def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
+    """Set ``res.apex_2d``: where each solved apex lies in the pattern's layout."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(pattern.vertices_3d)
+    cones = {int(s.split()[1]) for s in set(pattern.face_patch) if s.startswith("cone ")}
+    us = np.array(
+        [u for u in np.flatnonzero(np.isfinite(res.apex[:, 0])).tolist() if u in cones],
+        dtype=np.int64,
+    )
+    if not len(us):
+        return
+    dist, k = tree.query(res.apex[us])
+    near = dist < 1e-9 * (1 + np.abs(res.apex[us]).max(axis=1))
+    res.apex_2d[us[near]] = pattern.vertices_2d[k[near]]

@@ -1,0 +1,144 @@
+"""The layout stage: where the flat pieces go (paper step 4, the 2D development laid out).
+
+:func:`arrange` takes the vertex modules and returns the crease pattern: the modules side by
+side on shelves, glued into one uncut sheet where every development closes, or joined into
+nets (on sheets of a size, packed), with glue tabs and labels on the cut borders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError, SolverError
+from ..surface.assemble import assemble_pattern
+from ..surface.piece import piece_area
+from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
+from .sheet import glue_pieces
+from .shelf import shelf_offsets
+from .tabs import add_tabs_and_labels
+
+#: Height of a glue tab, as a share of the mean edge length.
+TAB_HEIGHT = 0.04
+
+
+def arrange(
+    pm,
+    rounding,
+    pieces: list,
+    solved: list | None,
+    centres,
+    points,
+    res,
+    ring_closed: list,
+    *,
+    layout: str,
+    material_loss: bool,
+    sheet,
+    units: str,
+    scale,
+    tabs: bool,
+    stage=lambda name: None,
+):
+    """The crease pattern of the vertex modules' pieces, laid out.
+
+    Parameters
+    ----------
+    pm : PolyMesh
+    rounding : EdgeRounding
+    pieces : list of Piece
+        Every vertex module's pieces.
+    solved : list of (frame, apex, developed apex), or None
+        Per vertex (needed by nets only: they re-cut the modules).
+    centres : (n_faces, 3) float
+    points : (n_edges,) int
+        Samples per arc.
+    res : VertexResult
+    ring_closed : list of bool
+        Whether each vertex's ring is closed.
+    layout : str
+        ``"auto"``, ``"modules"``, ``"net"`` or ``"sheet"`` (:func:`filletfold.round_mesh`).
+    material_loss : bool
+    sheet, units, scale
+        The sheet of material (None: none) and how a pattern unit is drawn.
+    tabs : bool
+    stage : callable
+        Called with the name of each sub-stage as it starts (``"glue tabs"``).
+
+    Returns
+    -------
+    pattern : CreasePattern
+    layout_used : str
+    layout_note : str
+    fabrication : dict
+        Cut borders, tabs and sheet figures (the report's ``fabrication``).
+    """
+    ref = pm.mean_edge_length
+    layout_used, layout_note = "modules", ""
+    eps = 1e-9 * ref
+    if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
+        not_closed = [
+            u for u, closed in enumerate(ring_closed) if closed and res.kind[u] != "developable"
+        ]
+        if not_closed:
+            listed = ", ".join(map(str, not_closed[:8])) + (", ..." if len(not_closed) > 8 else "")
+            glued, layout_note = (
+                None,
+                (
+                    f"the input is not developable at {len(not_closed)} vertices ({listed}): their "
+                    "developments do not close, so their modules keep a cut"
+                ),
+            )
+        else:
+            glued, _, layout_note = glue_pieces(pieces, eps)
+        if glued is not None:
+            pieces, layout_used = [glued], "sheet"
+        elif layout == "sheet":
+            raise SolverError(f"the modules do not form one sheet: {layout_note}")
+    tab_h = TAB_HEIGHT * ref if tabs else 0.0
+    gap = 0.1 * ref + 2.5 * tab_h
+    sheet_box = room = None
+    if sheet is not None:
+        sheet_box = sheet_in_pattern_units(sheet, units, scale)
+        margin = 2 * (gap + tab_h)
+        room = (sheet_box[0] - margin, sheet_box[1] - margin)
+        if min(room) <= 0:
+            raise ParameterError(
+                f"the sheet {sheet} at scale {scale:g} {units} per unit is too small for any piece",
+                name="sheet",
+            )
+    if layout == "net" or (layout == "auto" and layout_used == "modules" and sheet is not None):
+        pieces = net_pieces(
+            pm,
+            rounding,
+            pieces,
+            solved,
+            centres,
+            points,
+            eps,
+            sheet=room,
+        )
+        layout_used = "net"
+    if sheet is not None:
+        pieces = [orient(piece) for piece in pieces]
+        offsets, boxes, sheet_of = pack_on_sheets(pieces, sheet_box, gap)
+        pattern = assemble_pattern(pieces, offsets)
+        pattern.annotations.sheets = boxes
+        area = np.array([piece_area(piece) for piece in pieces])
+        sheet_area = sheet_box[0] * sheet_box[1]
+        sheet_stats = {
+            "sheets": len(boxes),
+            "sheet_size": [float(max(sheet_box)), float(min(sheet_box))],
+            "pieces_per_sheet": np.bincount(sheet_of, minlength=len(boxes)).tolist(),
+            "material_use": (
+                np.bincount(sheet_of, weights=area, minlength=len(boxes)) / sheet_area
+            ).tolist(),
+        }
+    else:
+        pattern = assemble_pattern(pieces, shelf_offsets(pieces, gap))
+    fab = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
+    if tabs:
+        stage("glue tabs")
+        fab = add_tabs_and_labels(pattern, tab_h)
+    if sheet is not None:
+        fab.update(sheet_stats)
+    return pattern, layout_used, layout_note, fab
