@@ -7,6 +7,7 @@ import itertools
 
 import numpy as np
 import pytest
+from hypothesis import settings
 from scipy.spatial import ConvexHull
 
 import filletfold
@@ -74,3 +75,10 @@ def jittered_grid(rng, n: int, jitter: float):
         for i, j in itertools.product(range(n - 1), range(n - 1))
     ]
     return pts, quads
+
+
+# the same examples on every run (CI must not turn red on a newly drawn case; a case found
+# failing is then a failing test until it is fixed): `--hypothesis-profile=explore` draws anew
+settings.register_profile("repeatable", derandomize=True)
+settings.register_profile("explore", derandomize=False)
+settings.load_profile("repeatable")
