@@ -22,10 +22,11 @@ from filletfold.export import (
     report_json,
     validate_pattern,
 )
-from filletfold.export.fold import _float_text, _round, validated_faces
+from filletfold.export.fold import _float_text, _round
 from filletfold.export.obj import obj_group_name
 from filletfold.export.report import to_json_data
 from filletfold.surface.pattern import CreasePattern
+from filletfold.surface.validate import validated_faces
 
 from .conftest import design_of
 
@@ -306,7 +307,7 @@ def ref_report_json(report) -> str:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_report_records_write_the_report_of_dicts(name):
-    from filletfold.reporting import design_report, report_records
+    from filletfold.export.outputs import design_report, report_records
 
     d = design_of(name)
     report = design_report(d)

@@ -5,10 +5,11 @@ Writing goes through :func:`write_outputs` (all files or none) or :func:`write_f
 
 from __future__ import annotations
 
+from ..surface.validate import validate_pattern
 from .atomic import write_file_atomic, write_outputs
 from .cutfiles import cut_files, parse_formats
 from .dxf import pattern_dxf
-from .fold import fold_document, fold_json, validate_pattern
+from .fold import fold_document, fold_json
 from .fold_read import read_fold
 from .obj import folded_obj
 from .pdf import pattern_pdf

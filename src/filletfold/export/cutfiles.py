@@ -32,9 +32,10 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..surface.pattern import Annotations, CreasePattern, Label
+from ..surface.validate import validated_faces
 from ..units import check_units, sheet_size_mm
 from .dxf import check_scale, pattern_dxf
-from .fold import _fold_document, fold_json, validated_faces
+from .fold import _fold_document, fold_json
 from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf

@@ -39,8 +39,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
+from ..surface.validate import validate_pattern
 from ..units import check_units
-from .fold import validate_pattern
 from .paths import chain_runs, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 
 __all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
@@ -70,7 +70,7 @@ def pattern_dxf(
     Parameters
     ----------
     pattern : CreasePattern
-        Checked with :func:`~filletfold.export.fold.validate_pattern`; its annotations (tabs,
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`; its annotations (tabs,
         hinges, labels) are drawn when present.
     units : str
         Drawing unit written to ``$INSUNITS``: ``""`` (unitless), ``"mm"``, ``"cm"``, ``"m"`` or

@@ -18,7 +18,8 @@ import numpy as np
 
 from ..errors import ExportError, MeshReadError
 from ..surface.pattern import Annotations, CreasePattern, Label
-from .fold import NAMESPACE, validate_pattern
+from ..surface.validate import validate_pattern
+from .fold import NAMESPACE
 
 __all__ = ["pattern_from_fold", "read_fold"]
 

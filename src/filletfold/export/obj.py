@@ -7,8 +7,9 @@ import re
 import numpy as np
 
 from ..surface.pattern import CreasePattern
+from ..surface.validate import validated_faces
 from ..tolerances import tol
-from .fold import face_arrays, file_creator, validated_faces
+from .fold import face_arrays, file_creator
 
 __all__ = ["folded_obj", "obj_group_name", "vertex_normal_3d"]
 
@@ -76,7 +77,7 @@ def folded_obj(pattern: CreasePattern, *, vertex_normals: bool = False) -> str:
     Parameters
     ----------
     pattern : CreasePattern
-        Checked with :func:`~filletfold.export.fold.validate_pattern`.
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
     vertex_normals : bool
         Also write ``vn`` lines (see :func:`vertex_normal_3d`), one per vertex, referenced as
         ``f a//a b//b ...``.
@@ -102,7 +103,7 @@ def _xyz_lines(tag: str, xyz: np.ndarray) -> str:
 
 def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) -> str:
     """:func:`folded_obj` of a pattern already checked (``faces`` from
-    :func:`~filletfold.export.fold.validated_faces`)."""
+    :func:`~filletfold.surface.validate.validated_faces`)."""
     v3 = pattern.vertices_3d
     flat, start = faces
     patches = dict.fromkeys(pattern.face_patch)  # in order of their first face

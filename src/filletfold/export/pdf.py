@@ -26,9 +26,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
+from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
-from .fold import validate_pattern
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 from .svg import nice_length
@@ -153,7 +153,7 @@ def pattern_pdf(
     Parameters
     ----------
     pattern : CreasePattern
-        Checked with :func:`~filletfold.export.fold.validate_pattern`; its annotations are
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`; its annotations are
         drawn when present.
     page : str
         A sheet of :func:`~filletfold.units.sheet_size_mm` (``"A4"``, ``"A1"``, ``"Letter"``,

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
-from .fold import validate_pattern
+from ..surface.validate import validate_pattern
 from .palette import LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 
@@ -66,7 +66,7 @@ def pattern_png(pattern: CreasePattern, *, width_px: int = 1600) -> bytes:
     Parameters
     ----------
     pattern : CreasePattern
-        Checked with :func:`~filletfold.export.fold.validate_pattern`.
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
     width_px : int
         Image width in pixels; the height follows the layout's aspect ratio (kept between a
         quarter and four times the width).
@@ -181,7 +181,7 @@ def preview_png(
     Parameters
     ----------
     pattern : CreasePattern
-        Checked with :func:`~filletfold.export.fold.validate_pattern`.
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
     width_px : int
         Image width in pixels (the height is three quarters of it).
     elev, azim : float

@@ -22,8 +22,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
+from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units
-from .fold import validate_pattern
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import pattern_extent, tab_cut_paths
 
@@ -101,7 +101,7 @@ def pattern_svg(
     Parameters
     ----------
     pattern : CreasePattern
-        Checked with :func:`~filletfold.export.fold.validate_pattern`.
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
     units : str
         Length unit of the pattern coordinates: ``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"pt"``,
         or ``""`` (no physical unit: the larger side is printed 200 mm long). Sets the printed
