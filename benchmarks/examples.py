@@ -20,8 +20,8 @@ import time
 import numpy as np
 
 import filletfold
+from filletfold.export.outputs import edge_mismatch, relative_mismatch
 from filletfold.mesh import example_names
-from filletfold.reporting import edge_mismatch, relative_mismatch
 
 
 def machine() -> str:

@@ -15,7 +15,7 @@ from scipy.spatial import ConvexHull
 
 import filletfold
 from filletfold.errors import MeshReadError, ParameterError
-from filletfold.reporting import edge_mismatch, relative_mismatch
+from filletfold.export.outputs import edge_mismatch, relative_mismatch
 from filletfold.rounding.edges import round_edges
 from filletfold.vertex.apex import crease_length
 from filletfold.vertex.frame import vertex_frame

@@ -49,8 +49,7 @@ def test_every_function_of_the_equation_table_exists():
 def test_the_pipeline_names_functions_that_exist():
     text = METHOD.read_text(encoding="utf-8")
     pipeline = text[text.index("## Pipeline") : text.index("## Conventions")]
-    stages = "mesh|vertex|rounding|material_loss|conical|module|module_batch|design|fabrication"
-    stages += "|sheet|tabs|reporting|check"
+    stages = "mesh|rounding|vertex|surface|layout|export|design|check"
     files = ("py", "fold", "json", "obj", "svg", "png")
     found = re.findall(rf"`((?:{stages})\.[\w.]+)`", pipeline)
     named = [n for n in found if n.split(".")[-1] not in files]

@@ -688,7 +688,7 @@ def test_cut_files_rejects(kw, match):
 
 
 def test_export_design_all_formats(cube, tmp_path):
-    from filletfold.reporting import export_design
+    from filletfold.export.outputs import export_design
 
     written = export_design(cube, tmp_path / "all", formats="all", units="mm", scale=60.0)
     assert [p.name for p in written] == [

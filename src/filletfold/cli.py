@@ -271,7 +271,7 @@ def round_cmd(
     input and options.
     """
     from .export.cutfiles import DEFAULT_FORMATS, parse_formats
-    from .reporting import export_design
+    from .export.outputs import export_design
 
     target = out if out is not None else _default_out(mesh)
     try:

@@ -285,13 +285,13 @@ class Design:
 
     def report(self) -> dict:
         """The content of ``report.json``."""
-        from .reporting import design_report
+        from .export.outputs import design_report
 
         return design_report(self)
 
     def summary(self) -> str:
         """A short plain-text summary."""
-        from .reporting import design_summary
+        from .export.outputs import design_summary
 
         return design_summary(self)
 
@@ -324,7 +324,7 @@ class Design:
         list of Path
             The files written.
         """
-        from .reporting import export_design
+        from .export.outputs import export_design
 
         return export_design(
             self, folder, title=title, formats=formats, units=units, scale=scale, page=page

@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .errors import named_stages
-from .export import report_json, write_outputs
-from .export.cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
-from .export.report import Records
-from .layout.tabs import assembly_text
-from .rounding.edges import loss_from_radius
-from .tolerances import tol
+from .. import __version__
+from ..errors import named_stages
+from ..layout.tabs import assembly_text
+from ..rounding.edges import loss_from_radius
+from ..tolerances import tol
+from . import report_json, write_outputs
+from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
+from .report import Records
 
 #: The files :func:`export_design` writes by default (and ``assembly.txt`` with glue tabs).
 OUTPUT_FILES = (*output_names(DEFAULT_FORMATS), "timings.json")
