@@ -4,15 +4,23 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import settings
+from numpy.testing import assert_allclose
 from scipy.spatial import ConvexHull
 
 import filletfold
-from filletfold.mesh import EXAMPLES, example_names
+from filletfold.export.outputs import edge_mismatch
+from filletfold.mesh import EXAMPLES, example_names, load_mesh
+from filletfold.rounding.edges import clamp_radii, round_edges
+from filletfold.rounding.material_loss import solve_material_loss
+from filletfold.surface.pattern import CreasePattern
 from filletfold.vertex import batch
+from filletfold.vertex.solve import apex_problems
 
 ALL = example_names()
 CLOSED_CONVEX = [n for n, e in EXAMPLES.items() if "convex" in e.kinds and e.closed]
@@ -82,3 +90,226 @@ def jittered_grid(rng, n: int, jitter: float):
 settings.register_profile("repeatable", derandomize=True)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile("repeatable")
+
+
+# ---------------------------------------------------------------- shared test helpers
+
+
+def patch_faces(pattern, kind):
+    return [i for i, p in enumerate(pattern.face_patch) if p.split()[0] == kind]
+
+
+def check_contraction_everywhere(d):
+    example_design = d
+    """No 3D chord is longer than its flat counterpart."""
+    L = example_design.mesh.mean_edge_length
+    assert edge_mismatch(example_design.pattern).min() > -1e-12 * L
+
+
+def check_ruling_lengths_are_isometric(d):
+    example_design = d
+    d = example_design
+    p, m = d.pattern, d.mesh
+    e2 = lambda a, b: np.linalg.norm(p.vertices_2d[a] - p.vertices_2d[b])  # noqa: E731
+    e3 = lambda a, b: np.linalg.norm(p.vertices_3d[a] - p.vertices_3d[b])  # noqa: E731
+    apex = {tuple(np.round(d.vertices.apex[u], 12)) for u in range(m.n_vertices)}
+    checked = 0
+    for i, face in enumerate(p.faces):
+        kind, idx = p.face_patch[i].split()
+        pairs = list(zip(face, np.roll(face, -1), strict=True))
+        if kind == "face":  # flat piece: every edge and diagonal
+            pairs = [(a, b) for a in face for b in face if a < b]
+        elif kind == "cone":  # rulings from the apex
+            pairs = [
+                (a, b)
+                for a, b in pairs
+                if tuple(np.round(p.vertices_3d[a], 12)) in apex
+                or tuple(np.round(p.vertices_3d[b], 12)) in apex
+            ]
+        else:  # cylinder rulings run along the mesh edge
+            a0, b0 = m.edges[int(idx)]
+            t = m.vertices[b0] - m.vertices[a0]
+            t /= np.linalg.norm(t)
+            pairs = [
+                (a, b)
+                for a, b in pairs
+                if abs(abs((p.vertices_3d[b] - p.vertices_3d[a]) @ t) - e3(a, b)) < 1e-12
+            ]
+        for a, b in pairs:
+            assert abs(e2(a, b) - e3(a, b)) < 1e-11 * m.mean_edge_length
+            checked += 1
+    assert checked > len(p.faces)
+
+
+def check_pieces_lie_on_their_planes_and_cylinders(d):
+    example_design = d
+    d = example_design
+    p, m, rd = d.pattern, d.mesh, d.rounding
+    for i, face in enumerate(p.faces):
+        kind, idx = p.face_patch[i].split()
+        pts = p.vertices_3d[face]
+        if kind == "face":
+            f = int(idx)
+            assert np.abs((pts - m.vertices[m.faces[f][0]]) @ m.face_normal[f]).max() < 1e-10
+        elif kind == "cylinder":
+            e = int(idx)
+            t = m.vertices[m.edges[e, 1]] - m.vertices[m.edges[e, 0]]
+            t /= np.linalg.norm(t)
+            q = pts - rd.axis_point[e]
+            dist = np.linalg.norm(q - np.outer(q @ t, t), axis=1)
+            assert_allclose(dist, rd.radius[e], atol=1e-10)
+
+
+def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
+    example_design = d
+    """A cone whose apex lies behind the surface (sigma = -1) folds every crease as a mountain;
+    a crease between two face pieces lies on an edge left sharp and folds by its dihedral
+    angle, a mountain where the edge is convex."""
+    d = example_design
+    p, m, rd = d.pattern, d.mesh, d.rounding
+    cone_of = np.array([int(s.split()[1]) if s.startswith("cone") else -1 for s in p.face_patch])
+    face_of = np.array([int(s.split()[1]) if s.startswith("face") else -1 for s in p.face_patch])
+    crease = np.isin(p.edge_assignment, ["M", "V"])
+    assert np.all(
+        np.sign(p.edge_fold_angle[crease]) == np.where(p.edge_assignment[crease] == "M", -1, 1)
+    )
+    edge_of = {tuple(sorted(f)): e for e, f in enumerate(m.edge_faces.tolist())}
+    for k in np.nonzero(crease)[0]:
+        fa, fb = p.edge_faces[k]
+        u = max(cone_of[fa], cone_of[fb])
+        if u < 0:  # two face pieces: a sharp edge
+            e = edge_of[tuple(sorted((face_of[fa], face_of[fb])))]
+            assert rd.sharp[e], "every crease borders a cone or lies on a sharp edge"
+            assert p.edge_assignment[k] == ("M" if rd.kappa[e] > 0 else "V")
+            assert_allclose(abs(p.edge_fold_angle[k]), np.degrees(2 * rd.half_angle[e]), atol=1e-6)
+            continue
+        assert p.edge_assignment[k] == ("M" if d.vertices.sigma[u] < 0 else "V")
+    # cylinder/face joins and facets are F with angle 0; borders are B
+    assert np.all(p.edge_fold_angle[~crease] == 0)
+    assert np.all((p.edge_assignment == "B") == (p.edge_faces < 0).any(axis=1))
+
+
+def check_no_overlap_in_the_pattern(d):
+    example_design = d
+    p = example_design.pattern
+    polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
+    assert all(q.is_valid and q.area > 0 for q in polys)
+    total = sum(q.area for q in polys)
+    assert shapely.union_all(polys).area == pytest.approx(total, rel=1e-9)
+
+
+def check_faces_counter_clockwise_in_2d_and_front_facing_in_3d(d):
+    example_design = d
+    d = example_design
+    p, m = d.pattern, d.mesh
+    normals = p.face_normal_3d()
+    for i, face in enumerate(p.faces):
+        q = p.vertices_2d[face]
+        assert np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]) > 0
+        kind, idx = p.face_patch[i].split()
+        if kind == "face":
+            assert normals[i] @ m.face_normal[int(idx)] > 1 - 1e-9
+
+
+def check_crease_loop_closes_around_every_cone(d):
+    """Around every cone the creases form one loop: closed in the plane (closed development)
+    or open at the cut, whose two ends are one point of the folded form."""
+    p = d.pattern
+    for u in range(d.mesh.n_vertices):
+        if d.vertices.status[u] != "ok":
+            continue
+        faces = [i for i, s in enumerate(p.face_patch) if s == f"cone {u}"]
+        if len(set(p.face_piece[faces])) != 1:
+            continue  # a module split in several pieces
+        sel = np.isin(p.edge_faces, faces).any(axis=1) & np.isin(p.edge_assignment, ["M", "V"])
+        deg = np.bincount(p.edges[sel].ravel(), minlength=len(p.vertices_2d))
+        ends = np.nonzero(deg == 1)[0]
+        assert set(deg[deg > 0]) <= {1, 2} and len(ends) in (0, 2)
+        if len(ends) == 2:
+            assert_allclose(p.vertices_3d[ends[0]], p.vertices_3d[ends[1]], atol=1e-12)
+            r = np.linalg.norm(p.vertices_2d[ends] - d.vertices.apex_2d[u], axis=1)
+            assert_allclose(r[0], r[1], rtol=1e-9)
+
+
+CHECKS = [
+    check_contraction_everywhere,
+    check_ruling_lengths_are_isometric,
+    check_pieces_lie_on_their_planes_and_cylinders,
+    check_creases_are_mountains_at_back_apices_valleys_at_front,
+    check_no_overlap_in_the_pattern,
+    check_faces_counter_clockwise_in_2d_and_front_facing_in_3d,
+    check_crease_loop_closes_around_every_cone,
+]
+
+
+def folded_degree4_vertex(a=(1.0, 2.0), t=0.3):
+    """Four triangles around one interior vertex whose angles sum to 2 pi, folded in 3D."""
+    a1, a2 = a
+    a3, a4 = np.pi - a1, np.pi - a2  # Kawasaki-like choice; the sum is 2 pi
+    d0 = np.array([1.0, 0, 0])
+    d1 = np.array([np.cos(a1), np.sin(a1), 0])
+    n1 = np.array([-np.sin(a1), np.cos(a1), 0])
+    d2 = np.cos(a2) * d1 + np.sin(a2) * (np.cos(t) * n1 + np.sin(t) * np.array([0, 0, 1.0]))
+    g = np.array([[1, d0 @ d2], [d0 @ d2, 1]])
+    x, y = np.linalg.solve(g, [np.cos(a4), np.cos(a3)])
+    inplane = x * d0 + y * d2
+    z = np.sqrt(1 - inplane @ inplane)
+    n = np.cross(d2, d0)
+    d3 = inplane + z * n / np.linalg.norm(n)
+    v = np.vstack([[0, 0, 0], d0, d1, d2, d3])
+    f = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]]
+    return v, f
+
+
+def annulus_strip(turn: float, n: int = 24, fan: bool = False):
+    """Quads of a strip bent round an annulus sector of ``turn`` radians (a cone's apex fan
+    with ``fan``): overlapping once ``turn`` exceeds 2 pi, every face still counter-clockwise."""
+    t = np.linspace(0.0, turn, n + 1)
+    inner = np.c_[np.cos(t), np.sin(t)]
+    outer = 2.0 * inner
+    pts = np.vstack([inner, outer])
+    faces = [[k, n + 1 + k, n + 2 + k, k + 1] for k in range(n)]
+    if fan:
+        pts = np.vstack([pts, [[0.0, 0.0]]])
+        faces += [[2 * n + 2, k, k + 1] for k in range(n)]
+    return pts, faces
+
+
+def first_attempts(
+    mesh,
+    radius_frac: float,
+    depth_frac: float,
+    margin_scale: float = 1.0,
+    loss: bool = False,
+    samples: int = 9,
+):
+    """(cons, target, starts) of every cone vertex's first attempt (9 samples per arc unless
+    ``samples`` says otherwise).
+
+    With ``loss`` the radii come from the consistent-material-loss programme, so developable
+    vertices close and get a 5-variable problem.
+    """
+    pm, _ = load_mesh(mesh)
+    ref = pm.mean_edge_length
+    if loss:
+        r = solve_material_loss(pm, max_radius=np.full(pm.n_edges, radius_frac * ref))
+        r = r.edge_radius
+    else:
+        r = clamp_radii(pm, np.full(pm.n_edges, radius_frac * ref))
+    depths = np.full(pm.n_vertices, depth_frac * ref)
+    return [
+        (p.constraints(samples, margin_scale), p.target, p.starts)
+        for p in apex_problems(pm, round_edges(pm, r), depths)
+    ]
+
+
+def objective(cons, target, x) -> float:
+    return float(np.sum((x - target) ** 2) / cons.scale**2)
+
+
+def tiny_square() -> CreasePattern:
+    """A 1 x 1 square folded along its diagonal (valley 90 degrees)."""
+    v2 = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    v3 = np.c_[v2, np.zeros(4)]
+    v3[3] = [0.5, 0.5, math.sqrt(0.5)]
+    return CreasePattern(v2, v3, [[0, 1, 2], [0, 2, 3]], ["cone 0", "face 1"], [0, 0], [0])

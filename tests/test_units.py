@@ -25,7 +25,7 @@ from filletfold.units import (
     sheet_size_mm,
 )
 
-from .test_export_cutfiles import tiny_square
+from .conftest import tiny_square
 
 PT_PER_MM = 72.0 / 25.4
 SHEETS = [*SHEET_SIZES_MM, "600x400"]

@@ -37,7 +37,7 @@ the rule for dropping finished problems, which changes nothing for a problem tha
 The kernel has no copy of the crease formula of eq. (1) (:mod:`filletfold.vertex.crease`):
 it receives every constraint row already evaluated about the target, as
 ``a + A . y + alpha (y . e y)`` (:func:`filletfold.vertex.batch.pack_problems`), which is exact
-for those rows because the charts are rigid (tests/test_batch_solver.py checks the rows
+for those rows because the charts are rigid (tests/vertex/test_batch.py checks the rows
 against :meth:`~filletfold.vertex.apex.ApexConstraints.values` away from the target).
 
 numba is optional: without it this module still imports, :data:`AVAILABLE` is False and

@@ -18,46 +18,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from filletfold.mesh import load_mesh
-from filletfold.rounding.edges import clamp_radii, round_edges
-from filletfold.rounding.material_loss import solve_material_loss
 from filletfold.vertex.batch import pack, pack_problems, rows_of, solve_apex, solve_apex_batch
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems
 
-from .conftest import design_of, random_convex
-
-
-def first_attempts(
-    mesh,
-    radius_frac: float,
-    depth_frac: float,
-    margin_scale: float = 1.0,
-    loss: bool = False,
-    samples: int = 9,
-):
-    """(cons, target, starts) of every cone vertex's first attempt (9 samples per arc unless
-    ``samples`` says otherwise).
-
-    With ``loss`` the radii come from the consistent-material-loss programme, so developable
-    vertices close and get a 5-variable problem.
-    """
-    pm, _ = load_mesh(mesh)
-    ref = pm.mean_edge_length
-    if loss:
-        r = solve_material_loss(pm, max_radius=np.full(pm.n_edges, radius_frac * ref))
-        r = r.edge_radius
-    else:
-        r = clamp_radii(pm, np.full(pm.n_edges, radius_frac * ref))
-    depths = np.full(pm.n_vertices, depth_frac * ref)
-    return [
-        (p.constraints(samples, margin_scale), p.target, p.starts)
-        for p in apex_problems(pm, round_edges(pm, r), depths)
-    ]
-
-
-def objective(cons, target, x) -> float:
-    return float(np.sum((x - target) ** 2) / cons.scale**2)
+from ..conftest import design_of, first_attempts, objective, random_convex
 
 
 def check_against_reference(problems) -> None:

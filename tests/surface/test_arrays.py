@@ -22,8 +22,8 @@ from filletfold.surface.pattern import CreasePattern
 from filletfold.surface.piece import Piece
 from filletfold.vertex.frame import apply, vertex_frame
 
-from .conftest import design_of, jittered_grid
-from .reference.module import build_module
+from ..conftest import annulus_strip, design_of, jittered_grid
+from ..reference.module import build_module
 
 
 def reference_overlap(points_2d, faces, rel=1e-9) -> bool:
@@ -59,20 +59,6 @@ def test_apply_rows_is_apply_row_by_row(seed, n):
 
 
 # ---------------------------------------------------------------- overlap proof
-
-
-def annulus_strip(turn: float, n: int = 24, fan: bool = False):
-    """Quads of a strip bent round an annulus sector of ``turn`` radians (a cone's apex fan
-    with ``fan``): overlapping once ``turn`` exceeds 2 pi, every face still counter-clockwise."""
-    t = np.linspace(0.0, turn, n + 1)
-    inner = np.c_[np.cos(t), np.sin(t)]
-    outer = 2.0 * inner
-    pts = np.vstack([inner, outer])
-    faces = [[k, n + 1 + k, n + 2 + k, k + 1] for k in range(n)]
-    if fan:
-        pts = np.vstack([pts, [[0.0, 0.0]]])
-        faces += [[2 * n + 2, k, k + 1] for k in range(n)]
-    return pts, faces
 
 
 @pytest.mark.parametrize("fan", [False, True])

@@ -13,8 +13,7 @@ from filletfold.rounding.edges import edge_dihedral, loss_from_radius, round_edg
 from filletfold.rounding.material_loss import cycle_equalities, solve_material_loss
 from filletfold.vertex.frame import vertex_frame
 
-from .test_design import CHECKS
-from .test_vertex import folded_degree4_vertex
+from ..conftest import CHECKS, folded_degree4_vertex
 
 
 def cut_edges(pattern) -> int:
@@ -129,7 +128,7 @@ def test_conical_mesh_is_detected_and_rounded_by_face_offset():
 def test_development_of_a_developable_mesh():
     from filletfold.errors import MeshError
 
-    from .reference.develop import develop_faces
+    from ..reference.develop import develop_faces
 
     m = load_mesh(folded_degree4_vertex())[0]
     flat = develop_faces(m)
@@ -152,7 +151,7 @@ def check_sheet_is_the_input_shrunk_by_the_losses(d):
 
     from filletfold.surface.centres import face_piece_centres
 
-    from .reference.develop import develop_faces
+    from ..reference.develop import develop_faces
 
     m, p = d.mesh, d.pattern
     flat = develop_faces(m)

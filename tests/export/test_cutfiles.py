@@ -47,6 +47,8 @@ from filletfold.export.pdf import MAX_PAGES, REGION_PAD_MM, pdf_tiles
 from filletfold.surface.pattern import Annotations, CreasePattern, Label
 from filletfold.units import sheet_size_mm
 
+from ..conftest import tiny_square
+
 SVG_NS = "{http://www.w3.org/2000/svg}"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -108,14 +110,6 @@ def arc_pattern(n: int = 40, annotated: bool = False) -> CreasePattern:
         edge_faces=base.edge_faces,
         annotations=ann,
     )
-
-
-def tiny_square() -> CreasePattern:
-    """A 1 x 1 square folded along its diagonal (valley 90 degrees)."""
-    v2 = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
-    v3 = np.c_[v2, np.zeros(4)]
-    v3[3] = [0.5, 0.5, math.sqrt(0.5)]
-    return CreasePattern(v2, v3, [[0, 1, 2], [0, 2, 3]], ["cone 0", "face 1"], [0, 0], [0])
 
 
 @pytest.fixture(scope="module")

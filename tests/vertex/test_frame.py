@@ -19,7 +19,7 @@ from filletfold.vertex.frame import (
     vertex_frames,
 )
 
-from .conftest import random_convex
+from ..conftest import random_convex
 
 ATOL = 1e-12  # on lengths divided by the mesh's mean edge length
 

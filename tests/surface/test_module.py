@@ -18,9 +18,8 @@ from filletfold.surface import module, overlap
 from filletfold.surface.module import build_modules
 from filletfold.surface.overlap import faces_interior_disjoint, faces_interior_disjoint_many
 
-from .conftest import design_of, jittered_grid, random_convex
-from .reference.module import build_module
-from .test_speed_module import annulus_strip
+from ..conftest import annulus_strip, design_of, jittered_grid, random_convex
+from ..reference.module import build_module
 
 
 @functools.cache
@@ -102,7 +101,7 @@ def test_real_meshes_give_the_modules_of_the_oracle(name):
     points merge, fitted radii: what the examples do not have."""
     from pathlib import Path
 
-    d = filletfold.round_mesh(Path(__file__).parent / "data" / "corpus" / name, tabs=False)
+    d = filletfold.round_mesh(Path(__file__).parent.parent / "data" / "corpus" / name, tabs=False)
     compare(d, d.stages.samples)
 
 

@@ -12,7 +12,7 @@ import filletfold
 from filletfold.errors import ParameterError
 from filletfold.units import sheet_size_mm
 
-from .test_design import CHECKS
+from ..conftest import CHECKS
 
 
 @pytest.fixture(scope="module")

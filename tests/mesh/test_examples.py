@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from filletfold.errors import MeshReadError
 from filletfold.mesh import EXAMPLES, PolyMesh, clean_mesh, example_mesh, example_names, load_mesh
 
-from .conftest import signed_volume
+from ..conftest import signed_volume
 
 NAMES = example_names()
 CLOSED = [n for n in NAMES if EXAMPLES[n].closed]

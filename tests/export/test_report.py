@@ -28,7 +28,7 @@ from filletfold.export.report import to_json_data
 from filletfold.surface.pattern import CreasePattern
 from filletfold.surface.validate import validated_faces
 
-from .conftest import design_of
+from ..conftest import design_of
 
 NAMES = ["cube", "torus", "house", "open-box", "miura"]
 

@@ -19,9 +19,9 @@ from filletfold.mesh import (
     write_off,
 )
 
-from .conftest import signed_volume
+from ..conftest import signed_volume
 
-BUNNY = Path(__file__).resolve().parents[1] / "examples" / "bunny-lowres.obj"
+BUNNY = Path(__file__).resolve().parents[2] / "examples" / "bunny-lowres.obj"
 
 
 def assert_same_faces(a, b):

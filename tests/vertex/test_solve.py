@@ -20,7 +20,7 @@ from filletfold.vertex.batch import solve_apex
 from filletfold.vertex.frame import developed_apices, vertex_frame, vertex_frames
 from filletfold.vertex.normal import max_min_direction, vertex_normal
 
-from .conftest import ALL, CLOSED_CONVEX, design_of, random_convex
+from ..conftest import ALL, CLOSED_CONVEX, design_of, folded_degree4_vertex, random_convex
 
 
 def frame_of(name, r, u=0):
@@ -184,25 +184,6 @@ def test_random_convex_polyhedra_every_solved_apex_is_valid(seed, share, depth):
         fr = vertex_frame(d.mesh, rd, u)
         check = validate_apex(fr, d.vertices.apex[u], fr.developed_apex(), -1, n_samples=513)
         assert check.ok, check.failing
-
-
-def folded_degree4_vertex(a=(1.0, 2.0), t=0.3):
-    """Four triangles around one interior vertex whose angles sum to 2 pi, folded in 3D."""
-    a1, a2 = a
-    a3, a4 = np.pi - a1, np.pi - a2  # Kawasaki-like choice; the sum is 2 pi
-    d0 = np.array([1.0, 0, 0])
-    d1 = np.array([np.cos(a1), np.sin(a1), 0])
-    n1 = np.array([-np.sin(a1), np.cos(a1), 0])
-    d2 = np.cos(a2) * d1 + np.sin(a2) * (np.cos(t) * n1 + np.sin(t) * np.array([0, 0, 1.0]))
-    g = np.array([[1, d0 @ d2], [d0 @ d2, 1]])
-    x, y = np.linalg.solve(g, [np.cos(a4), np.cos(a3)])
-    inplane = x * d0 + y * d2
-    z = np.sqrt(1 - inplane @ inplane)
-    n = np.cross(d2, d0)
-    d3 = inplane + z * n / np.linalg.norm(n)
-    v = np.vstack([[0, 0, 0], d0, d1, d2, d3])
-    f = [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]]
-    return v, f
 
 
 def test_developable_vertex_is_detected_and_reported():

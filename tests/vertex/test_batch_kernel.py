@@ -32,8 +32,7 @@ import filletfold
 from filletfold.vertex import batch, batch_kernel
 from filletfold.vertex.batch_kernel import AVAILABLE, interior_point_numba
 
-from .conftest import random_convex
-from .test_batch_solver import first_attempts, objective
+from ..conftest import first_attempts, objective, random_convex
 
 #: The numpy reference.
 numpy_ipm = batch.interior_point_numpy

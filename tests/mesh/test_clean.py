@@ -12,7 +12,7 @@ from filletfold.errors import MeshError
 from filletfold.mesh import CleanLog, PolyMesh, clean_mesh, example_mesh
 from filletfold.tolerances import tol
 
-from .conftest import random_convex, signed_volume
+from ..conftest import random_convex, signed_volume
 
 
 def cube():

@@ -13,7 +13,7 @@ import filletfold
 from filletfold.tolerances import tol
 from filletfold.vertex.apex import KINDS, ApexCheck, validate_apex, validate_apices
 
-from .conftest import design_of
+from ..conftest import design_of
 
 EXAMPLES = ["icosahedron", "cube", "dimpled-cube", "l-prism", "torus", "blob", "conical-dome"]
 
