@@ -1,0 +1,58 @@
+"""Nets (:mod:`filletfold.layout.net`): rigid fits, shared borders, the cut tree, and modules
+joined into nets that overlap nothing."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import filletfold
+from filletfold.layout.net import build_nets, cut_edges_for_nets, rigid_fit, shared_points
+from filletfold.surface.piece import piece_area
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.floats(-np.pi, np.pi), st.floats(-10, 10), st.floats(-10, 10), st.integers(0, 10**6))
+def test_rigid_fit_recovers_a_rigid_motion(angle, tx, ty, seed):
+    src = np.random.default_rng(seed).normal(size=(6, 2))
+    c, s = np.cos(angle), np.sin(angle)
+    dst = src @ np.array([[c, s], [-s, c]]) + [tx, ty]
+    m = rigid_fit(src, dst)
+    np.testing.assert_allclose(src @ m[:2, :2].T + m[:2, 2], dst, atol=1e-9)
+    assert np.linalg.det(m[:2, :2]) == pytest.approx(1.0)
+
+
+def test_a_reflection_is_not_fitted():
+    src = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    m = rigid_fit(src, src * [1, -1])
+    assert np.linalg.det(m[:2, :2]) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("name", ["cube", "icosahedron", "house"])
+def test_the_cut_tree_cuts_each_closed_vertex_along_one_of_its_edges(name):
+    m = filletfold.load_mesh(name)[0]
+    cut = cut_edges_for_nets(m)
+    assert cut.shape == (m.n_vertices,)
+    for u in range(m.n_vertices):
+        assert u in m.edges[cut[u]]
+
+
+@pytest.mark.parametrize("name", ["cube", "icosahedron"])
+def test_nets_hold_every_piece_once_and_overlap_nothing(name):
+    d = filletfold.round_mesh(name, tabs=False, layout="modules")
+    eps = 1e-9 * d.mesh.mean_edge_length
+    shared = shared_points(d.pieces, eps)
+    assert shared and all(shared[(b, a)] for (a, b) in shared)
+    nets, members = build_nets(d.pieces, eps)
+    assert sorted(i for m in members for i in m) == list(range(len(d.pieces)))
+    assert 1 <= len(nets) < len(d.pieces)
+    for net, m in zip(nets, members, strict=True):
+        assert not net.overlaps()
+        assert piece_area(net) == pytest.approx(sum(piece_area(d.pieces[i]) for i in m), rel=1e-9)
+
+
+def test_a_net_design_has_fewer_pieces_than_modules():
+    d = filletfold.round_mesh("cube", tabs=False, layout="net")
+    assert d.layout == "net" and d.pattern.n_pieces < d.mesh.n_vertices

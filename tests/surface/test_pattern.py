@@ -1,0 +1,68 @@
+"""The crease pattern (:mod:`filletfold.surface.pattern`): edges derived from the faces, their
+assignments and fold angles, the cut borders, and the faces read as arrays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from filletfold.surface.pattern import face_arrays
+
+from ..conftest import design_of
+
+
+@pytest.mark.parametrize("name", ["cube", "torus", "l-prism"])
+def test_edges_are_the_faces_sides_once_each(name):
+    p = design_of(name).pattern
+    sides = set()
+    for f in p.faces:
+        f = np.asarray(f)
+        for a, b in zip(f.tolist(), np.roll(f, -1).tolist(), strict=True):
+            sides.add((min(a, b), max(a, b)))
+    edges = [tuple(e) for e in p.edges.tolist()]
+    assert edges == sorted(sides)
+    assert (p.edges[:, 0] < p.edges[:, 1]).all()
+
+
+@pytest.mark.parametrize("name", ["cube", "torus"])
+def test_edge_faces_hold_the_edge(name):
+    p = design_of(name).pattern
+    for e, (a, b) in enumerate(p.edges.tolist()):
+        faces = [f for f in p.edge_faces[e].tolist() if f >= 0]
+        assert faces
+        for f in faces:
+            assert {a, b} <= set(np.asarray(p.faces[f]).tolist())
+        border = len(faces) == 1
+        assert border == (p.edge_assignment[e] == "B")
+
+
+@pytest.mark.parametrize("name", ["cube", "torus", "dimpled-cube"])
+def test_fold_angle_signs_follow_the_assignment(name):
+    p = design_of(name).pattern
+    angle, assign = p.edge_fold_angle, p.edge_assignment
+    assert (angle[assign == "M"] < 0).all()
+    assert (angle[assign == "V"] > 0).all()
+    assert (angle[(assign == "B") | (assign == "F")] == 0).all()
+    assert (np.abs(angle) < 180).all()
+
+
+def test_cut_borders_come_in_pairs_on_one_folded_segment():
+    p = design_of("cube").pattern
+    cut = p.cut_mask()
+    border = p.edge_assignment == "B"
+    assert cut.any() and (border & ~cut).sum() == 0  # a closed surface: every border is a cut
+    ends = np.sort(np.round(p.vertices_3d[p.edges[cut]], 9).reshape(-1, 6), axis=0)
+    segments = {}
+    for e in np.flatnonzero(cut).tolist():
+        a, b = (tuple(np.round(p.vertices_3d[i], 9)) for i in p.edges[e])
+        segments.setdefault(tuple(sorted([a, b])), []).append(e)
+    assert len(ends) == cut.sum()
+    assert all(len(v) == 2 for v in segments.values())
+
+
+def test_face_arrays_are_the_faces():
+    p = design_of("torus").pattern
+    flat, start = face_arrays(p.faces)
+    assert start[-1] == len(flat) and len(start) == len(p.faces) + 1
+    for k in (0, 1, len(p.faces) // 2, len(p.faces) - 1):
+        assert flat[start[k] : start[k + 1]].tolist() == np.asarray(p.faces[k]).tolist()
