@@ -313,3 +313,79 @@ def tiny_square() -> CreasePattern:
     v3 = np.c_[v2, np.zeros(4)]
     v3[3] = [0.5, 0.5, math.sqrt(0.5)]
     return CreasePattern(v2, v3, [[0, 1, 2], [0, 2, 3]], ["cone 0", "face 1"], [0, 0], [0])
+
+
+def rotation(angle: float, shift) -> np.ndarray:
+    m = np.eye(3)
+    m[:2, :2] = [[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]]
+    m[:2, 2] = shift
+    return m
+
+
+# ---------------------------------------------------------------- hand-made crease patterns
+
+
+def _rotate(p, c, d, theta):
+    """Rotate points ``p`` (k, 3) about the axis through ``c`` along unit ``d`` by ``theta``."""
+    r = np.asarray(p, dtype=float) - c
+    return (
+        c
+        + r * math.cos(theta)
+        + np.cross(d, r) * math.sin(theta)
+        + np.outer(r @ d, d) * (1 - math.cos(theta))
+    )
+
+
+def diagonal_square(angle_deg: float, size: float = 1.0, offset=(0.0, 0.0)) -> dict:
+    """A square folded along its diagonal 0-2; ``angle_deg > 0`` lifts vertex 3 to +z (valley)."""
+    v2 = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float) * size + offset
+    v3 = np.c_[v2, np.zeros(4)]
+    d = np.array([1.0, 1.0, 0.0]) / math.sqrt(2)
+    v3[3] = _rotate(v3[3:4], v3[0], d, math.radians(angle_deg))[0]
+    return {"v2": v2, "v3": v3, "faces": [[0, 1, 2], [0, 2, 3]]}
+
+
+def square_pattern(angle_deg: float) -> CreasePattern:
+    s = diagonal_square(angle_deg)
+    return CreasePattern(s["v2"], s["v3"], s["faces"], ["cone 7", "face 1"], [0, 0], [7])
+
+
+def two_pieces() -> CreasePattern:
+    """A valley square (piece 0) and a mountain square (piece 1), apart in 2D and 3D."""
+    a, b = diagonal_square(60.0), diagonal_square(-45.0, size=2.0, offset=(3.0, 0.5))
+    v2 = np.vstack([a["v2"], b["v2"]])
+    v3 = np.vstack([a["v3"], b["v3"] + [0.0, 0.0, 5.0]])
+    faces = a["faces"] + [[i + 4 for i in f] for f in b["faces"]]
+    patches = ["cone 3", "face 2", "cone 9", "face 5"]
+    return CreasePattern(v2, v3, faces, patches, [0, 0, 1, 1], [3, 9])
+
+
+def strip_pattern() -> CreasePattern:
+    """Three quads in a row: a flat join (F), then a 30 degree mountain; B border around."""
+    v2 = np.array([[0, 0], [1, 0], [2, 0], [3, 0], [3, 1], [2, 1], [1, 1], [0, 1]], dtype=float)
+    v3 = np.c_[v2, np.zeros(8)]
+    # fold the last quad down (away from the +z front) about x = 2: a mountain
+    t = math.radians(30.0)
+    for i in (3, 4):
+        dx = v2[i, 0] - 2.0
+        v3[i] = [2.0 + dx * math.cos(t), v2[i, 1], -dx * math.sin(t)]
+    faces = [[0, 1, 6, 7], [1, 2, 5, 6], [2, 3, 4, 5]]
+    return CreasePattern(v2, v3, faces, ["face 0", "face 0", "cone 1"], [0, 0, 0], [0])
+
+
+PATTERNS = {
+    "valley": lambda: square_pattern(90.0),
+    "mountain": lambda: square_pattern(-90.0),
+    "two_pieces": two_pieces,
+    "strip": strip_pattern,
+}
+
+
+@pytest.fixture(params=sorted(PATTERNS))
+def pattern(request) -> CreasePattern:
+    return PATTERNS[request.param]()
+
+
+def signed_area(p: np.ndarray) -> float:
+    q = np.roll(p, -1, axis=0)
+    return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -420,3 +421,49 @@ def test_group_names_all_at_once_are_obj_group_name():
     assert _group_names(names) == [obj_group_name(n) for n in names]
     assert _group_names([*names, "p\x00q"]) == [obj_group_name(n) for n in [*names, "p\x00q"]]
     assert _group_names([]) == []
+
+
+# ---------------------------------------------------------------- report JSON (hand-made)
+
+
+@dataclasses.dataclass
+class _Stats:
+    count: int
+    ratio: float
+
+
+def test_report_json_numpy_and_nan():
+    report = {
+        "z": np.float64(1.5),
+        "a": np.array([[1.0, np.nan], [np.inf, -2.0]]),
+        "n": np.int64(7),
+        "flag": np.bool_(True),
+        "nan": float("nan"),
+        "ids": (np.int32(1), 2),
+        "nested": {np.int64(3): "three", "stats": _Stats(2, float("-inf"))},
+    }
+    text = report_json(report)
+    assert text.endswith("\n")
+    assert text.startswith('{\n  "z": 1.5,')
+    back = json.loads(text)
+    assert list(back) == ["z", "a", "n", "flag", "nan", "ids", "nested"]
+    assert back["a"] == [[1.0, None], [None, -2.0]]
+    assert back["n"] == 7 and back["flag"] is True and back["nan"] is None
+    assert back["ids"] == [1, 2]
+    assert back["nested"] == {"3": "three", "stats": {"count": 2, "ratio": None}}
+    assert "NaN" not in text and "Infinity" not in text
+    assert report_json(report) == text
+
+
+@pytest.mark.parametrize(
+    ("report", "match"),
+    [
+        ({"x": object()}, r"at x has no JSON form \(object\)"),
+        ({"x": [1, complex(1, 2)]}, r"x\[1\] has no JSON form"),
+        ({"x": np.array([1j])}, "complex128 array"),
+        ({(1, 2): 3}, "is not a string or number"),
+    ],
+)
+def test_report_json_rejects(report, match):
+    with pytest.raises(ExportError, match=match):
+        report_json(report)

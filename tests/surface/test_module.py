@@ -10,15 +10,21 @@ import itertools
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import filletfold
 from filletfold.mesh import example_names
 from filletfold.rounding.edges import round_edges
 from filletfold.surface import module, overlap
-from filletfold.surface.module import build_modules
-from filletfold.surface.overlap import faces_interior_disjoint, faces_interior_disjoint_many
+from filletfold.surface.module import apply_rows, build_modules
+from filletfold.surface.overlap import (
+    faces_interior_disjoint,
+    faces_interior_disjoint_many,
+)
+from filletfold.vertex.frame import apply
 
-from ..conftest import annulus_strip, design_of, jittered_grid, random_convex
+from ..conftest import annulus_strip, design_of, jittered_grid, random_convex, rotation
 from ..reference.module import build_module
 
 
@@ -237,3 +243,20 @@ def test_batched_proof_answers_as_the_per_piece_one():
         piece = np.repeat(np.arange(len(order)), [len(fs) for fs in faces])
         got = faces_interior_disjoint_many(np.vstack(pts), flat, size, piece, len(order))
         assert np.array_equal(got, want[order])
+
+
+# ---------------------------------------------------------------- bitwise helpers
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40))
+def test_apply_rows_is_apply_row_by_row(seed, n):
+    """Batched 2D maps give the bits of one ``apply`` per row (else the patterns would move)."""
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(n, 2)) * 10.0 ** rng.integers(-3, 3)
+    m = rotation(rng.uniform(0, 2 * np.pi), rng.normal(size=2) * 5)
+    one = np.vstack([apply(m, q) for q in p])
+    assert np.array_equal(apply_rows(m, p), one)
+    maps = np.stack([rotation(a, rng.normal(size=2)) for a in rng.uniform(0, 7, size=n)])
+    each = np.vstack([apply(mk, q) for mk, q in zip(maps, p, strict=True)])
+    assert np.array_equal(apply_rows(maps, p), each)

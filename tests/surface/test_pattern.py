@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from filletfold.surface.pattern import face_arrays
+from filletfold.surface.pattern import CreasePattern, face_arrays
 
 from ..conftest import design_of
 
@@ -66,3 +66,32 @@ def test_face_arrays_are_the_faces():
     assert start[-1] == len(flat) and len(start) == len(p.faces) + 1
     for k in (0, 1, len(p.faces) // 2, len(p.faces) - 1):
         assert flat[start[k] : start[k + 1]].tolist() == np.asarray(p.faces[k]).tolist()
+
+
+# ---------------------------------------------------------------- cut borders
+
+
+def reference_cut_mask(p: CreasePattern, decimals: int = 9) -> np.ndarray:
+    b = np.nonzero(p.edge_assignment == "B")[0]
+    ends = np.round(p.vertices_3d[p.edges[b]], decimals)
+    ends = np.sort(ends.view([("", ends.dtype)] * 3).reshape(len(b), 2), axis=1)
+    _, inv, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+    mask = np.zeros(len(p.edges), dtype=bool)
+    mask[b] = counts[inv.ravel()] > 1
+    return mask
+
+
+@pytest.mark.parametrize("name", ["cube", "torus", "open-box", "tent"])
+def test_cut_mask_matches_the_structured_unique(name):
+    p = design_of(name).pattern
+    assert np.array_equal(p.cut_mask(), reference_cut_mask(p))
+    assert np.array_equal(p.cut_mask(3), reference_cut_mask(p, 3))
+
+
+def test_cut_mask_treats_minus_zero_as_zero():
+    """Two border edges whose folded ends differ only by the sign of a zero are one cut."""
+    v2 = np.array([[0, 0], [1, 0], [0, 1], [3, 0], [4, 0], [3, 1]], dtype=float)
+    v3 = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1e-12, 0, 0], [1, 0, -0.0], [0, -1, 0]])
+    p = CreasePattern(v2, v3, [[0, 1, 2], [3, 4, 5]], ["face 0", "face 1"], [0, 1], [0, 1])
+    assert np.array_equal(p.cut_mask(), reference_cut_mask(p))
+    assert p.cut_mask().sum() == 2
