@@ -78,6 +78,10 @@ class Tolerances:
         The development's map ``rho`` of a vertex has a fixed point (the developed apex) when
         ``|det(I - Q)| = 4 sin^2(theta / 2)`` is at least this (a turn ``theta`` above about
         1e-7 radians); below, it is a translation.
+    parallel : float
+        Two lines (or a segment and a triangle's plane) are parallel when the determinant of
+        their crossing, for unit directions ``sin^2`` of their angle (``1e-12``: 1e-6 rad), is
+        below this: the one singular-2x2 test of line crossings and segment hits.
     coincide : float
         Two points of a vertex module are one point (merged) when they are this close in 2D
         and in 3D, relative to the larger of the module's shortest edge and the size of its
@@ -106,6 +110,7 @@ class Tolerances:
     min_fillet: float = 1e-6
     fold: float = 0.0105
     ruling: float = 2e-7
+    parallel: float = 1e-12
     coincide: float = 1e-14
     fixed_point: float = 1e-14
 

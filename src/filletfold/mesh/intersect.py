@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tolerances import tol
+
 
 def crossing_triangle_pairs(v: np.ndarray, faces) -> int:
     """Number of pairs of vertex-disjoint triangles (faces fanned) that intersect.
@@ -41,7 +43,8 @@ def segment_hits_triangle(s0: np.ndarray, s1: np.ndarray, t: np.ndarray) -> np.n
     e2 = t[:, 2] - t[:, 0]
     h = np.cross(d, e2)
     det = np.einsum("ij,ij->i", e1, h)
-    ok = np.abs(det) > 1e-12
+    scale = np.linalg.norm(d, axis=1) * np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
+    ok = np.abs(det) > tol.parallel * scale  # not parallel to the triangle's plane
     det = np.where(ok, det, 1.0)
     s = s0 - t[:, 0]
     u = np.einsum("ij,ij->i", s, h) / det

@@ -490,7 +490,7 @@ def _line_crossings(p1, d1, p2, d2):
     delta = p2 - p1
     c, a, b = _dot(d1, d2), _dot(d1, delta), _dot(d2, delta)
     det = 1.0 - c * c
-    parallel = det < 1e-12
+    parallel = det < tol.parallel
     det = np.where(parallel, 1.0, det)
     z1, z2 = (a - c * b) / det, (c * a - b) / det
     if parallel.any():  # minimum-norm least squares, singular values cut as lstsq does

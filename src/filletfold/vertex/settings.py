@@ -27,3 +27,7 @@ PROJECTION_TOL = 1e-13
 PROX = 1e-2
 #: Starts tried at once in phase 1 before the remaining ones.
 PARALLEL_STARTS = 1
+#: The start of a closed development's developed apex is where two consecutive central rulings
+#: cross (sec. 3.2), taken from the first pair whose directions are further than this from
+#: parallel (``|det|``, unit directions): nearer pairs cross too far away to start from.
+START_PARALLEL = 1e-6

@@ -25,6 +25,7 @@ from .batch import solve_apex_batch
 from .frame import VertexFrame, developed_apices, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
+from .settings import START_PARALLEL
 
 STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable", "sharp")
 
@@ -237,7 +238,7 @@ def central_rulings_crossing(frame: VertexFrame) -> np.ndarray | None:
             lines.append((m[:2, :2] @ [0.5 * arc, 0.0] + m[:2, 2], m[:2, :2] @ [0.0, 1.0]))
     for (p1, d1), (p2, d2) in zip(lines, lines[1:] + lines[:1], strict=True):
         a = np.stack([d1, -d2], axis=1)
-        if abs(np.linalg.det(a)) > 1e-6:
+        if abs(np.linalg.det(a)) > START_PARALLEL:
             z = np.linalg.solve(a, p2 - p1)
             return p1 + z[0] * d1
     return None
