@@ -45,10 +45,18 @@ from .crease import (
 )
 from .reference import project_slsqp, solve_apex_slsqp
 from .settings import (
+    ARMIJO,
     CHUNK,
+    GIVE_UP_SLACK,
+    HESSIAN_FLOOR,
+    IPM_TOL,
     KKT_ACTIVE,
     KKT_TOL,
+    MERIT_ROUNDOFF,
+    MULTIPLIER_FLOOR,
+    MULTIPLIER_START_FLOOR,
     PARALLEL_STARTS,
+    PRIMAL_WEIGHT_MU,
     PROJECTION_TOL,
     PROX,
     ROW_BUDGET,
@@ -280,7 +288,7 @@ def interior_point_numpy(
     groups: np.ndarray | None = None,
     give_up: bool = False,
     max_iter: int = 80,
-    tol: float = 1e-12,
+    tol: float = IPM_TOL,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Minimise ``0.5 y.q.y + c.y`` subject to ``rows(y) > 0`` from strictly feasible ``y``.
 
@@ -328,7 +336,7 @@ def interior_point_numpy(
     g = _row_values(a, A, al, e, yl)
     # phase 1: multipliers that balance the objective's gradient, spread over the rows;
     # phase 2: a barrier-like start, larger on the rows close to their boundary
-    scale = np.maximum(1e-2, np.abs(yl * q + cl).max(axis=1))
+    scale = np.maximum(MULTIPLIER_START_FLOOR, np.abs(yl * q + cl).max(axis=1))
     lam = mf * (scale / count)[:, None] if stop_slack is not None else mf * scale[:, None] / g
     stuck = np.zeros(B, dtype=bool)
     mu = 0.1 * (lam * g).sum(axis=1) / count
@@ -353,7 +361,7 @@ def interior_point_numpy(
                 reached = np.isin(groups[live], groups[live[reached]])
             done |= reached
             if give_up:
-                done |= t + comp < -1e-9
+                done |= t + comp < -GIVE_UP_SLACK
         new = done & ~converged[live]
         y[live[new]], converged[live[new]] = yl[new], True
         done |= stuck  # no step possible: keep the point (not converged)
@@ -374,7 +382,8 @@ def interior_point_numpy(
         # curvature weights: lambda, or the primal mu / g where lambda lags behind (rows that
         # just became nearly active would otherwise be crossed by every step)
         # (late on, the exact lambda again, for fast local convergence)
-        lam_h = np.where((mu > 1e-8)[:, None], np.maximum(lam, mf * mu[:, None] / g), lam)
+        primal = (mu > PRIMAL_WEIGHT_MU)[:, None]
+        lam_h = np.where(primal, np.maximum(lam, mf * mu[:, None] / g), lam)
         w = lam_h / g
         wa = w * al
         u = _vecmat(wa, A)
@@ -384,7 +393,7 @@ def interior_point_numpy(
         H[:, diag_idx, diag_idx] += q - 2 * (lam_h * al).sum(axis=1)[:, None] * e
         # the reverse-convex rows make H indefinite at times: shift it to positive definite
         low = np.linalg.eigvalsh(H)[:, 0]
-        floor = 1e-8 * np.maximum(1.0, np.abs(H[:, diag_idx, diag_idx]).max(axis=1))
+        floor = HESSIAN_FLOOR * np.maximum(1.0, np.abs(H[:, diag_idx, diag_idx]).max(axis=1))
         H[:, diag_idx, diag_idx] += np.maximum(floor - low, 0.0)[:, None]
         v = mu[:, None] / g
         rhs = -(yl * q + cl) + _vecmat(v, A) + 2 * (v * al).sum(axis=1)[:, None] * ey
@@ -411,8 +420,8 @@ def interior_point_numpy(
             yt = yl[todo] + s_[:, None] * dy[todo]
             mt = 0.5 * (yt * q * yt).sum(axis=1) + (cl[todo] * yt).sum(axis=1)
             mt -= mu[todo] * np.log(np.where(ok[:, None], gt, 1.0)).sum(axis=1)
-            bound = merit0[todo] + 1e-4 * s_ * slope[todo]
-            ok &= mt <= bound + 1e-13 * np.maximum(1.0, np.abs(merit0[todo]))
+            bound = merit0[todo] + ARMIJO * s_ * slope[todo]
+            ok &= mt <= bound + MERIT_ROUNDOFF * np.maximum(1.0, np.abs(merit0[todo]))
             todo = todo[~ok]
             if len(todo) == 0:
                 break
@@ -425,7 +434,7 @@ def interior_point_numpy(
         stuck = step == 0
         yl = np.where(stuck[:, None], yl, y_new)
         g = np.where(stuck[:, None], g, g_new)
-        lam = np.maximum(lam + step[:, None] * dlam, 1e-30 * mf)
+        lam = np.maximum(lam + step[:, None] * dlam, MULTIPLIER_FLOOR * mf)
     rest = ~converged[live]
     y[live[rest]] = yl[rest]
     return y, converged

@@ -52,7 +52,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..parallel import thread_map, threads
-from .settings import STAT_TOL, T_CAP
+from .settings import (
+    ARMIJO,
+    GIVE_UP_SLACK,
+    HESSIAN_FLOOR,
+    IPM_TOL,
+    MERIT_ROUNDOFF,
+    MULTIPLIER_FLOOR,
+    MULTIPLIER_START_FLOOR,
+    PRIMAL_WEIGHT_MU,
+    STAT_TOL,
+    T_CAP,
+)
 
 try:
     from numba import njit
@@ -86,7 +97,7 @@ def interior_point_numba(
     groups: np.ndarray | None = None,
     give_up: bool = False,
     max_iter: int = 80,
-    tol: float = 1e-12,
+    tol: float = IPM_TOL,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Minimise ``0.5 y.q.y + c.y`` subject to ``rows(y) > 0`` from strictly feasible ``y``.
 
@@ -224,7 +235,7 @@ def _start(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, count, phase1):
         scale = 0.0
         for k in range(n):
             scale = max(scale, abs(yl[b, k] * q[k] + c[b, k]))
-        scale = max(1e-2, scale)
+        scale = max(MULTIPLIER_START_FLOOR, scale)
         comp = 0.0
         for j in range(R):
             lam[b, j] = mf[b, j] * (scale / cnt) if phase1 else mf[b, j] * scale / g[b, j]
@@ -279,7 +290,7 @@ def _status(idx, G, al, e, mf, q, c, yl, g, lam, mu, count, done, reached, gave_
         if stop_slack >= 0:
             t = yl[b, stop_slack]
             reached[b] = t >= 0.5 * t_cap or (t > 0 and comp <= t)
-            gave_up[b] = give_up and t + comp < -1e-9
+            gave_up[b] = give_up and t + comp < -GIVE_UP_SLACK
 
 
 @njit(cache=True)
@@ -352,7 +363,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
     H, W = np.empty((n, n)), np.empty((n, n))
     for b in idx:
         m = mu[b]
-        primal = m > 1e-8
+        primal = m > PRIMAL_WEIGHT_MU
         # Newton matrix and right-hand side
         s_waal = 0.0  # sum w alpha^2
         s_lal = 0.0  # sum lambda_h alpha
@@ -417,7 +428,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
             dlam[j] = dl
             ratio = min(ratio, lj / -dl if dl < 0 else math.inf)
         step = min(1.0, 0.995 * ratio)
-        tiny = 1e-13 * max(1.0, abs(merit0))
+        tiny = MERIT_ROUNDOFF * max(1.0, abs(merit0))
         found = False
         for _ in range(40):
             quad = 2 * step * p + step * step * qq
@@ -431,7 +442,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
                     yt[k] = yl[b, k] + step * dy[k]
                     mt += 0.5 * (yt[k] * q[k] * yt[k]) + c[b, k] * yt[k]
                 mt -= m * _sum_log(gt)
-                if mt <= merit0 + 1e-4 * step * slope + tiny:
+                if mt <= merit0 + ARMIJO * step * slope + tiny:
                     found = True
                     break
             step *= 0.5
@@ -453,7 +464,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
             for j in range(R):
                 g[b, j] = gt[j]
         for j in range(R):
-            lam[b, j] = max(lam[b, j] + step * dlam[j], 1e-30 * mf[b, j])
+            lam[b, j] = max(lam[b, j] + step * dlam[j], MULTIPLIER_FLOOR * mf[b, j])
 
 
 # --------------------------------------------------------------------------- row helpers
@@ -523,7 +534,7 @@ def _shift_or_reset(H, rhs, W):
     floor = 0.0
     for k in range(n):
         floor = max(floor, abs(H[k, k]))
-    floor = 1e-8 * max(1.0, floor)
+    floor = HESSIAN_FLOOR * max(1.0, floor)
     if _positive_definite(H, floor, W):  # the usual case: no shift, no eigenvalue needed
         return
     shift = max(floor - _smallest_eigenvalue(H, W), 0.0)

@@ -31,3 +31,23 @@ PARALLEL_STARTS = 1
 #: cross (sec. 3.2), taken from the first pair whose directions are further than this from
 #: parallel (``|det|``, unit directions): nearer pairs cross too far away to start from.
 START_PARALLEL = 1e-6
+
+# ---- the interior-point method (both versions, numpy and numba, read these)
+#: Mean complementarity at which a problem is done, relative to the squared length scale.
+IPM_TOL = 1e-12
+#: Smallest scale of the starting multipliers (of the objective's gradient).
+MULTIPLIER_START_FLOOR = 1e-2
+#: With ``give_up``, phase 1 stops once the smallest slack plus the complementarity is below
+#: minus this: the problem is infeasible.
+GIVE_UP_SLACK = 1e-9
+#: Above this barrier parameter the curvature weights use ``max(lambda, mu / g)`` (rows that just
+#: became nearly active); below it the exact ``lambda`` (fast local convergence).
+PRIMAL_WEIGHT_MU = 1e-8
+#: The Newton matrix is shifted to at least this times its largest diagonal entry (or 1).
+HESSIAN_FLOOR = 1e-8
+#: Sufficient decrease of the merit function along a step (Armijo).
+ARMIJO = 1e-4
+#: Round-off allowed in that test, relative to the merit (or 1).
+MERIT_ROUNDOFF = 1e-13
+#: Multipliers stay above this share of their row's mask (never exactly 0).
+MULTIPLIER_FLOOR = 1e-30
