@@ -26,7 +26,7 @@ from filletfold.app.view import (
 from filletfold.cli import main
 from filletfold.errors import MeshReadError, ParameterError
 
-from .conftest import design_of
+from ..conftest import design_of
 
 TETRA_OBJ = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
 ZIP_NAMES = {"design.fold", "report.json", "folded.obj", "pattern.svg", "pattern.dxf"}
