@@ -41,7 +41,7 @@ def test_what_is_not_a_design_is_refused_in_one_line(tmp_path):
     with pytest.raises(MeshReadError) as e:
         pattern_from_fold(broken)
     assert "\n" not in str(e.value)
-    bad = dict(doc, faces_vertices=[[0, 1, 10**9]] + doc["faces_vertices"][1:])
+    bad = dict(doc, faces_vertices=[[0, 1, 10**9], *doc["faces_vertices"][1:]])
     with pytest.raises(MeshReadError, match="not a valid filletfold design"):
         pattern_from_fold(bad)
     path = tmp_path / "x.fold"
