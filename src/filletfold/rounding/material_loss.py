@@ -42,6 +42,19 @@ from ..mesh.polymesh import PolyMesh
 from ..tolerances import tol
 from .edges import edge_dihedral, radius_from_loss, tan_minus_angle
 
+#: Stage 2 keeps every width at least this share below the optimal bound ``b*`` of stage 1
+#: (the LP's own round-off would otherwise make stage 2 infeasible).
+LP_STAGE_SLACK = 1e-9
+#: Tolerances of the least-squares polish that removes the equality residual.
+POLISH_TOL = 1e-16
+#: An inequality row is tight (named in the report) when its slack is below this share of the
+#: mean edge length.
+TIGHT = 1e-9
+#: The bound ``b`` is positive (a solution) above this share of the mean edge length.
+POSITIVE_BOUND = 1e-12
+#: With no solution, the equality rows whose dual marginal exceeds this bind (they are named).
+BINDING_MARGINAL = 1e-9
+
 
 @dataclass
 class MaterialLoss:
@@ -271,7 +284,8 @@ def solve_material_loss(
         # optimum of stage 1 leaves all widths but the smallest free, often at their caps
         b_star = float(res.x[-1])
         cost = np.append(var.astype(float), 0.0)
-        bounds2 = [*bounds[:-1], (b_star * (1 - 1e-9), b_star * (1 - 1e-9))]
+        keep = b_star * (1 - LP_STAGE_SLACK)
+        bounds2 = [*bounds[:-1], (keep, keep)]
         res2 = linprog(cost, bounds=bounds2, **lp)
         if res2.status == 0:
             res2.x[-1] = b_star
@@ -296,7 +310,7 @@ def solve_material_loss(
         sub = A_eq[:, np.nonzero(var)[0]]
         for _ in range(2):
             resid = A_eq @ np.where(var, u, 0.0)
-            corr = lsqr(sub, resid, atol=1e-16, btol=1e-16, iter_lim=10 * sub.shape[1])[0]
+            corr = lsqr(sub, resid, atol=POLISH_TOL, btol=POLISH_TOL, iter_lim=10 * sub.shape[1])[0]
             u[var] -= corr
     u = np.where(var, u, 0.0)
     closure = np.zeros(mesh.n_vertices)
@@ -308,16 +322,16 @@ def solve_material_loss(
     radius = np.where(rounded & (w > 0), radius_from_loss(w, np.where(rounded, gamma, 1.0)), 0.0)
     slack = b_ub - A_ub @ res.x if len(b_ub) else np.zeros(0)
     scale = float(L.mean())
-    tight = [ub_names[i] for i in range(n_names) if slack[i] <= 1e-9 * scale]
-    n_b_tight = int(np.sum(slack[n_names : n_names + n_width_rows] <= 1e-9 * scale))
+    tight = [ub_names[i] for i in range(n_names) if slack[i] <= TIGHT * scale]
+    n_b_tight = int(np.sum(slack[n_names : n_names + n_width_rows] <= TIGHT * scale))
     if n_b_tight:
         tight.append(f"{n_b_tight} half-edge width(s) at the bound b")
-    ok = b > 1e-12 * scale
+    ok = b > POSITIVE_BOUND * scale
     binding = []
     if not ok:
         marg = getattr(res, "eqlin", None)
         if marg is not None and len(rows):
-            strong = np.nonzero(np.abs(marg.marginals) > 1e-9)[0]
+            strong = np.nonzero(np.abs(marg.marginals) > BINDING_MARGINAL)[0]
             verts = sorted({rows[i][0] for i in strong})
             edges = sorted({rows[i][1] for i in strong})
             binding = [f"vertices {verts}", f"edges {edges}"]
