@@ -7,12 +7,15 @@ import json
 
 import numpy as np
 import pytest
+from numpy.testing import assert_allclose
 
 from filletfold.errors import MeshReadError
-from filletfold.export import fold_document, fold_json, read_fold
+from filletfold.export import fold_document, fold_json, pattern_dxf, read_fold
 from filletfold.export.fold_read import pattern_from_fold
+from filletfold.surface.pattern import CreasePattern
 
-from ..conftest import design_of
+from ..conftest import design_of, tiny_square
+from .conftest import arc_pattern, layer_lengths, read_dxf
 
 
 @pytest.mark.parametrize("name", ["cube", "torus", "miura"])
@@ -49,3 +52,102 @@ def test_what_is_not_a_design_is_refused_in_one_line(tmp_path):
     with pytest.raises(MeshReadError) as e:
         read_fold(path)
     assert "\n" not in str(e.value)
+
+
+# ---------------------------------------------------------------- FOLD read back
+
+
+def write_fold(tmp_path, doc, name="design.fold"):
+    path = tmp_path / name
+    path.write_text(doc if isinstance(doc, str) else json.dumps(doc))
+    return path
+
+
+def assert_same_pattern(a: CreasePattern, b: CreasePattern) -> None:
+    assert_allclose(a.vertices_2d, b.vertices_2d, atol=1e-9)
+    assert_allclose(a.vertices_3d, b.vertices_3d, atol=1e-9)
+    assert [list(f) for f in a.faces] == [list(f) for f in b.faces]
+    assert list(a.face_patch) == list(b.face_patch)
+    assert a.face_piece.tolist() == b.face_piece.tolist()
+    assert a.piece_vertex.tolist() == b.piece_vertex.tolist()
+    assert a.edges.tolist() == b.edges.tolist()
+    assert a.edge_assignment.tolist() == b.edge_assignment.tolist()
+    assert_allclose(a.edge_fold_angle, b.edge_fold_angle, atol=1e-9)
+    assert a.edge_faces.tolist() == b.edge_faces.tolist()
+    aa, ba = a.annotations, b.annotations
+    assert len(aa.tabs) == len(ba.tabs) and len(aa.labels) == len(ba.labels)
+    for s, t in zip(aa.tabs, ba.tabs, strict=True):
+        assert_allclose(s, t, atol=1e-9)
+    for s, t in zip(aa.tab_hinges, ba.tab_hinges, strict=True):
+        assert_allclose(s, t, atol=1e-9)
+    for s, t in zip(aa.labels, ba.labels, strict=True):
+        assert (s.text, s.kind) == (t.text, t.kind)
+        assert_allclose([*s.position, s.angle, s.height], [*t.position, t.angle, t.height])
+    assert_allclose(np.reshape(aa.sheets, (-1, 4)), np.reshape(ba.sheets, (-1, 4)), atol=1e-9)
+
+
+def test_read_fold_round_trip_cube(cube, tmp_path):
+    doc = fold_document(cube.pattern)
+    assert doc["filletfold:pieces_vertex"] == cube.pattern.piece_vertex.tolist()
+    back = read_fold(write_fold(tmp_path, fold_json(doc)))
+    assert_same_pattern(cube.pattern, back)
+
+
+@pytest.mark.parametrize("annotated", [False, True])
+def test_read_fold_round_trip_annotations(annotated, tmp_path):
+    pattern = arc_pattern(annotated=annotated)
+    doc = fold_document(pattern)
+    assert ("filletfold:annotations" in doc) is annotated
+    back = read_fold(write_fold(tmp_path, fold_json(doc)))
+    assert_same_pattern(pattern, back)
+    # the pattern read back exports like the original (up to FOLD's 12 digits)
+    a, b = layer_lengths(read_dxf(pattern_dxf(back))), layer_lengths(read_dxf(pattern_dxf(pattern)))
+    assert a.keys() == b.keys()
+    for layer in a:
+        assert a[layer][0] == pytest.approx(b[layer][0], rel=1e-9)
+        assert len(a[layer][1]) == len(b[layer][1])
+
+
+def test_read_fold_without_pieces_vertex(tmp_path):
+    doc = fold_document(tiny_square())
+    del doc["filletfold:pieces_vertex"]
+    back = read_fold(write_fold(tmp_path, doc))
+    assert back.piece_vertex.tolist() == [-1]
+
+
+def _mutated(change):
+    doc = json.loads(fold_json(fold_document(tiny_square())))
+    change(doc)
+    return doc
+
+
+@pytest.mark.parametrize(
+    ("content", "match"),
+    [
+        ("{not json", "invalid JSON"),
+        ("[1, 2]", "top level is a list"),
+        ({"file_spec": 1.2, "vertices_coords": [[0, 0]]}, "missing key"),
+        (_mutated(lambda d: d.pop("file_frames")), "no folded frame"),
+        (_mutated(lambda d: d.update(file_frames=[{"frame_classes": []}])), "no frame of"),
+        (_mutated(lambda d: d["file_frames"][0].update(vertices_coords=[[0, 0]] * 4)), "3D"),
+        (_mutated(lambda d: d.update(vertices_coords=[[0, 0, 0]] * 4)), "2D points"),
+        (_mutated(lambda d: d["edges_assignment"].__setitem__(0, "X")), "not a valid filletfold"),
+        (_mutated(lambda d: d.update(edges_foldAngle="x")), "malformed arrays"),
+        (_mutated(lambda d: d.update({"filletfold:annotations": [1]})), "must be an object"),
+        (
+            _mutated(lambda d: d.update({"filletfold:annotations": {"labels": [{"x": 1}]}})),
+            "annotations is malformed",
+        ),
+    ],
+)
+def test_read_fold_rejects(content, match, tmp_path):
+    path = write_fold(tmp_path, content)
+    with pytest.raises(MeshReadError, match=match):
+        read_fold(path)
+
+
+def test_read_fold_missing_file_and_folder(tmp_path):
+    with pytest.raises(MeshReadError, match="no such file"):
+        read_fold(tmp_path / "nothing.fold")
+    with pytest.raises(MeshReadError, match="is a folder"):
+        read_fold(tmp_path)

@@ -17,6 +17,7 @@ from filletfold.export import (
 from filletfold.export.svg import nice_length
 
 from ..conftest import PATTERNS, signed_area, square_pattern, strip_pattern, two_pieces
+from .conftest import arc_pattern
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 ATOL = 1e-9
@@ -166,3 +167,28 @@ def test_nice_length(target, expected):
 def test_nice_length_rejects():
     with pytest.raises(ParameterError, match="positive"):
         nice_length(0.0)
+
+
+# ---------------------------------------------------------------- SVG annotations
+
+
+def test_svg_draws_annotations():
+    root = ET.fromstring(pattern_svg(arc_pattern(annotated=True), units="cm"))
+    groups = {g.get("id"): g for g in root.iter(f"{SVG_NS}g")}
+    assert {"tab-cut", "tab-hinge", "sheets", "labels"} <= set(groups)
+    (cut,) = list(groups["tab-cut"])
+    assert cut.tag == f"{SVG_NS}polyline" and cut.get("stroke") == "#000000"
+    assert len(cut.get("points").split()) == 4  # the outline without its hinge
+    assert groups["tab-hinge"].get("stroke-dasharray")
+    assert [c.get("stroke") for c in groups["tab-hinge"]] == ["#00a000"]
+    assert len(list(groups["sheets"])) == 1
+    texts = {t.text: t for t in groups["labels"]}
+    assert set(texts) == {"P1", "7"}
+    assert texts["7"].get("transform").startswith("rotate(-30 ")
+    assert texts["P1"].get("transform") is None
+
+
+def test_svg_without_annotations_has_no_annotation_groups():
+    root = ET.fromstring(pattern_svg(arc_pattern()))
+    ids = {g.get("id") for g in root.iter(f"{SVG_NS}g")}
+    assert not ids & {"tab-cut", "tab-hinge", "sheets", "labels"}

@@ -1,0 +1,52 @@
+"""One palette (:mod:`filletfold.export.palette`) for the SVG, PDF and PNG drawings."""
+
+from __future__ import annotations
+
+import re
+import zlib
+
+from filletfold.export import pattern_dxf, pattern_pdf, pattern_svg
+from filletfold.export.palette import ASSIGNMENT_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
+
+SVG_NS = "{http://www.w3.org/2000/svg}"
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+# ---------------------------------------------------------------- one palette
+
+
+def pdf_stroke_colors(data: bytes) -> set[str]:
+    """Stroke colours (``#rrggbb``) set in the content streams of a PDF."""
+    colors = set()
+    for raw in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", data, flags=re.S):
+        try:
+            text = zlib.decompress(raw).decode("latin-1")
+        except zlib.error:
+            continue
+        for rgb in re.findall(r"(?:([\d.]+) ([\d.]+) )?([\d.]+) (?:RG|G)\b", text):
+            rgb = rgb if rgb[0] else (rgb[2],) * 3  # "x G" is grey x
+            colors.add("#" + "".join(f"{round(float(c) * 255):02x}" for c in rgb))
+    return colors
+
+
+def test_svg_and_pdf_draw_with_one_palette(cube):
+    svg = pattern_svg(cube.pattern)
+    pdf = pattern_pdf(cube.pattern, scale=20.0)
+    present = set(cube.pattern.edge_assignment) - {"F"}
+    assert {"M", "B"} <= present
+    used = {ASSIGNMENT_COLOR[a] for a in present} | {TAB_HINGE_COLOR}
+    assert used <= pdf_stroke_colors(pdf)
+    for a in present:
+        assert f'stroke="{ASSIGNMENT_COLOR[a]}"' in svg, a
+    assert f'stroke="{TAB_HINGE_COLOR}"' in svg
+    assert f'fill="{LABEL_COLOR}"' in svg
+
+
+def test_dxf_classes_are_sorted(cube):
+    """ezdxf takes the classes from a set (ordered by the hash seed); the DXF sorts them."""
+    text = pattern_dxf(cube.pattern, units="mm")
+    section = text.split("\nCLASSES\n", 1)[1].split("\nENDSEC\n", 1)[0]
+    names = re.findall(r"\n  0\nCLASS\n  1\n(\S+)\n  2\n(\S+)", "\n" + section)
+    assert len(names) > 10
+    assert names == sorted(names)
+    assert {"LAYOUT", "ACDBPLACEHOLDER"} <= {n for n, _ in names}

@@ -1,0 +1,97 @@
+"""Cut paths (:mod:`filletfold.export.paths`): borders, creases and tabs as polylines and
+splines."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from filletfold.export.paths import (
+    SPLINE_MIN_POINTS,
+    chain_is_smooth,
+    chain_runs,
+    edge_chains,
+    simplify_polyline,
+    tab_cut_paths,
+)
+from filletfold.surface.pattern import Annotations
+
+SVG_NS = "{http://www.w3.org/2000/svg}"
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+# ---------------------------------------------------------------- paths
+
+
+def test_edge_chains_cover_every_edge_once():
+    edges = np.array([[0, 1], [1, 2], [2, 3], [1, 4], [5, 6], [6, 7], [5, 7]])
+    chains = edge_chains(edges)
+    # vertex 1 has degree 3: three open paths end there; 5-6-7 is a loop
+    assert sorted((tuple(c), closed) for c, closed in chains) == sorted(
+        [((0, 1), False), ((1, 2, 3), False), ((1, 4), False), ((5, 6, 7), True)]
+    )
+    segs = set()
+    for c, closed in chains:
+        ring = list(c) + ([c[0]] if closed else [])
+        segs |= {tuple(sorted(int(v) for v in s)) for s in itertools.pairwise(ring)}
+    assert segs == {tuple(e) for e in edges.tolist()}
+
+
+def test_edge_chains_mask_and_empty():
+    edges = np.array([[0, 1], [1, 2], [2, 3]])
+    assert edge_chains(edges, np.zeros(3, dtype=bool)) == []
+    ((c, closed),) = edge_chains(edges, np.array([True, True, False]))
+    assert c.tolist() == [0, 1, 2] and not closed
+
+
+def test_simplify_polyline_drops_collinear_points():
+    p = np.array([[0, 0], [1, 0], [2, 0], [2, 0], [2, 1], [2, 2]], dtype=float)
+    assert simplify_polyline(p).tolist() == [[0, 0], [2, 0], [2, 2]]
+    square = np.array([[0, 0], [1, 0], [2, 0], [2, 2], [0, 2]], dtype=float)
+    assert len(simplify_polyline(square, closed=True)) == 4
+
+
+def arc(step_deg: float, n: int) -> np.ndarray:
+    t = np.radians(step_deg) * np.arange(n)
+    return np.c_[np.cos(t), np.sin(t)]
+
+
+@pytest.mark.parametrize(
+    ("points", "smooth"),
+    [
+        (arc(5.0, 20), True),
+        (arc(10.0, 20), False),  # turns more than 8 degrees per point
+        (arc(5.0, SPLINE_MIN_POINTS - 1), False),  # too few points
+        (np.vstack([arc(5.0, 10), [[-3.0, 5.0]]]), False),  # a corner at the end
+    ],
+)
+def test_chain_is_smooth_rule(points, smooth):
+    assert chain_is_smooth(points) is smooth
+
+
+def test_chain_runs_split_at_corners_and_spacing_jumps():
+    # an arc, a long straight segment tangent to it, then a corner
+    a = arc(4.0, 15)
+    end = a[-1]
+    tangent = np.array([-math.sin(math.radians(56.0)), math.cos(math.radians(56.0))])
+    p = np.vstack([a, end + 2.0 * tangent, end + 2.0 * tangent + [5.0, 0.0]])
+    runs = chain_runs(p)
+    assert [(len(r), s) for r, s, _ in runs] == [(15, True), (3, False)]
+    assert_allclose(runs[0][0][-1], runs[1][0][0])
+    # a full circle is one closed spline whose last point repeats the first
+    ((pts, spline, closed),) = chain_runs(arc(6.0, 60), closed=True)
+    assert spline and closed and np.array_equal(pts[0], pts[-1])
+
+
+def test_tab_cut_paths_leave_the_hinge_out():
+    tab = np.array([[0, 0], [0.2, -0.2], [0.8, -0.2], [1, 0]], dtype=float)
+    ann = Annotations(
+        tabs=[tab, tab + np.array([2.0, 0.0])], tab_hinges=[np.array([[1.0, 0.0], [0.0, 0.0]])]
+    )
+    (p0, c0), (p1, c1) = tab_cut_paths(ann)
+    assert not c0 and p0.tolist() == tab.tolist()  # open path 0 -> 3, the hinge 3 -> 0 left out
+    assert c1 and len(p1) == 4  # no hinge given for the second tab: all of it is cut
