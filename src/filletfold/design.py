@@ -29,7 +29,7 @@ from .errors import stage as _stage
 from .layout.arrange import arrange
 from .layout.fabrication import sheet_in_pattern_units
 from .mesh import load_mesh
-from .mesh.polymesh import PolyMesh
+from .mesh.polymesh import PolyMesh, mesh_size
 from .rounding.conical import conical_material_loss, is_conical, use_cone_axes
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
@@ -39,7 +39,7 @@ from .surface.module import build_modules
 from .surface.pattern import CreasePattern
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
-from .vertex.solve import STATUSES, VertexResult, classify_vertices, mesh_size, solve_apices
+from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
 
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
@@ -579,6 +579,7 @@ def round_mesh(
         depths,
         st,
         progress,
+        size,
         material_loss=material_loss,
         fit_vertices=fit_vertices,
         coplanar_deg=coplanar_deg,
@@ -685,6 +686,7 @@ def _apices(
     depths,
     st,
     progress,
+    size,
     *,
     material_loss,
     fit_vertices,
@@ -697,7 +699,6 @@ def _apices(
     ones. Returns the frames, classification, rounding and face-piece centres afterwards (the
     rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
     kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
-    size = mesh_size(pm)
     pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
     kept = set()
     if st is not None:

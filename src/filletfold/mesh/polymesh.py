@@ -289,3 +289,8 @@ class PolyMesh:
 
     def __repr__(self) -> str:
         return f"PolyMesh(n_vertices={self.n_vertices}, n_faces={self.n_faces})"
+
+
+def mesh_size(mesh: PolyMesh) -> float:
+    """The size crease rulings are measured against: the mesh's bounding-box diagonal."""
+    return float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))

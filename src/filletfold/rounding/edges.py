@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..mesh.polymesh import PolyMesh
+from ..mesh.polymesh import PolyMesh, mesh_size
 from ..tolerances import tol
 
 
@@ -123,7 +123,7 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
         Largest radius that is valid when used on every rounded edge.
     """
     e_out, e_in, alpha = _corner_table(mesh)
-    sliver = 4.0 * tol.ruling * float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))
+    sliver = 4.0 * tol.ruling * mesh_size(mesh)
     tan_g = np.tan(half_angle)
     rounded = edge_radius > 0
     length = mesh.edge_length

@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..mesh.polymesh import PolyMesh
+from ..mesh.polymesh import PolyMesh, mesh_size
 from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
-from .solve import VertexResult, classify_vertices, mesh_size, solve_apices
+from .solve import VertexResult, classify_vertices, solve_apices
 
 #: Halvings of an infeasible vertex's radii tried before it is left infeasible (1/16 at most).
 ROUNDS = 4

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mesh.polymesh import PolyMesh
+from ..mesh.polymesh import PolyMesh, mesh_size
 from ..parallel import thread_map
 from ..rounding.edges import EdgeRounding
 from ..tolerances import tol
@@ -330,11 +330,6 @@ START_DEPTHS = np.array([0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5])
 #: Vertices solved and validated together: bounds the memory of a round's sampled
 #: constraints and dense validation (about 100 kB per vertex at 65 validation samples).
 ROUND_SLICE = 2048
-
-
-def mesh_size(mesh: PolyMesh) -> float:
-    """The size crease rulings are measured against: the mesh's bounding-box diagonal."""
-    return float(np.linalg.norm(np.ptp(mesh.vertices, axis=0)))
 
 
 def apex_problem(
