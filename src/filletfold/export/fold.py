@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import ExportError, ParameterError
 from ..surface.pattern import Annotations, CreasePattern, face_arrays
 from ..surface.validate import validated_faces
+from .report import python_scalar
 
 __all__ = [
     "FOLD_SPEC",
@@ -336,12 +337,9 @@ def _plain(obj, where: str):
         return _Raw(obj.text())
     elif isinstance(obj, _Raw):
         return obj
-    elif isinstance(obj, np.generic):
-        obj = obj.item()
-    if obj is None or isinstance(obj, bool | str):
+    obj = python_scalar(obj)
+    if obj is None or isinstance(obj, bool | str | int):
         return obj
-    if isinstance(obj, int):
-        return int(obj)
     if isinstance(obj, float):
         try:
             return _round(obj)

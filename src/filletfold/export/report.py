@@ -160,6 +160,16 @@ def to_json_data(obj, where: str = ""):
     return _data(obj, where, records=False)
 
 
+def python_scalar(obj):
+    """``obj`` with a numpy scalar made the Python one, and an ``int`` subclass (an ``IntEnum``,
+    say) a plain ``int``; anything else as it is."""
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, int) and not isinstance(obj, bool):
+        return int(obj)
+    return obj
+
+
 def _data(obj, where: str, records: bool):
     """:func:`to_json_data`; with ``records``, lists of dicts and :class:`Records` become
     :class:`Records` of JSON data (what :func:`_indented` writes a column at a time)."""
@@ -171,12 +181,9 @@ def _data(obj, where: str, records: bool):
         if records and _numeric_array(obj):
             return obj
         obj = obj.tolist()
-    elif isinstance(obj, np.generic):
-        obj = obj.item()
-    if obj is None or isinstance(obj, bool | str):
+    obj = python_scalar(obj)
+    if obj is None or isinstance(obj, bool | str | int):
         return obj
-    if isinstance(obj, int):
-        return int(obj)
     if isinstance(obj, float):
         return float(obj) if math.isfinite(obj) else None
     if isinstance(obj, enum.Enum):
