@@ -414,12 +414,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
             merit0 += 0.5 * (yl[b, k] * q[k] * yl[b, k]) + c[b, k] * yl[b, k]
         slope = min(slope, 0.0)
         merit0 -= m * _sum_log(g[b])
-        for j in range(R):
-            Ad[j] = 0.0
-        for k in range(n):
-            dk = dy[k]
-            for j in range(R):
-                Ad[j] += G[b, k, j] * dk
+        _rows_times(b, G, dy, Ad)
         # fraction to the boundary for lambda, then backtracking on g > 0 and the merit
         ratio = math.inf
         for j in range(R):
@@ -476,14 +471,22 @@ def _rows_at(b, a, G, al, e, y, out):
     yey = 0.0
     for k in range(n):
         yey += y[k] * e[k] * y[k]
+    _rows_times(b, G, y, out)
+    for j in range(R):
+        out[j] = a[b, j] + out[j] + al[b, j] * yey
+
+
+@njit(cache=True, fastmath=FAST)
+def _rows_times(b, G, y, out):
+    """``A.y`` of problem ``b`` (``G[b]`` is ``A`` transposed, (n, R)) at ``y`` ((n,) float)
+    into ``out`` ((R,) float)."""
+    _, n, R = G.shape
     for j in range(R):
         out[j] = 0.0
     for k in range(n):
         yk = y[k]
         for j in range(R):
             out[j] += G[b, k, j] * yk
-    for j in range(R):
-        out[j] = a[b, j] + out[j] + al[b, j] * yey
 
 
 @njit(cache=True, fastmath=FAST)
