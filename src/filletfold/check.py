@@ -51,6 +51,7 @@ from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
 from .export.fold_read import _edge_faces, read_fold
 from .surface.pattern import CreasePattern, face_arrays
+from .tolerances import tol
 
 __all__ = [
     "ANGLE_TOL_DEG",
@@ -813,7 +814,7 @@ def _convex_faces(g: _Data, area: np.ndarray) -> np.ndarray:
     dn = d[g.nxt]
     cross = d[:, 0] * dn[:, 1] - d[:, 1] * dn[:, 0]
     length = np.hypot(d[:, 0], d[:, 1])
-    left = cross >= -1e-12 * length * length[g.nxt]
+    left = cross >= -tol.roundoff * length * length[g.nxt]
     turn = np.arctan2(cross, np.einsum("ij,ij->i", d, dn))
     one_turn = np.add.reduceat(turn, g.start[:-1]) < 3 * np.pi
     return (

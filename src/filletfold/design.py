@@ -862,7 +862,7 @@ def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue) -> dict:
     bent = rounding.half_angle > 0  # rounded or left sharp (not boundary, not flat)
     asked = np.where(bent, requested, 0.0)
     sharp = rounding.sharp if rounding.sharp is not None else np.zeros(len(bent), dtype=bool)
-    reduced = np.flatnonzero(bent & ~sharp & (fitted < asked * (1 - 1e-12)))
+    reduced = np.flatnonzero(bent & ~sharp & (fitted < asked * (1 - tol.roundoff)))
     return {
         "radius_requested": asked,
         "fitted_radius": fitted,

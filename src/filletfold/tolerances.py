@@ -89,6 +89,14 @@ class Tolerances:
         moves no point by more than the rounding of its coordinates (a looser merge breaks the
         ruling isometry and the contraction by as much, e.g. across the cut of a development
         that closes to 1e-11).
+    roundoff : float
+        Relative slack for round-off in a test that is exact in exact arithmetic: a turn's sign
+        against the product of its two lengths, a fitted radius against the asked one, an area
+        against the polygon's, a solver's constraint value against its length scale.
+    relative : float
+        Two quantities that agree to this share of their size are equal where nothing finer is
+        at stake: a piece fits its sheet, a turn is an exact multiple of the arc step, a page
+        count, a point on a triangle's edge, a vertex is conical, layout's merge distance.
     """
 
     merge: float = 1e-9
@@ -113,6 +121,8 @@ class Tolerances:
     parallel: float = 1e-12
     coincide: float = 1e-14
     fixed_point: float = 1e-14
+    roundoff: float = 1e-12
+    relative: float = 1e-9
 
 
 tol = Tolerances()

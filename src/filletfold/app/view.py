@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..design import Design
+from ..tolerances import tol
 
 #: RGB (0..255) of each patch kind.
 PATCH_RGB = {"cone": (245, 158, 64), "cylinder": (89, 153, 230), "face": (115, 199, 115)}
@@ -67,7 +68,7 @@ def triangulate_polygon(poly_2d: np.ndarray) -> np.ndarray:
     prev, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
     turn = _cross(p - prev, nxt - p)
     scale = max(float(np.ptp(p, axis=0).max()) ** 2, 1e-300)
-    if np.all(turn >= -1e-12 * scale):
+    if np.all(turn >= -tol.roundoff * scale):
         return np.array([[0, i, i + 1] for i in range(1, k - 1)])
     idx = list(range(k))
     out = []
@@ -124,7 +125,7 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
         q = p[f]
         turn = _cross(q - np.roll(q, 1, axis=1), np.roll(q, -1, axis=1) - q)
         scale = np.maximum(np.ptp(q, axis=1).max(axis=1) ** 2, 1e-300)
-        convex = np.all(turn >= -1e-12 * scale[:, None], axis=1)
+        convex = np.all(turn >= -tol.roundoff * scale[:, None], axis=1)
         fan = np.array([[0, i, i + 1] for i in range(1, k - 1)], dtype=np.int64)
         rows = t_start[which][:, None] + np.arange(k - 2)
         triangles[rows[convex]] = f[convex][:, fan]

@@ -27,6 +27,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
+from ..tolerances import tol
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
@@ -125,8 +126,8 @@ def pdf_tiles(
             x1 + REGION_PAD_MM,
             y1 + REGION_PAD_MM,
         )
-        cols = max(1, math.ceil((x1 - x0) / tw - 1e-9))
-        rows = max(1, math.ceil((y1 - y0) / th - 1e-9))
+        cols = max(1, math.ceil((x1 - x0) / tw - tol.relative))
+        rows = max(1, math.ceil((y1 - y0) / th - tol.relative))
         if len(tiles) + rows * cols > MAX_PAGES:
             raise ParameterError(
                 f"the PDF would need more than {MAX_PAGES} {width:g} x {height:g} mm pages; "

@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import ParameterError, SolverError
 from ..surface.assemble import assemble_pattern
 from ..surface.piece import piece_area
+from ..tolerances import tol
 from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
 from .sheet import glue_pieces
 from .shelf import shelf_offsets
@@ -74,7 +75,7 @@ def arrange(
     """
     ref = pm.mean_edge_length
     layout_used, layout_note = "modules", ""
-    eps = 1e-9 * ref
+    eps = tol.relative * ref
     if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
         not_closed = [
             u for u, closed in enumerate(ring_closed) if closed and res.kind[u] != "developable"

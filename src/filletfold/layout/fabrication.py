@@ -15,6 +15,7 @@ from ..errors import ParameterError
 from ..surface.faces import face_polygons
 from ..surface.module import build_modules
 from ..surface.piece import Piece
+from ..tolerances import tol
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from ..vertex.frame import apply, invert, vertex_frames
 from .net import build_nets, cut_edges_for_nets
@@ -150,7 +151,7 @@ def pack_on_sheets(pieces: list[Piece], sheet: tuple[float, float], gap: float):
     arrays = [p.arrays()[0] for p in pieces]
     size = np.array([np.ptp(a, axis=0) for a in arrays])
     for k, (sw, sh) in enumerate(size):
-        if sw + 2 * gap > w * (1 + 1e-9) or sh + 2 * gap > h * (1 + 1e-9):
+        if sw + 2 * gap > w * (1 + tol.relative) or sh + 2 * gap > h * (1 + tol.relative):
             raise ParameterError(
                 f"piece {k + 1} ({sw:.4g} x {sh:.4g}) does not fit on the sheet "
                 f"({w:.4g} x {h:.4g} in pattern units); use a larger sheet or a smaller scale",

@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 
 from ..surface.faces import FaceLists, face_polygons, flat_faces
 from ..surface.piece import Piece
+from ..tolerances import tol
 
 
 def rigid_fit(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
@@ -150,7 +151,7 @@ def build_nets(
     pieces: list[Piece],
     eps: float,
     sheet: tuple[float, float] | None = None,
-    overlap_tol: float = 1e-9,
+    overlap_tol: float = tol.relative,
 ) -> tuple[list[Piece], list[list[int]]]:
     """Join pieces into nets that overlap nothing and fit the sheet.
 

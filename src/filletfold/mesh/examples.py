@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 from ..errors import MeshReadError, ParameterError
+from ..tolerances import tol
 from . import tessellations
 
 _PHI = (1.0 + np.sqrt(5.0)) / 2.0
@@ -72,7 +73,7 @@ def _convex_polyhedron(points) -> tuple[np.ndarray, list[np.ndarray]]:
     for i in range(len(eq)):
         if group[i] >= 0:
             continue
-        same = (np.abs(eq - eq[i]) <= 1e-9 * max(scale, 1.0)).all(axis=1) & (group < 0)
+        same = (np.abs(eq - eq[i]) <= tol.relative * max(scale, 1.0)).all(axis=1) & (group < 0)
         group[same] = n_groups
         n_groups += 1
     faces = []

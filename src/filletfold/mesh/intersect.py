@@ -51,7 +51,7 @@ def segment_hits_triangle(s0: np.ndarray, s1: np.ndarray, t: np.ndarray) -> np.n
     q = np.cross(s, e1)
     w = np.einsum("ij,ij->i", d, q) / det
     along = np.einsum("ij,ij->i", e2, q) / det
-    eps = 1e-9
+    eps = tol.relative
     return (
         ok & (u >= -eps) & (w >= -eps) & (u + w <= 1 + eps) & (along >= -eps) & (along <= 1 + eps)
     )

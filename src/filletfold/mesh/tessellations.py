@@ -33,6 +33,16 @@ from .intersect import crossing_triangle_pairs
 __all__ = ["chicken_wire", "conical_dome", "miura", "resch", "yoshimura"]
 
 _SQRT3 = np.sqrt(3.0)
+#: Points of the Resch grid are one point when their coordinates agree to 1 / this.
+_KEY_SCALE = 1e6
+#: Unit lengths and distances of the Resch grid are equal to within this.
+_GRID_TOL = 1e-6
+#: ``ftol`` and ``xtol`` of the least-squares fold of the Resch pattern.
+_FIT_TOL = 1e-8
+#: The projection onto the edge lengths stops once every length is this close ...
+_LENGTH_DONE = 1e-15
+#: ... and fails when one is further than this after its rounds.
+_LENGTH_TOL = 1e-12
 
 
 # ----------------------------------------------------------------------------- validation
@@ -377,7 +387,7 @@ def _resch_flat(m: int, n: int):
     key: dict[tuple[int, int], int] = {}
 
     def vid(p) -> int:
-        k = (round(float(p[0]) * 1e6), round(float(p[1]) * 1e6))
+        k = (round(float(p[0]) * _KEY_SCALE), round(float(p[1]) * _KEY_SCALE))
         if k not in key:
             key[k] = len(pts)
             pts.append(np.asarray(p, dtype=np.float64))
@@ -403,9 +413,9 @@ def _resch_flat(m: int, n: int):
     # tops: unit equilateral triangles of star boundary points, outside every star, with at
     # least two sides on star edges (a top between only two stars fills a notch of the patch)
     boundary = np.array(sorted(set(range(len(p))) - set(centre_ids)))
-    pairs = cKDTree(p[boundary]).query_pairs(1.0 + 1e-6, output_type="ndarray")
+    pairs = cKDTree(p[boundary]).query_pairs(1.0 + _GRID_TOL, output_type="ndarray")
     d = np.linalg.norm(p[boundary[pairs[:, 0]]] - p[boundary[pairs[:, 1]]], axis=1)
-    pairs = boundary[pairs[np.abs(d - 1.0) < 1e-6]]
+    pairs = boundary[pairs[np.abs(d - 1.0) < _GRID_TOL]]
     nbr: dict[int, set[int]] = {}
     for a, b in pairs.tolist():
         nbr.setdefault(a, set()).add(b)
@@ -415,7 +425,7 @@ def _resch_flat(m: int, n: int):
     )
     for c in cand:
         centroid = p[list(c)].mean(axis=0)
-        if np.linalg.norm(centre_xy - centroid, axis=1).min() < _SQRT3 - 1e-6:
+        if np.linalg.norm(centre_xy - centroid, axis=1).min() < _SQRT3 - _GRID_TOL:
             continue  # inside a star (its inscribed circle holds every unit triangle in it)
         sides = ((c[0], c[1]), (c[1], c[2]), (c[0], c[2]))
         if sum(e in star_edges for e in sides) >= 2:
@@ -523,7 +533,9 @@ def _resch_folded(m: int, n: int, fold: float):
         _, js = _edge_residual(x, shape_pairs, shape_len)
         return vstack([je, w_shape * js, j_pull]).tocsr()
 
-    sol = least_squares(residual, x0.ravel(), jac=jacobian, method="trf", ftol=1e-8, xtol=1e-8)
+    sol = least_squares(
+        residual, x0.ravel(), jac=jacobian, method="trf", ftol=_FIT_TOL, xtol=_FIT_TOL
+    )
     x = _project_lengths(sol.x, edges, length)
     v = x.reshape(-1, 3)
     v = v - v.mean(axis=0)
@@ -545,11 +557,11 @@ def _project_lengths(x: np.ndarray, edges: np.ndarray, length: np.ndarray) -> np
     """Gauss-Newton with minimal-norm steps onto ``|p_a - p_b| = L`` for every edge."""
     for _ in range(30):
         r, jac = _edge_residual(x, edges, length)
-        if np.abs(r).max() < 1e-15:
+        if np.abs(r).max() < _LENGTH_DONE:
             break
         step, *_ = np.linalg.lstsq(jac.toarray(), r, rcond=None)
         x = x - step
     r, _ = _edge_residual(x, edges, length)
-    if np.abs(r).max() > 1e-12:
+    if np.abs(r).max() > _LENGTH_TOL:
         raise SolverError(f"the folded Resch pattern misses an edge length by {np.abs(r).max():g}")
     return x

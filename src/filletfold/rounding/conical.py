@@ -61,7 +61,7 @@ def vertex_cone_axes(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:
     return axis, residual
 
 
-def is_conical(mesh: PolyMesh, atol: float = 1e-9) -> bool:
+def is_conical(mesh: PolyMesh, atol: float = tol.relative) -> bool:
     """True when every interior vertex is conical (and there is at least one)."""
     _, res = vertex_cone_axes(mesh)
     inner = ~mesh.is_boundary_vertex

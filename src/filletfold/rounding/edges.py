@@ -160,7 +160,9 @@ def radius_limits(mesh: PolyMesh, edge_radius: np.ndarray, half_angle: np.ndarra
             # an unrounded edge (boundary, flat, sharp) keeps a face piece only if its rounded
             # neighbours' tangent lines cross it before its midpoint too, and far enough
             # before it that its line there is no sliver edge of the pattern
-            room = np.where(rounded[e], -1e-12 * length[e], np.minimum(sliver, 0.25 * length[e]))
+            room = np.where(
+                rounded[e], -tol.roundoff * length[e], np.minimum(sliver, 0.25 * length[e])
+            )
             over = (rounded[e] | rounded[g]) & (x_e > 0.5 * length[e] - room)
             broken[e[over & rounded[e]]] = True
             broken[g[over & rounded[g]]] = True
@@ -291,7 +293,9 @@ class EdgeRounding:
         n = np.full(len(self.arc_length), int(samples))
         if step_deg > 0:
             turn = np.degrees(2 * self.half_angle)
-            steps = np.ceil(turn / step_deg - 1e-9)  # an exact multiple of the step gains none
+            steps = np.ceil(
+                turn / step_deg - tol.relative
+            )  # an exact multiple of the step gains none
             n = np.minimum(n, np.maximum(2, steps + 1).astype(int))
         if min_chord > 0:
             fit = np.floor(self.arc_length / min_chord) + 1

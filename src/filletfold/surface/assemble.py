@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..tolerances import tol
 from .faces import flat_faces
 from .pattern import CreasePattern, FaceRows
 from .piece import Piece
@@ -111,5 +112,5 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
     if not len(us):
         return
     dist, k = tree.query(res.apex[us])
-    near = dist < 1e-9 * (1 + np.abs(res.apex[us]).max(axis=1))
+    near = dist < tol.relative * (1 + np.abs(res.apex[us]).max(axis=1))
     res.apex_2d[us[near]] = pattern.vertices_2d[k[near]]

@@ -8,6 +8,7 @@ import shapely
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh
 from ..rounding.edges import EdgeRounding
+from ..tolerances import tol
 
 
 def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
@@ -93,7 +94,7 @@ def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
         t = t / np.linalg.norm(t) * size
         half = shapely.Polygon([a - t, b + t, b + t + nrm, a - t + nrm])
         kernel = kernel.intersection(half)
-    if kernel.is_empty or kernel.area <= 1e-12 * poly.area:
+    if kernel.is_empty or kernel.area <= tol.roundoff * poly.area:
         return None
     c = kernel.centroid
     return np.array([c.x, c.y])

@@ -9,14 +9,14 @@ from ..tolerances import tol
 from .faces import face_polygons, flat_faces
 
 
-def faces_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9) -> bool:
+def faces_overlap(points_2d: np.ndarray, faces, rel: float = tol.relative) -> bool:
     """:meth:`Piece.overlaps` of the polygons ``faces`` (index lists) over ``points_2d`` (k, 2)."""
     if faces_interior_disjoint(points_2d, faces):
         return False
     return measured_overlap(points_2d, faces, rel)
 
 
-def measured_overlap(points_2d: np.ndarray, faces, rel: float = 1e-9, pairs=None) -> bool:
+def measured_overlap(points_2d: np.ndarray, faces, rel: float = tol.relative, pairs=None) -> bool:
     """:func:`faces_overlap` without the proof: a face is not a valid polygon, two faces of
     ``pairs`` share more than ``rel`` of the smaller one, or the union of the faces is smaller
     than the sum of their areas by more than ``rel`` of it.

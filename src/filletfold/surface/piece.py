@@ -10,6 +10,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from ..tolerances import tol
 from .faces import FaceLists, face_polygons, flat_faces, polygon_area2
 from .overlap import faces_overlap
 
@@ -150,7 +151,7 @@ class Piece:
         p3 = np.array(self.points_3d, dtype=float).reshape(-1, 3)
         return p2, p3
 
-    def overlaps(self, rel: float = 1e-9) -> bool:
+    def overlaps(self, rel: float = tol.relative) -> bool:
         """True when faces of the piece overlap in 2D (or one is not a valid polygon).
 
         Overlap means: the union of the faces is smaller than the sum of their areas by more

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
+from ..tolerances import tol
 from .apex import ApexConstraints, ApexSolution
 
 
@@ -94,4 +95,4 @@ def project_slsqp(cons: ApexConstraints, target: np.ndarray, start: np.ndarray) 
         method="SLSQP",
         options={"ftol": 1e-15, "maxiter": 500},
     )
-    return res.x if cons.values(res.x).min() >= -1e-12 * L else start
+    return res.x if cons.values(res.x).min() >= -tol.roundoff * L else start
