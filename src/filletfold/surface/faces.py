@@ -56,7 +56,7 @@ def face_polygons(points_2d: np.ndarray, faces) -> np.ndarray:
 
 
 def polygon_area2(xy: np.ndarray) -> np.ndarray:
-    """Twice the signed area of polygons of one size, summed as :meth:`Piece.face` does.
+    """Twice the signed area of polygons of one size (the shoelace sum, corner by corner).
 
     Parameters
     ----------

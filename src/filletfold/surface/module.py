@@ -41,7 +41,7 @@ from ..parallel import thread_map
 from ..tolerances import tol
 from ..vertex.apex import _stack
 from ..vertex.crease import chart_apex, crease_denominator, crease_height, crease_numerator
-from ..vertex.frame import SideArrays, VertexFrame, _dot, _gluing_maps, stack_sides
+from ..vertex.frame import SideArrays, VertexFrame, dot_rows, gluing_maps, stack_sides
 from .faces import FaceLists, polygon_area2
 from .overlap import faces_interior_disjoint, faces_interior_disjoint_many, run_overlaps
 from .piece import Piece
@@ -422,7 +422,8 @@ class _Chunk:
         fr = self.face_frame[face]
         rel = p - fr[:, 0]
         return apply_rows(
-            self.face_map[face], np.stack([_dot(rel, fr[:, 1]), _dot(rel, fr[:, 2])], axis=1)
+            self.face_map[face],
+            np.stack([dot_rows(rel, fr[:, 1]), dot_rows(rel, fr[:, 2])], axis=1),
         )
 
 
@@ -678,7 +679,7 @@ def _end_copy(chunk: _Chunk, P2, P3, at: np.ndarray, side: np.ndarray, face: np.
     sa = chunk.sides
     s0 = np.zeros(len(side))
     C, z, F = chunk.curves(side, s0)
-    glue = _gluing_maps(sa.tangent(side, s0), sa.R[side], chunk.face_frame[face], C, s0)
+    glue = gluing_maps(sa.tangent(side, s0), sa.R[side], chunk.face_frame[face], C, s0)
     m = chunk.face_map[face] @ glue
     P2[at] = apply_rows(m, np.stack([s0, s0], axis=1))
     P2[at + 1] = apply_rows(m, np.stack([s0, z], axis=1))

@@ -91,11 +91,7 @@ class Piece:
             out.pop()
         if len(out) < 3:
             return
-        area = 0.0
-        for j in range(len(out)):
-            x0, y0 = self.points_2d[out[j - 1]]
-            x1, y1 = self.points_2d[out[j]]
-            area += x0 * y1 - x1 * y0
+        area = polygon_area2(np.array([self.points_2d[i] for i in out], dtype=float)[None])[0]
         if abs(area) <= 2 * min_area:
             return
         if area < 0:

@@ -94,14 +94,14 @@ class Side:
         return self.kappa * (-np.sin(t) * self.N0 + np.cos(t) * self.B)
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise dot products (...,) of vectors (..., 3); the same bits as ``a[k] @ b[k]``."""
+def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products (...,) of vectors (..., 3), each one ``a[k] @ b[k]``."""
     return (a[..., None, :] @ b[..., :, None])[..., 0, 0]
 
 
-def _norm(a: np.ndarray) -> np.ndarray:
-    """Row-wise lengths (...,) of vectors (..., 3); the same bits as ``np.linalg.norm(a[k])``."""
-    return np.sqrt(_dot(a, a))
+def norm_rows(a: np.ndarray) -> np.ndarray:
+    """Row-wise lengths (...,) of vectors (..., 3)."""
+    return np.sqrt(dot_rows(a, a))
 
 
 def _face_axes(mesh: PolyMesh, faces: np.ndarray) -> np.ndarray:
@@ -113,7 +113,7 @@ def _face_axes(mesh: PolyMesh, faces: np.ndarray) -> np.ndarray:
     first = mesh.face_start[faces]
     a = mesh.vertices[mesh.halfedge_from[first]]
     d = mesh.vertices[mesh.halfedge_from[first + 1]] - a
-    e1 = d / _norm(d)[:, None]
+    e1 = d / norm_rows(d)[:, None]
     return np.stack([e1, np.cross(mesh.face_normal[faces], e1)], axis=1)
 
 
@@ -417,7 +417,7 @@ class VertexFrame:
     @staticmethod
     def _gluing(side: Side, frame: np.ndarray, s: float) -> np.ndarray:
         s = np.array([s], dtype=float)
-        return _gluing_maps(side.tangent(s), side.R[None], frame[None], side.base(s), s)[0]
+        return gluing_maps(side.tangent(s), side.R[None], frame[None], side.base(s), s)[0]
 
 
 def developed_apices(rho: np.ndarray, min_det: float = tol.fixed_point) -> np.ndarray:
@@ -451,7 +451,7 @@ def developed_apices(rho: np.ndarray, min_det: float = tol.fixed_point) -> np.nd
     return v
 
 
-def _gluing_maps(
+def gluing_maps(
     tangent: np.ndarray, R: np.ndarray, frames: np.ndarray, C: np.ndarray, s: np.ndarray
 ) -> np.ndarray:
     """Maps from cylinder charts ``(s, z)`` into face charts, where cylinder and face touch.
@@ -475,8 +475,8 @@ def _gluing_maps(
         Rigid maps: ``(s, 0) -> C`` and the chart axes ``(C'(s), R)`` onto the face's.
     """
     axes = frames[:, 1:]
-    lin = np.stack([_dot(axes, tangent[:, None]), _dot(axes, R[:, None])], axis=-1)
-    p = _dot(axes, (C - frames[:, 0])[:, None])
+    lin = np.stack([dot_rows(axes, tangent[:, None]), dot_rows(axes, R[:, None])], axis=-1)
+    p = dot_rows(axes, (C - frames[:, 0])[:, None])
     return rigid(lin, p - lin[..., 0] * s[:, None])
 
 
@@ -488,7 +488,7 @@ def _line_crossings(p1, d1, p2, d2):
     :func:`numpy.linalg.lstsq`).
     """
     delta = p2 - p1
-    c, a, b = _dot(d1, d2), _dot(d1, delta), _dot(d2, delta)
+    c, a, b = dot_rows(d1, d2), dot_rows(d1, delta), dot_rows(d2, delta)
     det = 1.0 - c * c
     parallel = det < tol.parallel
     det = np.where(parallel, 1.0, det)
@@ -654,7 +654,7 @@ def vertex_frames(
     U = mesh.vertices[verts]
     other = mesh.vertices[nbr]
     d = U[sv] - other
-    length = _norm(d)
+    length = norm_rows(d)
     R = d / length[:, None]
     M = 0.5 * (U[sv] + other)
     rounded = closed[sv] | ((sp > 0) & ~tail)
@@ -671,7 +671,7 @@ def vertex_frames(
     # R x N0 it is orthogonal to R and N0 to round-off; orthogonalising N(a) against N0
     # instead loses digits on a nearly flat edge (1e-12 off R at a 0.1 degree bend, and the
     # development's maps stop being rigid by as much)
-    B[c] *= np.sign(_dot(B[c], n_next))[:, None]
+    B[c] *= np.sign(dot_rows(B[c], n_next))[:, None]
     O = M.copy()
     O[c] = rounding.axis_point[edge[c]]
     radius = np.where(curved, rounding.radius[edge], 0.0)
@@ -713,12 +713,12 @@ def vertex_frames(
     s0 = np.zeros(len(rs))
     g_start = np.full((len(sv), 3, 3), np.nan)
     g_end_inv = np.full((len(sv), 3, 3), np.nan)
-    g_start[rs] = _gluing_maps(sa.tangent(rs, s0), R[rs], frames[f_prev[rs]], sa.base(rs, s0), s0)
+    g_start[rs] = gluing_maps(sa.tangent(rs, s0), R[rs], frames[f_prev[rs]], sa.base(rs, s0), s0)
     t_end = sa.tangent(rs, arc[rs])
     unbent = ~curved[rs]  # a side of radius 0 (flat or sharp) meets f_i along its own line
     t_end[unbent] = np.cross(R[rs[unbent]], normals[f_next[rs[unbent]]])
     g_end_inv[rs] = invert(
-        _gluing_maps(t_end, R[rs], frames[f_next[rs]], sa.base(rs, arc[rs]), arc[rs])
+        gluing_maps(t_end, R[rs], frames[f_next[rs]], sa.base(rs, arc[rs]), arc[rs])
     )
     current = np.repeat(np.eye(3)[None], n, axis=0)  # tau = f_{n-1}; f_0 for an open ring
     cyl_map = np.full((len(sv), 3, 3), np.nan)
