@@ -156,13 +156,6 @@ def test_face_lists_from_offsets():
     assert FaceLists(np.zeros(0), np.zeros(1)).lists() == [] and len(FaceLists([], [0])) == 0
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=(TypeError, ValueError),
-    reason="FaceLists.__eq__ compares its lists with list(other): faces held as arrays (as "
-    "FaceRows and CreasePattern hold them) make list equality ambiguous (ValueError), and an "
-    "object that is not a sequence raises TypeError instead of comparing unequal",
-)
 @pytest.mark.parametrize(
     ("other", "equal"),
     [

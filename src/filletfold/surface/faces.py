@@ -34,7 +34,12 @@ class FaceLists(FlatFaces):
         return iter(self.lists())
 
     def __eq__(self, other) -> bool:
-        return self.lists() == list(other)
+        """Equal to any sequence of the same faces (lists, arrays, or flat faces), in order."""
+        try:
+            faces = [[int(i) for i in f] for f in other]
+        except (TypeError, ValueError):
+            return NotImplemented
+        return self.lists() == faces
 
 
 def flat_faces(faces) -> tuple[np.ndarray, np.ndarray]:
