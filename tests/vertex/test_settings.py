@@ -103,14 +103,6 @@ def test_numpy_and_numba_agree_on_real_vertices(monkeypatch):
         np.testing.assert_allclose(s.x, r.x, rtol=0, atol=1e-9 * cons.scale)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="numba's on-disk cache (cache=True) freezes a global read by a compiled function "
-    "at its value when compiled, and is invalidated only when batch_kernel.py changes: after "
-    "an edit of settings.py the kernel keeps the old values while the numpy version reads "
-    "the new ones",
-)
 def test_the_compiled_kernel_reads_no_setting_from_a_cached_global():
     """A setting reaches the numba kernel as an argument (as ``tol``, ``T_CAP`` and
     ``STAT_TOL`` do), or the function reading it is not cached on disk: else editing

@@ -86,6 +86,30 @@ if TYPE_CHECKING:
 #: multiply-add), reciprocals and signed zeros; not the ones that assume no NaN or infinity.
 FAST = {"reassoc", "contract", "arcp", "nsz"}
 
+# Places in the array of :func:`_settings`.
+_MULTIPLIER_START_FLOOR, _GIVE_UP_SLACK, _PRIMAL_WEIGHT_MU, _MERIT_ROUNDOFF = 0, 1, 2, 3
+_ARMIJO, _MULTIPLIER_FLOOR, _HESSIAN_FLOOR = 4, 5, 6
+
+
+def _settings() -> np.ndarray:
+    """The solver settings the compiled functions read, as one array passed to them.
+
+    Not read as globals: numba's disk cache would freeze a global at its value when the
+    kernel was compiled and keep it after an edit of ``settings.py`` (the cache is renewed
+    only when this file changes), while the numpy version reads the new value.
+    """
+    return np.array(
+        [
+            MULTIPLIER_START_FLOOR,
+            GIVE_UP_SLACK,
+            PRIMAL_WEIGHT_MU,
+            MERIT_ROUNDOFF,
+            ARMIJO,
+            MULTIPLIER_FLOOR,
+            HESSIAN_FLOOR,
+        ]
+    )
+
 
 def interior_point_numba(
     rows: RowBlock,
@@ -125,7 +149,7 @@ def interior_point_numba(
         np.ascontiguousarray(y, dtype=f8),
     )
     e, q = np.ascontiguousarray(rows.e, dtype=f8), np.ascontiguousarray(q, dtype=f8)
-    rules = (bool(give_up), int(max_iter), float(tol), float(T_CAP), float(STAT_TOL))
+    rules = (bool(give_up), int(max_iter), float(tol), float(T_CAP), float(STAT_TOL), _settings())
     slack = -1 if stop_slack is None else int(stop_slack)
 
     def run(idx):
@@ -179,7 +203,7 @@ def _parts(groups: np.ndarray, n_threads: int) -> list[np.ndarray]:
 
 @njit(cache=True, nogil=True)
 def _kernel(a, G, al, e, mf, q, c, y0, stop_slack, groups, n_groups, give_up, max_iter, tol,
-            t_cap, stat_tol):  # fmt: skip
+            t_cap, stat_tol, st):  # fmt: skip
     """The iterations of all problems (see the comment above for the parameters)."""
     B, _, R = G.shape
     yl, y_out = y0.copy(), y0.copy()
@@ -191,22 +215,22 @@ def _kernel(a, G, al, e, mf, q, c, y0, stop_slack, groups, n_groups, give_up, ma
     hit = np.zeros(max(n_groups, 1), dtype=np.bool_)
     live = np.arange(B)
     n_live = B
-    _start(live, a, G, al, e, mf, q, c, yl, g, lam, mu, count, stop_slack >= 0)
+    _start(live, a, G, al, e, mf, q, c, yl, g, lam, mu, count, stop_slack >= 0, st)
     for _ in range(max_iter):
         _status(live[:n_live], G, al, e, mf, q, c, yl, g, lam, mu, count, done, reached,
-                gave_up, stop_slack, give_up, tol, t_cap, stat_tol)  # fmt: skip
+                gave_up, stop_slack, give_up, tol, t_cap, stat_tol, st)  # fmt: skip
         n_live = _settle(live, n_live, groups, n_groups, hit, yl, y_out, conv, stuck, done,
                          reached, gave_up)  # fmt: skip
         if n_live == 0:
             return y_out, conv
-        _step(live[:n_live], a, G, al, e, mf, q, c, yl, g, lam, mu, stuck)
+        _step(live[:n_live], a, G, al, e, mf, q, c, yl, g, lam, mu, stuck, st)
     _finish(live[:n_live], yl, y_out, conv)
     return y_out, conv
 
 
 # --------------------------------------------------------------------------- the iteration
 @njit(cache=True, fastmath=FAST)
-def _start(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, count, phase1):
+def _start(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, count, phase1, st):
     """Row values, multipliers and barrier parameter of the problems ``idx`` at their start.
 
     Phase 1: multipliers that balance the objective's gradient, spread over the rows;
@@ -225,6 +249,8 @@ def _start(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, count, phase1):
     mu, count : (B,) float
         Set: barrier parameters and numbers of real rows.
     phase1 : bool
+    st : (k,) float
+        :func:`_settings`.
     """
     _, n, R = G.shape
     for b in idx:
@@ -235,7 +261,7 @@ def _start(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, count, phase1):
         scale = 0.0
         for k in range(n):
             scale = max(scale, abs(yl[b, k] * q[k] + c[b, k]))
-        scale = max(MULTIPLIER_START_FLOOR, scale)
+        scale = max(st[_MULTIPLIER_START_FLOOR], scale)
         comp = 0.0
         for j in range(R):
             lam[b, j] = mf[b, j] * (scale / cnt) if phase1 else mf[b, j] * scale / g[b, j]
@@ -246,7 +272,7 @@ def _start(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, count, phase1):
 
 @njit(cache=True, fastmath=FAST)
 def _status(idx, G, al, e, mf, q, c, yl, g, lam, mu, count, done, reached, gave_up,
-            stop_slack, give_up, tol, t_cap, stat_tol):  # fmt: skip
+            stop_slack, give_up, tol, t_cap, stat_tol, st):  # fmt: skip
     """Stationarity, complementarity and the stopping tests of the problems ``idx``; lowers
     the barrier parameter of those near their central-path point.
 
@@ -290,7 +316,7 @@ def _status(idx, G, al, e, mf, q, c, yl, g, lam, mu, count, done, reached, gave_
         if stop_slack >= 0:
             t = yl[b, stop_slack]
             reached[b] = t >= 0.5 * t_cap or (t > 0 and comp <= t)
-            gave_up[b] = give_up and t + comp < -GIVE_UP_SLACK
+            gave_up[b] = give_up and t + comp < -st[_GIVE_UP_SLACK]
 
 
 @njit(cache=True)
@@ -345,7 +371,7 @@ def _finish(idx, yl, y_out, conv):
 
 
 @njit(cache=True, fastmath=FAST)
-def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
+def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck, st):
     """One primal-dual Newton step of each problem of ``idx``, with the line search of the
     numpy version; updates ``yl``, ``g``, ``lam`` and sets ``stuck`` where no step is
     possible.
@@ -363,7 +389,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
     H, W = np.empty((n, n)), np.empty((n, n))
     for b in idx:
         m = mu[b]
-        primal = m > PRIMAL_WEIGHT_MU
+        primal = m > st[_PRIMAL_WEIGHT_MU]
         # Newton matrix and right-hand side
         s_waal = 0.0  # sum w alpha^2
         s_lal = 0.0  # sum lambda_h alpha
@@ -400,7 +426,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
             H[k, k] += q[k] - 2 * s_lal * e[k]
             rhs[k] = -(yl[b, k] * q[k] + c[b, k]) + rhs[k] + 2 * s_val * ey[k]
         # the reverse-convex rows make H indefinite at times: shift it to positive definite
-        _shift_or_reset(H, rhs, W)
+        _shift_or_reset(H, rhs, W, st[_HESSIAN_FLOOR])
         _solve(H, rhs, dy, W)
         # directional derivatives, multiplier step, merit at the current point
         p = 0.0
@@ -423,7 +449,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
             dlam[j] = dl
             ratio = min(ratio, lj / -dl if dl < 0 else math.inf)
         step = min(1.0, 0.995 * ratio)
-        tiny = MERIT_ROUNDOFF * max(1.0, abs(merit0))
+        tiny = st[_MERIT_ROUNDOFF] * max(1.0, abs(merit0))
         found = False
         for _ in range(40):
             quad = 2 * step * p + step * step * qq
@@ -437,7 +463,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
                     yt[k] = yl[b, k] + step * dy[k]
                     mt += 0.5 * (yt[k] * q[k] * yt[k]) + c[b, k] * yt[k]
                 mt -= m * _sum_log(gt)
-                if mt <= merit0 + ARMIJO * step * slope + tiny:
+                if mt <= merit0 + st[_ARMIJO] * step * slope + tiny:
                     found = True
                     break
             step *= 0.5
@@ -459,7 +485,7 @@ def _step(idx, a, G, al, e, mf, q, c, yl, g, lam, mu, stuck):
             for j in range(R):
                 g[b, j] = gt[j]
         for j in range(R):
-            lam[b, j] = max(lam[b, j] + step * dlam[j], MULTIPLIER_FLOOR * mf[b, j])
+            lam[b, j] = max(lam[b, j] + step * dlam[j], st[_MULTIPLIER_FLOOR] * mf[b, j])
 
 
 # --------------------------------------------------------------------------- row helpers
@@ -518,9 +544,9 @@ def _sum_log(x):
 
 # --------------------------------------------------------------------------- small matrices
 @njit(cache=True)
-def _shift_or_reset(H, rhs, W):
+def _shift_or_reset(H, rhs, W, hessian_floor):
     """Shift ``H`` ((n, n) symmetric) to positive definite, its smallest eigenvalue at least
-    ``1e-8`` times its largest diagonal entry (or 1); a non-finite system becomes
+    ``hessian_floor`` times its largest diagonal entry (or 1); a non-finite system becomes
     ``I x = 0``. ``W`` is scratch."""
     n = H.shape[0]
     finite = True
@@ -537,7 +563,7 @@ def _shift_or_reset(H, rhs, W):
     floor = 0.0
     for k in range(n):
         floor = max(floor, abs(H[k, k]))
-    floor = HESSIAN_FLOOR * max(1.0, floor)
+    floor = hessian_floor * max(1.0, floor)
     if _positive_definite(H, floor, W):  # the usual case: no shift, no eigenvalue needed
         return
     shift = max(floor - _smallest_eigenvalue(H, W), 0.0)
