@@ -72,9 +72,13 @@ def test_version_loads_no_heavy_library():
 
 
 def test_the_pipeline_loads_no_optional_or_export_library():
-    """Rounding needs scipy and shapely; the cut files, the reader of files and the solver's
-    kernel load theirs when used."""
-    code = "import filletfold; filletfold.round_mesh; import filletfold.export.outputs"
+    """Rounding needs scipy and shapely; scipy.optimize (material loss, SLSQP, some
+    tessellations), the cut files, the mesh reader and the solver's kernel load theirs when
+    used."""
+    code = (
+        "import sys, filletfold; filletfold.round_mesh; import filletfold.export.outputs\n"
+        "assert 'scipy.optimize' not in sys.modules, 'scipy.optimize: import it where used'"
+    )
     assert set(loaded_after(code)) <= {"scipy", "shapely"}
 
 
