@@ -12,7 +12,11 @@ the interpreter's own start-up) and the median less the baseline (what filletfol
 the heavy libraries the command loaded (none is the aim: they are imported where they are
 used). ``--also CODE`` adds a ``python -c CODE`` row (``--also "import numpy"``, say).
 ``--python`` and ``--filletfold`` time another install (default: this interpreter and the
-``filletfold`` script beside it). Prints the machine and the command first.
+``filletfold`` script beside it). The children inherit the environment; with
+``PYTHONDONTWRITEBYTECODE`` set no ``__pycache__`` is written, so filletfold's own modules
+(an editable install) are compiled on every start: ``--bytecode`` unsets it for the children
+(the warm-up writes the ``.pyc`` files, as an installed package has them). Prints the machine,
+the command and the bytecode state first.
 """
 
 from __future__ import annotations
@@ -47,7 +51,7 @@ def default_filletfold(python: str) -> list[str]:
     return [script] if os.path.isfile(script) else [python, "-m", "filletfold.cli"]
 
 
-def heavy_loaded(python: str, code: str | None, argv: list[str] | None = None) -> str:
+def heavy_loaded(python: str, code: str | None, argv: list[str] | None, env: dict) -> str:
     """The heavy libraries loaded after ``python -c code`` (or the CLI run with ``argv``)."""
     probe = _PROBE % (HEAVY,)
     if code is not None:
@@ -58,14 +62,16 @@ def heavy_loaded(python: str, code: str | None, argv: list[str] | None = None) -
             f"sys.argv = ['filletfold', *{argv!r}]\ntry:\n    main()\nfinally:\n"
             f"    {probe}"
         )
-    out = subprocess.run([python, "-c", prog], capture_output=True, text=True, cwd=ROOT)
+    out = subprocess.run([python, "-c", prog], capture_output=True, text=True, cwd=ROOT, env=env)
     found = [line[6:] for line in out.stdout.splitlines() if line.startswith("heavy:")]
     return (found[-1] or "none") if found else f"? (exit {out.returncode})"
 
 
-def run_once(cmd: list[str]) -> float:
+def run_once(cmd: list[str], env: dict) -> float:
     t = time.perf_counter()
-    subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True, cwd=ROOT)
+    subprocess.run(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True, cwd=ROOT, env=env
+    )
     return time.perf_counter() - t
 
 
@@ -79,7 +85,20 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--also", action="append", default=[], metavar="CODE", help="also time python -c CODE"
     )
+    ap.add_argument(
+        "--bytecode",
+        action="store_true",
+        help="unset PYTHONDONTWRITEBYTECODE in the children (time with .pyc files)",
+    )
     args = ap.parse_args(argv)
+    env = dict(os.environ)
+    if args.bytecode:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+    bytecode = (
+        "not written (PYTHONDONTWRITEBYTECODE set: modules without .pyc compiled every start)"
+        if env.get("PYTHONDONTWRITEBYTECODE")
+        else "written and reused (.pyc)"
+    )
     py = args.python
     ff = [args.filletfold] if args.filletfold else default_filletfold(py)
     cases = {
@@ -94,18 +113,18 @@ def main(argv=None) -> int:
 
     print(f"# machine: {machine()}")
     print(f"# command: {shlex.join([os.path.basename(sys.executable), *sys.argv])}")
-    print(f"# timed: {py} and {shlex.join(ff)}")
+    print(f"# timed: {py} and {shlex.join(ff)}; bytecode {bytecode}")
     print(
         f"# wall time from start to exit of a fresh process, {args.repeat} runs each (taking "
         "turns) after a warm-up; baseline = python -c pass; heavy = which of "
         f"{', '.join(HEAVY)} were loaded"
     )
     for cmd, _ in cases.values():
-        run_once(cmd)
+        run_once(cmd, env)
     times: dict[str, list[float]] = {name: [] for name in cases}
     for _ in range(args.repeat):
         for name, (cmd, _) in cases.items():
-            times[name].append(run_once(cmd))
+            times[name].append(run_once(cmd, env))
     base = statistics.median(times["python -c pass"])
     print(
         f"{'command':28s} {'median s':>9s} {'min s':>7s} {'ratio':>6s} {'added s':>8s} "
@@ -115,7 +134,7 @@ def main(argv=None) -> int:
         med = statistics.median(times[name])
         budget = BUDGETS.get(name)
         mark = "" if budget is None else f"{budget:.1f} {'ok' if med <= budget else 'over'}"
-        heavy = heavy_loaded(py, code, None if code is not None else ["--help"])
+        heavy = heavy_loaded(py, code, None if code is not None else ["--help"], env)
         print(
             f"{name:28s} {med:9.3f} {min(times[name]):7.3f} {med / base:6.1f} "
             f"{med - base:8.3f} {mark:>7s}  {heavy}"
