@@ -8,9 +8,10 @@ within 0.3 s. Each command runs ``--repeat`` times (default 7) in a fresh child 
 commands taking turns (so a burst of load on a shared machine hits all of them alike), after
 one untimed warm-up run each (the file cache). Printed per command: the median wall time from
 start to exit, the fastest run, the ratio of the median to the baseline's (``python -c pass``:
-the interpreter's own start-up) and the median less the baseline (what filletfold adds); then
-the heavy libraries the command loaded (none is the aim: they are imported where they are
-used). ``--also CODE`` adds a ``python -c CODE`` row (``--also "import numpy"``, say).
+the interpreter's own start-up), the median less the baseline (what filletfold adds), the
+median CPU time (user + system: on a shared machine less swayed by other jobs); then the heavy
+libraries the command loaded (none is the aim: they are imported where they are used).
+``--also CODE`` adds a ``python -c CODE`` row (``--also "import numpy"``, say).
 ``--python`` and ``--filletfold`` time another install (default: this interpreter and the
 ``filletfold`` script beside it). The children inherit the environment; with
 ``PYTHONDONTWRITEBYTECODE`` set no ``__pycache__`` is written, so filletfold's own modules
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shlex
 import statistics
 import subprocess
@@ -67,12 +69,16 @@ def heavy_loaded(python: str, code: str | None, argv: list[str] | None, env: dic
     return (found[-1] or "none") if found else f"? (exit {out.returncode})"
 
 
-def run_once(cmd: list[str], env: dict) -> float:
+def run_once(cmd: list[str], env: dict) -> tuple[float, float]:
+    """Wall time and CPU time (user + system) of one run of ``cmd``."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     subprocess.run(
         cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True, cwd=ROOT, env=env
     )
-    return time.perf_counter() - t
+    wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def main(argv=None) -> int:
@@ -116,28 +122,30 @@ def main(argv=None) -> int:
     print(f"# timed: {py} and {shlex.join(ff)}; bytecode {bytecode}")
     print(
         f"# wall time from start to exit of a fresh process, {args.repeat} runs each (taking "
-        "turns) after a warm-up; baseline = python -c pass; heavy = which of "
+        "turns) after a warm-up; baseline = python -c pass; cpu = user + system; heavy = which of "
         f"{', '.join(HEAVY)} were loaded"
     )
     for cmd, _ in cases.values():
         run_once(cmd, env)
-    times: dict[str, list[float]] = {name: [] for name in cases}
+    times: dict[str, list[tuple[float, float]]] = {name: [] for name in cases}
     for _ in range(args.repeat):
         for name, (cmd, _) in cases.items():
             times[name].append(run_once(cmd, env))
-    base = statistics.median(times["python -c pass"])
+    base = statistics.median(w for w, _ in times["python -c pass"])
     print(
         f"{'command':28s} {'median s':>9s} {'min s':>7s} {'ratio':>6s} {'added s':>8s} "
-        f"{'budget':>7s}  heavy"
+        f"{'cpu s':>6s} {'budget':>7s}  heavy"
     )
     for name, (_, code) in cases.items():
-        med = statistics.median(times[name])
+        walls = [w for w, _ in times[name]]
+        med = statistics.median(walls)
+        cpu = statistics.median(c for _, c in times[name])
         budget = BUDGETS.get(name)
         mark = "" if budget is None else f"{budget:.1f} {'ok' if med <= budget else 'over'}"
         heavy = heavy_loaded(py, code, None if code is not None else ["--help"], env)
         print(
-            f"{name:28s} {med:9.3f} {min(times[name]):7.3f} {med / base:6.1f} "
-            f"{med - base:8.3f} {mark:>7s}  {heavy}"
+            f"{name:28s} {med:9.3f} {min(walls):7.3f} {med / base:6.1f} "
+            f"{med - base:8.3f} {cpu:6.3f} {mark:>7s}  {heavy}"
         )
     return 0
 
