@@ -10,9 +10,13 @@ angles) that fold into it.
 12
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
 __version__ = "0.1.0"
 
-from .design import Design, Parameters, round_mesh
 from .errors import (
     ExportError,
     FilletfoldError,
@@ -21,8 +25,23 @@ from .errors import (
     ParameterError,
     SolverError,
 )
-from .mesh import PolyMesh, example_names, load_mesh
-from .surface.pattern import CreasePattern
+
+if TYPE_CHECKING:
+    from .design import Design, Parameters, round_mesh
+    from .mesh import PolyMesh, example_names, load_mesh
+    from .surface.pattern import CreasePattern
+
+# The rest of the API is imported on first use (PEP 562), so that ``import filletfold`` and
+# the command line's start stay fast: these modules load numpy, scipy and shapely.
+_LAZY = {
+    "CreasePattern": ".surface.pattern",
+    "Design": ".design",
+    "Parameters": ".design",
+    "PolyMesh": ".mesh",
+    "example_names": ".mesh",
+    "load_mesh": ".mesh",
+    "round_mesh": ".design",
+}
 
 __all__ = [
     "CreasePattern",
@@ -40,3 +59,24 @@ __all__ = [
     "load_mesh",
     "round_mesh",
 ]
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is not None:
+        value = getattr(importlib.import_module(module, __name__), name)
+    elif not name.startswith("_"):  # a subpackage, as ``filletfold.mesh`` was once imported
+        try:
+            value = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -31,11 +31,9 @@ from typing import Annotated
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.table import Table
 
 from . import __version__
-from .design import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES, round_mesh
+from .defaults import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES
 from .errors import FilletfoldError, InternalError, one_line
 from .tolerances import tol
 
@@ -72,6 +70,8 @@ def _root(
 @app.command()
 def examples():
     """List the built-in example meshes (use a name wherever a mesh file is expected)."""
+    from rich.table import Table
+
     from .mesh import EXAMPLES, example_mesh
 
     table = Table("name", "vertices", "faces", "kind", "description")
@@ -270,6 +270,9 @@ def round_cmd(
     pattern.png and preview.png. Every file but timings.json has the same bytes for the same
     input and options.
     """
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from .design import round_mesh
     from .export.cutfiles import DEFAULT_FORMATS, parse_formats
     from .export.outputs import export_design
 

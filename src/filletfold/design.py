@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .defaults import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES
 from .errors import (
     FilletfoldError,
     InternalError,
@@ -40,11 +41,6 @@ from .surface.pattern import CreasePattern
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
-
-DEFAULT_RADIUS = "10%"
-DEFAULT_DEPTH = "30%"
-DEFAULT_SAMPLES = 24
-DEFAULT_ARC_STEP = 1.5  # degrees: see round_mesh(arc_step=...)
 
 
 def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:

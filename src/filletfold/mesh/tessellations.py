@@ -23,7 +23,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import least_squares
 from scipy.sparse import coo_matrix, identity, vstack
 from scipy.spatial import cKDTree
 
@@ -492,6 +491,8 @@ def _resch_star_heights(depth: float) -> tuple[float, float]:
 
 @lru_cache(maxsize=16)
 def _resch_folded(m: int, n: int, fold: float):
+    from scipy.optimize import least_squares  # 0.1-0.3 s to import: only here
+
     flat2, faces, centres, rings, tucked = _resch_flat(m, n)
     flat = np.column_stack([flat2, np.zeros(len(flat2))])
     edges = _edges_of(faces)

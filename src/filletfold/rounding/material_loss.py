@@ -34,7 +34,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from scipy.optimize import linprog
 from scipy.sparse.linalg import lsqr
 
 from ..errors import ParameterError
@@ -181,6 +180,8 @@ def solve_material_loss(
     -------
     MaterialLoss
     """
+    from scipy.optimize import linprog  # 0.1-0.3 s to import: only with material loss
+
     if not 0 < share < 1:
         raise ParameterError(f"share must be in (0, 1), got {share!r}", name="share")
     if max_loss is not None and not (np.isfinite(max_loss) and max_loss > 0):

@@ -32,7 +32,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import nnls
 
 from ..errors import FilletfoldError
 from .apex import ApexConstraints, ApexSolution
@@ -563,6 +562,8 @@ def kkt_point(cons: ApexConstraints, target: np.ndarray, x: np.ndarray) -> bool:
     cons : ApexConstraints
     target, x : (n,) float
     """
+    from scipy.optimize import nnls  # 0.1-0.3 s to import: only when needed
+
     L = cons.scale
     grad = 2 * (x - target) / L
     size = np.linalg.norm(grad)

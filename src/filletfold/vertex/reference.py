@@ -9,7 +9,6 @@ converge on. :func:`solve_apex_slsqp` is the independent reference that tests an
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize
 
 from ..tolerances import tol
 from .apex import ApexConstraints, ApexSolution
@@ -17,6 +16,8 @@ from .apex import ApexConstraints, ApexSolution
 
 def _max_slack(cons: ApexConstraints, x_init: np.ndarray) -> tuple[np.ndarray, float]:
     """Maximise the smallest constraint value from ``x_init``; return the point and value."""
+    from scipy.optimize import minimize  # 0.1-0.3 s to import: only when needed
+
     L = cons.scale
     n = cons.n_vars
     g = cons.values(x_init)
@@ -86,6 +87,8 @@ def project_slsqp(cons: ApexConstraints, target: np.ndarray, start: np.ndarray) 
 
     Returns the point, or ``start`` when SLSQP ends on an infeasible one.
     """
+    from scipy.optimize import minimize  # 0.1-0.3 s to import: only when needed
+
     L = cons.scale
     res = minimize(
         lambda x: ((x - target) @ (x - target)) / L**2,

@@ -1,0 +1,8 @@
+"""Default parameters of a design, shared by :func:`~filletfold.round_mesh`, the command line
+and the app (a module of its own, so that ``filletfold --help`` shows them without loading the
+pipeline)."""
+
+DEFAULT_RADIUS = "10%"
+DEFAULT_DEPTH = "30%"
+DEFAULT_SAMPLES = 24
+DEFAULT_ARC_STEP = 1.5  # degrees: see round_mesh(arc_step=...)
