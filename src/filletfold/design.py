@@ -291,29 +291,16 @@ class Design:
 
         return design_summary(self)
 
-    def export(
-        self,
-        folder,
-        *,
-        title: str | None = None,
-        formats="fold,json,obj,svg",
-        units: str = "",
-        scale: float | None = None,
-        page: str = "A4",
-    ) -> list[Path]:
-        """Write the design's files into ``folder`` atomically (all of them or none).
+    def export(self, folder, **options) -> list[Path]:
+        """Write the design's files into ``folder`` atomically (all of them or none):
+        :func:`~filletfold.export.outputs.export_design` of this design.
 
         Parameters
         ----------
         folder : str or Path
-        title : str, optional
-        formats : sequence of str or str
-            Any of ``fold`` (design.fold), ``json`` (report.json and timings.json), ``obj``
-            (folded.obj),
-            ``svg`` (pattern.svg), ``dxf`` (pattern.dxf), ``pdf`` (pattern.pdf), ``png``
-            (pattern.png and preview.png), or ``"all"``.
-        units, scale, page : str, float, str
-            Drawing units and pattern-units-to-drawing scale of the cut files; PDF page size.
+        **options
+            ``title``, ``formats``, ``units``, ``scale``, ``page``: those of
+            :func:`~filletfold.export.outputs.export_design` (the same defaults).
 
         Returns
         -------
@@ -322,9 +309,7 @@ class Design:
         """
         from .export.outputs import export_design
 
-        return export_design(
-            self, folder, title=title, formats=formats, units=units, scale=scale, page=page
-        )
+        return export_design(self, folder, **options)
 
 
 def _resolve_depth(depth, reference: float, n: int) -> np.ndarray:
