@@ -1,0 +1,34 @@
+"""The one set of default parameters: the API, the command line and the app read it."""
+
+import inspect
+
+import typer.main
+
+from filletfold import defaults
+from filletfold.app.session import AppSession
+from filletfold.cli import app
+from filletfold.design import round_mesh
+
+NAMES = {"radius": "DEFAULT_RADIUS", "depth": "DEFAULT_DEPTH", "samples": "DEFAULT_SAMPLES",
+         "arc_step": "DEFAULT_ARC_STEP"}  # fmt: skip
+
+
+def test_round_mesh_and_the_app_default_to_the_shared_values():
+    for fn in (round_mesh, AppSession.__init__):
+        params = inspect.signature(inspect.unwrap(fn)).parameters
+        for name, const in NAMES.items():
+            assert params[name].default == getattr(defaults, const), (fn, name)
+
+
+def test_the_round_command_defaults_to_the_shared_values():
+    command = typer.main.get_command(app)
+    options = {p.name: p for p in command.commands["round"].params}
+    for name, const in NAMES.items():
+        assert options[name].default == getattr(defaults, const), name
+
+
+def test_the_defaults_are_valid_parameters():
+    assert defaults.DEFAULT_RADIUS.endswith("%") and float(defaults.DEFAULT_RADIUS[:-1]) > 0
+    assert defaults.DEFAULT_DEPTH.endswith("%") and float(defaults.DEFAULT_DEPTH[:-1]) > 0
+    assert isinstance(defaults.DEFAULT_SAMPLES, int) and defaults.DEFAULT_SAMPLES >= 3
+    assert 0 < defaults.DEFAULT_ARC_STEP < 90
