@@ -16,6 +16,7 @@ import platform
 import statistics
 import sys
 import time
+from importlib import metadata
 
 import numpy as np
 
@@ -34,9 +35,13 @@ def machine() -> str:
                     break
     except OSError:
         pass
+    try:
+        numba = f"numba {metadata.version('numba')}"
+    except metadata.PackageNotFoundError:
+        numba = "no numba"
     return (
         f"{platform.system()} {platform.machine()}, {os.cpu_count()} cores, {cpu}; "
-        f"Python {platform.python_version()}, numpy {np.__version__}, "
+        f"Python {platform.python_version()}, numpy {np.__version__}, {numba}, "
         f"filletfold {filletfold.__version__}"
     )
 
