@@ -360,7 +360,7 @@ def main(argv=None) -> int:
             ap.error(f"unknown method {m!r}; choose from {', '.join(METHODS)}")
 
     if "batched-numba" in methods and importlib.util.find_spec("numba") is None:
-        print("# batched-numba skipped: numba is not installed (pip install -e .[fast])")
+        print("# batched-numba skipped: numba is missing (a dependency: pip install -e .)")
         methods.remove("batched-numba")
     print(f"# machine: {machine()}")
     print(f"# command: {' '.join([os.path.basename(sys.executable), *sys.argv])}")

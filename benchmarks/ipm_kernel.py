@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/ipm_kernel.py [--repeat N] [--no-compile] [--pipeline]
                                               [cases...]
 
-Needs numba (``pip install -e .[fast]``). Per case, the apex problems of the pipeline's first
+Needs numba (a dependency). Per case, the apex problems of the pipeline's first
 attempt (radius 10 %, depth 30 %, 9 samples per arc, the margin; set up as in
 ``round_mesh`` by :func:`filletfold.vertex.solve.apex_problems`) go through
 ``solve_apex_batch`` (``thorough`` as in the pipeline's first round: off, so an infeasible
