@@ -67,6 +67,27 @@ def test_measures_of_a_closed_convex_solid(name):
     assert (2 * np.pi - m.vertex_angle_sum).sum() == pytest.approx(4 * np.pi)
 
 
+@pytest.mark.parametrize("seed", range(5))
+def test_sliver_normals_far_from_the_origin_are_their_planes(seed):
+    # Newell's sum about the origin cancels |p|^2 large terms down to twice the area: a sliver
+    # of the ant scan (edges 0.18, 0.18, 0.005 at |p| = 16) got a normal 2e-11 rad off its own
+    # plane, which made the development's gluing maps shrink lengths (the contraction check)
+    rng = np.random.default_rng(seed)
+    k = 200
+    a = rng.uniform(-20.0, 20.0, (k, 3))
+    d = rng.normal(size=(k, 3))
+    d *= (0.18 / np.linalg.norm(d, axis=1))[:, None]
+    w = np.cross(d, rng.normal(size=(k, 3)))
+    w *= (0.005 / np.linalg.norm(w, axis=1))[:, None]
+    b, c = a + d, a + 0.5 * d + w
+    m = PolyMesh(np.concatenate([a, b, c]), np.arange(3 * k).reshape(3, k).T.copy())
+    exact = np.cross(b - a, c - a)
+    np.testing.assert_allclose(m.face_area, 0.5 * np.linalg.norm(exact, axis=1), rtol=1e-12)
+    for p, q in [(a, b), (b, c), (c, a)]:
+        # every edge is in the face's plane to round-off of its own length (was 1e-11)
+        assert np.abs(np.einsum("ij,ij->i", m.face_normal, q - p)).max() < 1e-15
+
+
 def test_faces_used_twice_in_one_direction_are_named():
     v = np.eye(3)
     with pytest.raises(MeshError, match=r"edge \(0, 1\) is used twice"):

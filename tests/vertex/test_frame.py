@@ -409,3 +409,38 @@ def test_random_convex_polyhedra(seed, share):
     limit = round_edges(m, 1e-6 * m.mean_edge_length).uniform_limit
     rd = round_edges(m, share * limit)
     check_mesh(m, rd)
+
+
+# vertex 1377 of pyvista's ant, Loop-subdivided once (corpus2): a ring of six triangles at
+# |U| = 19 with a sliver (edges 0.18, 0.18, 0.0048), the centre vertex 4
+ANT_RING = np.array(
+    [
+        [-15.666474015737453, -9.186267662506397, -7.37952590531504],
+        [-15.41260411693401, -8.942165355341332, -7.382787227610319],
+        [-15.366250038146973, -8.856375217437744, -7.255250096321106],
+        [-14.99500024318695, -8.48912525177002, -7.25837504863739],
+        [-15.65375006198883, -9.262125253677368, -7.387375056743622],
+        [-15.778749823570251, -9.37850022315979, -7.440249979496002],
+        [-15.775000095367432, -9.381250262260437, -7.441499948501587],
+    ]
+)
+ANT_FACES = [[2, 0, 4], [3, 4, 1], [2, 4, 3], [1, 4, 6], [4, 0, 5], [4, 5, 6]]
+
+
+def test_gluing_maps_are_rigid_on_a_sliver_far_from_the_origin():
+    # The face normals (Newell's sum) were taken about the origin and came out 2e-11 rad off
+    # the sliver's plane; the face charts' axes then missed the tangent lines by as much, the
+    # maps into the common frame were 2e-11 from orthogonal and the folded pattern edges of
+    # this vertex came out 2.8e-12 longer than flat (the certificate's contraction check)
+    m = PolyMesh(ANT_RING, ANT_FACES)
+    rd = round_edges(m, 0.5 * round_edges(m, 1e-6 * m.mean_edge_length).uniform_limit)
+    frame = vertex_frame(m, rd, 4)
+    assert frame.ring.closed
+    for f, axes in zip(frame.ring.faces, frame.face_frames, strict=True):
+        assert np.abs(axes[1:] @ m.face_normal[f]).max() < 1e-15
+    maps = frame.cyl_maps[frame.rounded]
+    lin = maps[:, :2, :2]
+    off = np.abs(lin.transpose(0, 2, 1) @ lin - np.eye(2)).max()
+    assert off < 1e-14  # was 2e-11
+    rho = frame.rho[:2, :2]
+    assert np.abs(rho.T @ rho - np.eye(2)).max() < 1e-14
