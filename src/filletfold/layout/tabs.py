@@ -57,18 +57,21 @@ def _rownorm(a: np.ndarray) -> np.ndarray:
 def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     """(k, 2) int: pairs of pattern edges that are the two sides of one cut.
 
-    Border edges are matched by their rounded folded end points; a pair is the two edges of a
-    segment held by exactly two of them, the lower index first, the pairs in the order of
-    their first edge.
+    Border edges are matched by their rounded folded end points (as
+    :meth:`CreasePattern.cut_mask` matches them); a pair is the two edges of a segment held
+    by exactly two of them, the lower index first, the pairs in the order of their first edge.
     """
-    cut = np.flatnonzero(p.cut_mask(decimals))
+    cut = np.flatnonzero(p.edge_assignment == "B")
     ends = np.round(p.vertices_3d[p.edges[cut]], decimals) + 0.0  # (k, 2, 3), no -0.0
-    keep = np.isfinite(ends).all(axis=(1, 2))  # NaN is equal to nothing: never paired
+    keep = ~np.isnan(ends).reshape(len(cut), -1).any(axis=1)  # NaN is equal to nothing
     cut, ends = cut[keep], ends[keep]
     if len(cut) == 0:
         return np.zeros((0, 2), dtype=np.int64)
-    points = np.ascontiguousarray(ends.reshape(-1, 3)).view(np.dtype((np.void, 24))).ravel()
-    _, point = np.unique(points, return_inverse=True)
+    bits = np.ascontiguousarray(ends.reshape(-1, 3)).view(np.int64)  # equal values, equal bits
+    order = np.lexsort(bits.T[::-1])
+    step = np.r_[True, (bits[order][1:] != bits[order][:-1]).any(axis=1)]
+    point = np.empty(len(bits), dtype=np.int64)
+    point[order] = np.cumsum(step) - 1
     point = point.reshape(-1, 2)
     key = point.min(axis=1) * (int(point.max()) + 1) + point.max(axis=1)
     order = np.lexsort((cut, key))  # by segment, then by edge
@@ -176,16 +179,14 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
     norm = _rownorm(d)
     with np.errstate(invalid="ignore", divide="ignore"):
         axis = np.where((norm > 0)[:, None], d / norm[:, None], [1.0, 0.0])
-    run = np.repeat(np.arange(n), 2 * np.diff(start))
-    t = np.empty(len(pts))
     count = 2 * np.diff(start)
-    for k in np.unique(count).tolist():  # the bits of `points @ axis`, run by run (BLAS gemv)
+    lo, hi = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    for k in np.unique(count).tolist():  # runs of k points together
         runs = np.flatnonzero(count == k)
-        at_k = (at[runs][:, None] + np.arange(k)).ravel()
-        t[at_k] = np.matmul(pts[at_k].reshape(-1, k, 2), axis[runs][:, :, None]).ravel()
-    # the first point of the smallest and of the largest t in each run
-    lo = np.lexsort((np.arange(len(t)), t, run))[at]
-    hi = np.lexsort((np.arange(len(t)), -t, run))[at]
+        at_k = at[runs][:, None] + np.arange(k)
+        # the bits of `points @ axis` (a BLAS gemv), and np.argmin's first of the smallest
+        t = np.matmul(pts[at_k], axis[runs][:, :, None])[..., 0]
+        lo[runs], hi[runs] = at_k[:, 0] + t.argmin(axis=1), at_k[:, 0] + t.argmax(axis=1)
     ends = np.stack([pts[lo], pts[hi]], axis=1)
     flat, fstart = face_arrays(p.faces)
     face = p.edge_faces[edges[start[:-1]]].max(axis=1)
@@ -258,10 +259,19 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _side_normals(poly: np.ndarray) -> np.ndarray:
     """Unit normals (n, k, 2) of the sides of polygons (n, k, 2), to the left of each side
     (NaN for a side of no length)."""
-    edge = np.roll(poly, -1, axis=1) - poly
-    u = np.stack([-edge[..., 1], edge[..., 0]], axis=-1)
+    edge = _next(poly) - poly
+    u = np.empty_like(edge)
+    u[..., 0], u[..., 1] = -edge[..., 1], edge[..., 0]
     with np.errstate(invalid="ignore", divide="ignore"):
-        return u / np.sqrt(u[..., 0] ** 2 + u[..., 1] ** 2)[..., None]
+        u /= np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)[..., None]
+    return u
+
+
+def _next(poly: np.ndarray) -> np.ndarray:
+    """``np.roll(poly, -1, axis=1)``, faster: the corner after each corner of polygons."""
+    out = np.empty_like(poly)
+    out[:, :-1], out[:, -1] = poly[:, 1:], poly[:, 0]
+    return out
 
 
 def inward_lines(quads: np.ndarray):
@@ -280,17 +290,21 @@ def inward_lines(quads: np.ndarray):
         A point ``x`` is inside side ``j`` of polygon ``i`` where
         ``normal[i, j] @ x >= offset[i, j]``.
     """
-    area2 = np.sum(_cross(quads, np.roll(quads, -1, axis=1)), axis=1)
-    normal = _side_normals(quads) * np.where(area2 >= 0, 1.0, -1.0)[:, None, None]
-    return normal, np.sum(normal * quads, axis=-1)
+    area2 = _cross(quads, _next(quads)).sum(axis=1)
+    normal = _side_normals(quads)
+    normal[~(area2 >= 0)] *= -1
+    return normal, normal[..., 0] * quads[..., 0] + normal[..., 1] * quads[..., 1]
 
 
-def shrink_convex(quads: np.ndarray, by) -> np.ndarray:
-    """Convex polygons (n, k, 2) with every side moved inwards by ``by`` (corners mitred)."""
-    normal, _ = inward_lines(quads)
+def shrink_convex(quads: np.ndarray, by, normal: np.ndarray | None = None) -> np.ndarray:
+    """Convex polygons (n, k, 2) with every side moved inwards by ``by`` (corners mitred);
+    ``normal``: their unit inward normals, if known (:func:`inward_lines`)."""
+    if normal is None:
+        normal, _ = inward_lines(quads)
     prev = np.roll(normal, 1, axis=1)  # the side before each corner
+    dot = prev[..., 0] * normal[..., 0] + prev[..., 1] * normal[..., 1]
     with np.errstate(invalid="ignore", divide="ignore"):
-        mitre = (prev + normal) / (1 + np.sum(prev * normal, axis=-1, keepdims=True))
+        mitre = (prev + normal) / (1 + dot)[..., None]
     return quads + np.asarray(by, dtype=np.float64).reshape(-1, 1, 1) * mitre
 
 
@@ -414,10 +428,10 @@ def _padded(coords: np.ndarray, flat: np.ndarray, start: np.ndarray, faces: np.n
 
 def _convex(corners: np.ndarray) -> np.ndarray:
     """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12)."""
-    edge = np.roll(corners, -1, axis=1) - corners
+    edge = _next(corners) - corners
     length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        turn = _cross(edge, np.roll(edge, -1, axis=1)) / (length * np.roll(length, -1, axis=1))
+        turn = _cross(edge, _next(edge)) / (length * _next(length))
     turn = np.where(np.isnan(turn), 0.0, turn)  # repeated corners turn by nothing
     return _fold(np.logical_and, turn >= -1e-12) | _fold(np.logical_and, turn <= 1e-12)
 
@@ -425,17 +439,17 @@ def _convex(corners: np.ndarray) -> np.ndarray:
 def _surely_valid(quads: np.ndarray) -> np.ndarray:
     """(n,) bool: quadrilaterals that are strictly convex by a margin far above round-off (so
     valid polygons); False means "ask shapely"."""
-    edge = np.roll(quads, -1, axis=1) - quads
+    edge = _next(quads) - quads
     length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        turn = _cross(edge, np.roll(edge, -1, axis=1)) / (length * np.roll(length, -1, axis=1))
+        turn = _cross(edge, _next(edge)) / (length * _next(length))
         return _fold(np.logical_and, turn > 1e-6) | _fold(np.logical_and, turn < -1e-6)
 
 
 def _area(quads: np.ndarray) -> np.ndarray:
     """Areas (n,) of polygons (n, k, 2), about their first corners."""
     local = quads - quads[:, :1]
-    return np.abs(np.sum(_cross(local, np.roll(local, -1, axis=1)), axis=1)) / 2
+    return np.abs(np.sum(_cross(local, _next(local)), axis=1)) / 2
 
 
 class _Grid:
@@ -458,7 +472,7 @@ class _Grid:
         self.origin = lo[kept].min(axis=0)
         span = max(float(np.max(hi[kept].max(axis=0) - self.origin)), 1e-300)
         # about a box per cell; larger cells while the boxes would fill too many of them
-        cell = max(float(np.median(size)) * 2, span / 4096, 1e-300)
+        cell = max(float(np.median(size)), span / 4096, 1e-300)
         while True:
             self.cell = cell
             self.shape = (np.floor((hi[kept].max(axis=0) - self.origin) / cell)).astype(
@@ -609,9 +623,7 @@ class _Faces:
         for k, (fx, fy, *_) in self.sets.items():
             faces = np.flatnonzero(self.bucket == k)
             x, y = fx - fx[:, :1], fy - fy[:, :1]
-            area[faces] = (
-                np.abs(np.sum(x * np.roll(y, -1, axis=1) - y * np.roll(x, -1, axis=1), axis=1)) / 2
-            )
+            area[faces] = np.abs(np.sum(x * _next(y) - y * _next(x), axis=1)) / 2
         fixed = [f for f in self.polys if not self.fast[f]]
         if fixed:
             area[fixed] = shapely.area(self.polygons(np.asarray(fixed, dtype=np.int64)))
@@ -642,14 +654,14 @@ class _Faces:
         s = self.s
         local = quads - quads[:, :1]
         normal, offset = inward_lines(local)
-        perimeter = np.sum(np.linalg.norm(local - np.roll(local, -1, axis=1), axis=-1), axis=1)
+        perimeter = np.sum(np.linalg.norm(local - _next(local), axis=-1), axis=1)
         # the region s / 2 inside the tab: apart from it by s / 4, a face is apart from the
         # shrunk tab whatever round-off shapely and these figures make (checked by `sure`)
         frame = {
             "origin": quads[:, 0],
             "normal": normal,
             "offset": offset + s / 2,
-            "inner": shrink_convex(local, s / 2) + quads[:, :1],
+            "inner": shrink_convex(local, s / 2, normal) + quads[:, :1],
             "least": 1e-9 * area + 2 * s * perimeter,
             "reach": _absmax(quads) + _absmax(local) + self.h,
         }
@@ -888,6 +900,35 @@ def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list
     ]
 
 
+def _candidates(ends, normal, tab_height, cand):
+    """Candidate tabs ``cand`` (``border * 12 + 2 * level + side``, :data:`LEVELS`).
+
+    Returns
+    -------
+    quads : (n, 4, 2) float
+    hinges : (n, 2, 2) float
+    ok : (n,) bool
+        False where the hinge is too short for a tab.
+    height : (n,) float
+    """
+    quads = np.empty((len(cand), 4, 2))
+    hinges = np.empty((len(cand), 2, 2))
+    ok = np.zeros(len(cand), dtype=bool)
+    height = np.zeros(len(cand))
+    border, k = cand // (2 * len(LEVELS)), cand % (2 * len(LEVELS))
+    for level, (scale, part) in enumerate(LEVELS):
+        for side in (0, 1):
+            at = np.flatnonzero(k == 2 * level + side)
+            if not len(at):
+                continue
+            sub = ends[border[at], side]
+            sub = sub if part is None else _halves(sub, part)
+            height[at] = scale * tab_height
+            quads[at], ok[at] = tab_outlines(sub, normal[border[at], side], height[at])
+            hinges[at] = sub
+    return quads, hinges, ok, height
+
+
 def _choose(faces: _Faces, ends, normal, tab_height):
     """The greedy choice of a tab for every border (see :func:`add_tabs_and_labels`).
 
@@ -916,32 +957,27 @@ def _choose(faces: _Faces, ends, normal, tab_height):
     n = len(ends)
     s = SHRINK * tab_height
     n_cand = 2 * len(LEVELS)  # candidate c of border r: r * n_cand + 2 * level + side
-    quads = np.zeros((n, n_cand, 4, 2))
-    hinge = np.zeros((n, n_cand, 2, 2))
-    ok = np.zeros((n, n_cand), dtype=bool)
-    height = np.zeros(n_cand)
-    for lv, (scale, part) in enumerate(LEVELS):
-        for side in (0, 1):
-            c = 2 * lv + side
-            sub = ends[:, side] if part is None else _halves(ends[:, side], part)
-            quads[:, c], ok[:, c] = tab_outlines(sub, normal[:, side], scale * tab_height)
-            hinge[:, c], height[c] = sub, scale * tab_height
-    # where any candidate of a border's side may lie: its full tab, or a rectangle of half
-    # the height on the border (a box around both, per side 2 * border + A or B)
-    rect = np.concatenate([ends, ends[:, :, ::-1] + 0.5 * tab_height * normal[:, :, None]], 2)
-    envelope = np.stack([quads[:, :2], rect], axis=2).reshape(2 * n, 2, 4, 2)
-    sides = _Grid(*_boxes(envelope.reshape(2 * n, 8, 2)))
-    quads, hinge, ok = quads.reshape(-1, 4, 2), hinge.reshape(-1, 2, 2), ok.ravel()
-    height = np.tile(height, n)
+    quads = np.empty((n * n_cand, 4, 2))  # filled as they are made, at row(c)
+    hinge = np.empty((n * n_cand, 2, 2))
+
+    def row(c):  # a round's candidates together
+        return (c % n_cand) * n + c // n_cand
+
+    # where any candidate of a border's side may lie: the rectangle of the full height on
+    # the border (per side 2 * border + A or B)
+    up = tab_height * normal[..., None, :]
+    envelope = np.concatenate([ends, ends[:, :, ::-1] + up], axis=2).reshape(2 * n, 4, 2)
+    sides = _Grid(*_boxes(envelope))
     good = np.zeros((n, n_cand), dtype=bool)
     state = _Greedy(n, n_cand)
     blocker_of = np.full((n, 2), -1, dtype=np.int64)  # a face that blocked a side's last tab
     undecided = np.arange(n)
     for ks in ROUNDS:
         c = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
-        c = c[ok[c]]
-        q = quads[c]
-        area, least = _area(q), 1e-3 * height[c] ** 2
+        q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
+        quads[row(c)] = q
+        c, q, height = c[ok], q[ok], height[ok]
+        area, least = _area(q), 1e-3 * height**2
         valid = _surely_valid(q)
         doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > 1e-6 * least))
         if len(doubt):
@@ -955,14 +991,14 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         c = c[~blocked]
         good.flat[c] = True
         # the sides of other borders near the new candidates
-        i, j = sides.query(*_boxes(quads[c]))
+        i, j = sides.query(*_boxes(quads[row(c)]))
         pc, ps = c[i], j
         other = ps // 2 != pc // n_cand
         pc, ps = pc[other], ps[other]
         # earlier borders still undecided: what a candidate might meet (their envelopes)
         lo = np.flatnonzero(ps // 2 < pc // n_cand)
-        hit_env = conflicts(envelope[ps[lo], 0], quads[pc[lo]], s, exact=False)
-        hit_env |= conflicts(envelope[ps[lo], 1], quads[pc[lo]], s, exact=False)
+        lo = lo[state.undecided[ps[lo] // 2]]
+        hit_env = conflicts(envelope[ps[lo]], quads[row(pc[lo])], s, exact=False)
         state.might_meet(pc[lo[hit_env]], ps[lo[hit_env]] // 2)
         # the tested candidates of those sides: which tabs intersect which
         rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
@@ -971,17 +1007,17 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
         later = np.where(a // n_cand > b // n_cand, a, b)
         earlier = a + b - later
-        hit = conflicts(quads[earlier], quads[later], s)
+        hit = conflicts(quads[row(earlier)], quads[row(later)], s)
         state.meets(later[hit], earlier[hit])
         undecided = state.run(undecided, good, tested=ks[-1] + 1)
         if not len(undecided):
             break
     picked = state.picked()
-    out = quads[picked]
+    out = quads[row(picked)]
     ccw = np.sum(_cross(out - out[:, :1], np.roll(out - out[:, :1], -1, axis=1)), axis=1) > 0
     out[~ccw] = out[~ccw, ::-1]  # far above round-off: shapely's orientation, had it been asked
     local = picked % n_cand
-    return picked // n_cand, local // 2, local % 2, out, hinge[picked]
+    return picked // n_cand, local // 2, local % 2, out, hinge[row(picked)]
 
 
 class _Greedy:
@@ -1002,6 +1038,7 @@ class _Greedy:
         self.placed = [False] * (n * n_cand)
         self.linked = np.zeros(n * n_cand, dtype=bool)  # candidates with a `meet` or `near`
         self.choice = [-2] * n  # -2 undecided, -1 no tab, else the candidate
+        self.undecided = np.ones(n, dtype=bool)
 
     def meets(self, later: np.ndarray, earlier: np.ndarray) -> None:
         """Record that candidates ``later`` (shrunk) intersect ``earlier``."""
@@ -1053,7 +1090,10 @@ class _Greedy:
             if wait:
                 waiting.add(r)
                 still.append(r)
-        return np.asarray(still, dtype=np.int64)
+        still = np.asarray(still, dtype=np.int64)
+        self.undecided[:] = False
+        self.undecided[still] = True
+        return still
 
     def picked(self) -> np.ndarray:
         """The placed candidates, in the order of their borders."""
