@@ -31,6 +31,10 @@ SHRINK = 1e-9
 #: Overlap area (a share of the tab's area) above which a tab overlaps a face.
 OVERLAP = 1e-12
 
+#: A candidate that holds each (the same or a larger tab on the same hinge): 1 in 0, 4 in 2,
+#: 5 in 3 (side A, then B).
+COVER = (0, 1, 0, 1, 4, 5, 6, 7, 4, 5, 6, 7)
+
 #: The candidates tested together (each round: on the borders still undecided).
 ROUNDS = ((0,), (1,), (2, 3), (4, 5), (6, 7), (8, 9), (10, 11))
 
@@ -929,6 +933,15 @@ def _candidates(ends, normal, tab_height, cand):
     return quads, hinges, ok, height
 
 
+def _untested(cand, side, tested, n_cand):
+    """Pairs of a candidate and each candidate not tested yet (beyond the first ``tested``)
+    of a border's side (``2 * border + A or B``), for every (``cand``, ``side``)."""
+    k = np.arange(tested, n_cand)
+    mask = k[None, :] % 2 == side[:, None] % 2
+    i, j = np.nonzero(mask)
+    return cand[i], (side[i] // 2) * n_cand + k[j]
+
+
 def _choose(faces: _Faces, ends, normal, tab_height):
     """The greedy choice of a tab for every border (see :func:`add_tabs_and_labels`).
 
@@ -973,7 +986,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
     blocker_of = np.full((n, 2), -1, dtype=np.int64)  # a face that blocked a side's last tab
     undecided = np.arange(n)
     for ks in ROUNDS:
-        c = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
+        c = tried = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
         q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
         quads[row(c)] = q
         c, q, height = c[ok], q[ok], height[ok]
@@ -990,16 +1003,25 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         blocker_of[c[blocked] // n_cand, c[blocked] % 2] = found[blocked]
         c = c[~blocked]
         good.flat[c] = True
+        state.tested(tried, good.flat[tried])
         # the sides of other borders near the new candidates
         i, j = sides.query(*_boxes(quads[row(c)]))
         pc, ps = c[i], j
         other = ps // 2 != pc // n_cand
         pc, ps = pc[other], ps[other]
-        # earlier borders still undecided: what a candidate might meet (their envelopes)
+        # earlier borders still undecided: the candidates not tested yet that each new one
+        # might meet (tested a few together: a full tab holds the half-height one, a half
+        # border's tab the quarter-height one)
         lo = np.flatnonzero(ps // 2 < pc // n_cand)
         lo = lo[state.undecided[ps[lo] // 2]]
-        hit_env = conflicts(envelope[ps[lo]], quads[row(pc[lo])], s, exact=False)
-        state.might_meet(pc[lo[hit_env]], ps[lo[hit_env]] // 2)
+        lo = lo[conflicts(envelope[ps[lo]], quads[row(pc[lo])], s, exact=False)]
+        a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
+        holder = np.asarray(COVER)[b % n_cand]
+        cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
+        key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
+        held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
+        maybe = conflicts(held, quads[row(key // (n * n_cand))], s, exact=False) | ~fits
+        state.might_meet(a[maybe[inv]], b[maybe[inv]])
         # the tested candidates of those sides: which tabs intersect which
         rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
         a, b = pc[rows], (ps[rows] // 2) * n_cand + ps[rows] % 2 + 2 * col
@@ -1034,7 +1056,9 @@ class _Greedy:
     def __init__(self, n, n_cand):
         self.n_cand = n_cand
         self.meet: dict[int, list] = {}  # candidate -> intersecting candidates, earlier borders
-        self.near: dict[int, list] = {}  # candidate -> earlier borders it might meet
+        self.near: dict[int, list] = {}  # candidate -> earlier candidates it might meet
+        self.possible = [True] * (n * n_cand)  # not tested yet, or good
+        self.waits = [False] * n
         self.placed = [False] * (n * n_cand)
         self.linked = np.zeros(n * n_cand, dtype=bool)  # candidates with a `meet` or `near`
         self.choice = [-2] * n  # -2 undecided, -1 no tab, else the candidate
@@ -1046,30 +1070,34 @@ class _Greedy:
         for a, b in zip(later.tolist(), earlier.tolist(), strict=True):
             self.meet.setdefault(a, []).append(b)
 
-    def might_meet(self, cand: np.ndarray, border: np.ndarray) -> None:
-        """Record that candidates may intersect some candidate of earlier borders."""
+    def might_meet(self, cand: np.ndarray, other: np.ndarray) -> None:
+        """Record that candidates may intersect candidates of earlier borders not tested."""
         self.linked[cand] = True
-        for a, b in zip(cand.tolist(), border.tolist(), strict=True):
+        for a, b in zip(cand.tolist(), other.tolist(), strict=True):
             self.near.setdefault(a, []).append(b)
+
+    def tested(self, cand: np.ndarray, good: np.ndarray) -> None:
+        """Record that candidates were tested (``good``: those that may be placed)."""
+        for c in cand[~good].tolist():
+            self.possible[c] = False
 
     def run(self, undecided: np.ndarray, good: np.ndarray, tested: int) -> np.ndarray:
         """Decide the borders ``undecided`` (in order) that the first ``tested`` candidates of
         each decide; the others, still undecided."""
         nc, placed, choice = self.n_cand, self.placed, self.choice
-        meet, near = self.meet, self.near
+        meet, near, possible, waits = self.meet, self.near, self.possible, self.waits
         # first the borders whose first good candidate meets nothing: decided whatever the
         # others do
         rows = good[undecided, :tested]
         first = undecided * nc + rows.argmax(axis=1)
         easy = rows.any(axis=1) & ~self.linked[first]
         for r, c in zip(undecided[easy].tolist(), first[easy].tolist(), strict=True):
-            placed[c], choice[r] = True, c
+            placed[c], choice[r], waits[r] = True, c, False
         if tested == nc:
             for r in undecided[~rows.any(axis=1)].tolist():
-                choice[r] = -1
+                choice[r], waits[r] = -1, False
         hard = rows.any(axis=1) & ~easy if tested == nc else ~easy
         undecided = undecided[hard]
-        waiting = set()
         still = []
         good_rows = good[undecided].tolist()
         for r, row in zip(undecided.tolist(), good_rows, strict=True):
@@ -1078,17 +1106,18 @@ class _Greedy:
                 if not row[j]:
                     continue
                 c = base + j
-                if any(placed[x] for x in meet.get(c, ())):
+                met = meet.get(c, ())
+                if any(placed[x] for x in met):
                     continue
-                if any(x in waiting for x in near.get(c, ())):
+                if any(waits[x // nc] and possible[x] for x in (*met, *near.get(c, ()))):
                     break  # an earlier border, undecided, may take this place
                 placed[c], choice[r], wait = True, c, False
                 break
             else:
                 if tested == nc:
                     choice[r], wait = -1, False
+            waits[r] = wait
             if wait:
-                waiting.add(r)
                 still.append(r)
         still = np.asarray(still, dtype=np.int64)
         self.undecided[:] = False
