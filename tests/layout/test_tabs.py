@@ -250,6 +250,13 @@ def test_separating_axes_and_clipping_agree_with_shapely(seed):
     want = np.array([x.intersection(y).area for x, y in zip(pa, pb, strict=True)])
     np.testing.assert_allclose(area, want, rtol=1e-9, atol=1e-12)
     assert (want[empty] == 0).all()
+    area, empty, doubt = tabs.convex_overlap(a, b)
+    np.testing.assert_allclose(area[~doubt], want[~doubt], rtol=1e-9, atol=1e-12)
+    assert (want[empty] == 0).all()
+    # a square on a side of the other: corners on its line, left to clip_area (or no overlap)
+    c = np.concatenate([b[:, 1::-1], b[:, :2] + (b[:, 1:2] - b[:, :1]) @ [[0, -1], [1, 0]]], 1)
+    area, empty, doubt = tabs.convex_overlap(c, b)
+    assert (doubt | (np.abs(area) <= 1e-12)).all()
 
 
 @settings(max_examples=40, deadline=None)

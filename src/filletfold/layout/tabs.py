@@ -36,7 +36,7 @@ OVERLAP = 1e-12
 COVER = (0, 1, 0, 1, 4, 5, 6, 7, 4, 5, 6, 7)
 
 #: The candidates tested together (each round: on the borders still undecided).
-ROUNDS = ((0,), (1,), (2, 3), (4, 5), (6, 7), (8, 9), (10, 11))
+ROUNDS = ((0,), (1,), (2, 3), (4, 5, 6, 7, 8, 9, 10, 11))
 
 EPS = np.finfo(np.float64).eps
 
@@ -343,6 +343,67 @@ def sat_gap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return _fold(np.maximum, np.where(np.isnan(gap), -np.inf, gap))
 
 
+def convex_overlap(a: np.ndarray, b: np.ndarray):
+    """Area of the overlap of convex polygons, by Green's theorem on their clipped sides.
+
+    Parameters
+    ----------
+    a, b : (n, ka, 2), (n, kb, 2) float
+        Convex polygons, either orientation (repeated corners allowed).
+
+    Returns
+    -------
+    area : (n,) float
+        Area of ``a[i]`` and ``b[i]`` overlapping.
+    empty : (n,) bool
+        Whether no side of either has a piece inside the other (they are apart).
+    doubt : (n,) bool
+        Where a corner lies exactly on the line of a side of the other: sides may overlap
+        there, and count twice; ask :func:`clip_area`.
+    """
+    sign_a, sign_b = np.sign(_signed_area2(a)), np.sign(_signed_area2(b))
+    s1, in1, doubt1 = _sides_inside(a, b, sign_b)
+    s2, in2, doubt2 = _sides_inside(b, a, sign_a)
+    return np.abs(sign_a * s1 + sign_b * s2) / 2, ~in1 & ~in2, doubt1 | doubt2
+
+
+def _signed_area2(poly: np.ndarray) -> np.ndarray:
+    """Twice the signed areas (n,) of polygons (n, k, 2), about their first corners."""
+    local = poly - poly[:, :1]
+    return _cross(local, _next(local)).sum(axis=1)
+
+
+def _sides_inside(p: np.ndarray, q: np.ndarray, sign_q: np.ndarray):
+    """The sides of polygons ``p`` clipped to the convex polygons ``q`` (their orientations
+    ``sign_q``): the sums (n,) of ``cross(start, end)`` of the pieces inside, whether any
+    piece is, and whether a corner of ``p`` lies on the line of a side of ``q``."""
+    a = p
+    b = _next(p)
+    lo = np.zeros(a.shape[:2])
+    hi = np.ones(a.shape[:2])
+    out = np.zeros(a.shape[:2], dtype=bool)
+    doubt = np.zeros(a.shape[:2], dtype=bool)
+    q_next = _next(q)
+    for j in range(q.shape[1]):
+        ex, ey = q_next[:, j, 0] - q[:, j, 0], q_next[:, j, 1] - q[:, j, 1]
+        nx, ny = (-ey * sign_q)[:, None], (ex * sign_q)[:, None]  # inward
+        qx, qy = q[:, j, 0, None], q[:, j, 1, None]
+        da = nx * (a[..., 0] - qx) + ny * (a[..., 1] - qy)
+        db = nx * (b[..., 0] - qx) + ny * (b[..., 1] - qy)
+        side = ((ex != 0) | (ey != 0))[:, None]
+        doubt |= side & ((da == 0) | (db == 0))
+        out |= (da < 0) & (db < 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = da / (da - db)
+        enter, leave = (da < 0) & (db >= 0), (db < 0) & (da >= 0)
+        np.maximum(lo, t, out=lo, where=enter)
+        np.minimum(hi, t, out=hi, where=leave)
+    keep = ~out & (lo < hi)
+    d = b - a
+    start, end = a + lo[..., None] * d, a + hi[..., None] * d
+    return np.where(keep, _cross(start, end), 0.0).sum(axis=1), keep.any(axis=1), doubt.any(1)
+
+
 def clip_area(poly: np.ndarray, normal: np.ndarray, offset: np.ndarray):
     """Area of polygons clipped by half-planes (Sutherland-Hodgman), in batches.
 
@@ -415,6 +476,13 @@ def _colmax(a: np.ndarray) -> np.ndarray:
 def _absmax(a: np.ndarray) -> np.ndarray:
     """(n,) float: the largest absolute value of every ``a[i]`` (n, k, 2)."""
     return _fold(np.maximum, np.abs(a).reshape(len(a), -1))
+
+
+def _pad(a: np.ndarray, width: int) -> np.ndarray:
+    """An (n, k) array widened to (n, width) by repeating its last column."""
+    if a.shape[1] == width:
+        return a
+    return np.concatenate([a, np.repeat(a[:, -1:], width - a.shape[1], axis=1)], axis=1)
 
 
 def _bucket(size: np.ndarray) -> np.ndarray:
@@ -665,7 +733,7 @@ class _Faces:
             "origin": quads[:, 0],
             "normal": normal,
             "offset": offset + s / 2,
-            "inner": shrink_convex(local, s / 2, normal) + quads[:, :1],
+            "inner": shrink_convex(local, s / 2, normal),  # about the origin
             "least": 1e-9 * area + 2 * s * perimeter,
             "reach": _absmax(quads) + _absmax(local) + self.h,
         }
@@ -699,6 +767,7 @@ class _Faces:
         todo = np.flatnonzero(sure)
         bucket = self.bucket[faces[todo]]
         normal, offset = frame["normal"], frame["offset"]
+        kept = []
         for k in self.sets:
             pair = todo[bucket == k]
             if not len(pair):
@@ -718,7 +787,7 @@ class _Faces:
                 conv = live[self.convex[faces[pair[live]]]]
                 if len(conv):
                     r, tc = row[conv], t[conv]
-                    inner = frame["inner"][tc]
+                    inner = frame["inner"][tc] + frame["origin"][tc, None]
                     proj = [
                         ux[r] * inner[:, i, 0, None] + uy[r] * inner[:, i, 1, None]
                         for i in range(4)
@@ -729,20 +798,33 @@ class _Faces:
                     drop = np.zeros(len(pair), dtype=bool)
                     drop[conv[apart]] = True
                     live = live[~drop[live]]
-            # a tab is blocked by its first overlapping face: clip the first pair of every
-            # tab, then the others of the tabs still clear
-            first = np.r_[True, t[live][1:] != t[live][:-1]][: len(live)]
-            for part in (live[first], live[~first]):
-                part = part[blocker[t[part]] < 0]
-                if not len(part):
-                    continue
-                tp = t[part]
-                poly = np.stack([x[part], y[part]], axis=-1)
-                got, empty = clip_area(poly, normal[tp], offset[tp])
-                big = ~empty & (got > frame["least"][tp])
-                blocker[tp[big]] = faces[pair[part[big]]]
-                if slow is not None:
-                    slow.append(pair[part[~empty & ~big]])
+            kept.append((pair[live], x[live], y[live]))
+        if not kept:
+            return
+        # a tab is blocked by its first overlapping face: clip the first pair of every tab,
+        # then the others of the tabs still clear (faces padded to as many corners)
+        width = max(x.shape[1] for _, x, _ in kept)
+        pair = np.concatenate([p for p, _, _ in kept])
+        poly = np.concatenate(
+            [np.stack([_pad(x, width), _pad(y, width)], axis=-1) for _, x, y in kept]
+        )
+        t = tabs[pair]
+        first = np.zeros(len(pair), dtype=bool)
+        first[np.unique(t, return_index=True)[1]] = True
+        for part in (np.flatnonzero(first), np.flatnonzero(~first)):
+            part = part[blocker[t[part]] < 0]
+            if not len(part):
+                continue
+            tp = t[part]
+            got, empty, doubt = convex_overlap(poly[part], frame["inner"][tp])
+            doubt |= ~self.convex[faces[pair[part]]]
+            if doubt.any():  # Sutherland-Hodgman: faces not convex, touching sides
+                d = np.flatnonzero(doubt)
+                got[d], empty[d] = clip_area(poly[part[d]], normal[tp[d]], offset[tp[d]])
+            big = ~empty & (got > frame["least"][tp])
+            blocker[tp[big]] = faces[pair[part[big]]]
+            if slow is not None:
+                slow.append(pair[part[~empty & ~big]])
 
     def _exact(self, quads, tabs, faces):
         """Blocked pairs of a tab and a face, by shapely on the tab shrunk by ``SHRINK``."""
@@ -998,9 +1080,13 @@ def _choose(faces: _Faces, ends, normal, tab_height):
             valid[doubt], area[doubt] = shapely.is_valid(shapes), shapely.area(shapes)
         keep = np.flatnonzero(valid & (area > least))
         c, q, area = c[keep], q[keep], area[keep]
-        found = faces.clear(q, area, blocker_of[c // n_cand, c % 2])
-        blocked = found >= 0
-        blocker_of[c[blocked] // n_cand, c[blocked] % 2] = found[blocked]
+        blocked = np.zeros(len(c), dtype=bool)
+        for level in np.unique(c % n_cand // 2).tolist():  # a side's last blocker first
+            at = np.flatnonzero(c % n_cand // 2 == level)
+            found = faces.clear(q[at], area[at], blocker_of[c[at] // n_cand, c[at] % 2])
+            hit = at[found >= 0]
+            blocked[hit] = True
+            blocker_of[c[hit] // n_cand, c[hit] % 2] = found[found >= 0]
         c = c[~blocked]
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
