@@ -66,17 +66,19 @@ def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     by exactly two of them, the lower index first, the pairs in the order of their first edge.
     """
     cut = np.flatnonzero(p.edge_assignment == "B")
-    ends = np.round(p.vertices_3d[p.edges[cut]], decimals) + 0.0  # (k, 2, 3), no -0.0
-    keep = ~np.isnan(ends).reshape(len(cut), -1).any(axis=1)  # NaN is equal to nothing
-    cut, ends = cut[keep], ends[keep]
+    vertex, end = np.unique(p.edges[cut], return_inverse=True)
+    at = np.round(p.vertices_3d[vertex], decimals) + 0.0  # no -0.0
+    nan = np.isnan(at).any(axis=1)  # NaN is equal to nothing: never paired
+    keep = ~nan[end.reshape(-1, 2)].any(axis=1)
+    cut, end = cut[keep], end.reshape(-1, 2)[keep]
     if len(cut) == 0:
         return np.zeros((0, 2), dtype=np.int64)
-    bits = np.ascontiguousarray(ends.reshape(-1, 3)).view(np.int64)  # equal values, equal bits
+    bits = at.view(np.int64)  # equal values, equal bits
     order = np.lexsort(bits.T[::-1])
     step = np.r_[True, (bits[order][1:] != bits[order][:-1]).any(axis=1)]
-    point = np.empty(len(bits), dtype=np.int64)
-    point[order] = np.cumsum(step) - 1
-    point = point.reshape(-1, 2)
+    same = np.empty(len(bits), dtype=np.int64)  # the rounded point of each vertex
+    same[order] = np.cumsum(step) - 1
+    point = same[end]
     key = point.min(axis=1) * (int(point.max()) + 1) + point.max(axis=1)
     order = np.lexsort((cut, key))  # by segment, then by edge
     key, edge = key[order], cut[order]
@@ -534,29 +536,32 @@ class _Grid:
     """
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray):
-        self.lo, self.hi = np.ascontiguousarray(lo), np.ascontiguousarray(hi)
-        kept = np.flatnonzero(np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1))
-        self.keys = self.items = np.zeros(0, dtype=np.int64)
+        self.box = np.concatenate([lo, hi], axis=1)  # (n, 4): x0, y0, x1, y1
+        kept = np.flatnonzero(np.isfinite(self.box).all(axis=1))
         self.origin, self.cell, self.shape = np.zeros(2), 1.0, np.ones(2, dtype=np.int64)
+        self.low = np.zeros((len(lo), 2), dtype=np.int64)  # the first cell of each box
+        self.items = np.zeros(0, dtype=np.int64)
+        self.start = np.zeros(2, dtype=np.int64)
         if not len(kept):
             return
-        size = np.max(hi[kept] - lo[kept], axis=1)
-        self.origin = lo[kept].min(axis=0)
-        span = max(float(np.max(hi[kept].max(axis=0) - self.origin)), 1e-300)
+        lo, hi = lo[kept], hi[kept]
+        self.origin = lo.min(axis=0)
+        span = max(float(np.max(hi.max(axis=0) - self.origin)), 1e-300)
         # about a box per cell; larger cells while the boxes would fill too many of them
-        cell = max(float(np.median(size)), span / 4096, 1e-300)
+        cell = max(float(np.median(np.max(hi - lo, axis=1))), span / 4096, 1e-300)
         while True:
             self.cell = cell
-            self.shape = (np.floor((hi[kept].max(axis=0) - self.origin) / cell)).astype(
-                np.int64
-            ) + 1
-            c0, c1 = self._cells(lo[kept], hi[kept])
+            self.shape = np.floor((hi.max(axis=0) - self.origin) / cell).astype(np.int64) + 1
+            c0, c1 = self._cells(lo, hi)
             if np.prod(c1 - c0 + 1, axis=1).sum() <= 8 * len(kept) + 1024:
                 break
             cell *= 2
-        keys, items = self._entries(c0, c1, kept)
-        order = np.argsort(keys, kind="stable")
-        self.keys, self.items = keys[order], items[order]
+        self.low[kept] = c0
+        keys, items, _, _ = self._entries(c0, c1, kept)
+        order = np.argsort(keys)
+        self.items = items[order]
+        # the entries of cell k: items[start[k]:start[k + 1]]
+        self.start = np.searchsorted(keys[order], np.arange(int(np.prod(self.shape)) + 1))
 
     def _cells(self, lo, hi):
         """The first and last cells (n, 2) that boxes cover, clipped to the grid."""
@@ -566,14 +571,14 @@ class _Grid:
         return np.clip(c0, 0, top).astype(np.int64), np.clip(c1, -1, top).astype(np.int64)
 
     def _entries(self, c0, c1, items):
-        """(cell key, item) of every cell of every box."""
+        """(cell key, item, cell x, cell y) of every cell of every box."""
         w = np.maximum(c1 - c0 + 1, 0)
         count = w[:, 0] * w[:, 1]
         item = np.repeat(np.arange(len(c0)), count)
-        k = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
-        ix = c0[item, 0] + k // np.maximum(w[item, 1], 1)
-        iy = c0[item, 1] + k % np.maximum(w[item, 1], 1)
-        return ix * self.shape[1] + iy, items[item]
+        k = np.arange(len(item)) - np.repeat(np.cumsum(count) - count, count)
+        wy = np.maximum(w[item, 1], 1)
+        ix, iy = c0[item, 0] + k // wy, c0[item, 1] + k % wy
+        return ix * self.shape[1] + iy, items[item], ix, iy
 
     def query(self, lo: np.ndarray, hi: np.ndarray):
         """The pairs of a box (``lo``, ``hi``: (m, 2)) and a filed box that overlap (closed).
@@ -583,30 +588,27 @@ class _Grid:
         (k,) int, (k,) int
             The boxes asked and the filed ones, in the order of the boxes asked.
         """
-        if not len(lo) or not len(self.keys):
+        if not len(lo) or not len(self.items):
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-        finite = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
+        box = np.concatenate([lo, hi], axis=1)
+        finite = np.isfinite(box).all(axis=1)
         c0, c1 = self._cells(np.where(finite[:, None], lo, 0), np.where(finite[:, None], hi, -1))
         c1[~finite] = -1
-        keys, asked = self._entries(c0, c1, np.arange(len(lo)))
-        first = np.searchsorted(self.keys, keys, side="left")
-        count = np.searchsorted(self.keys, keys, side="right") - first
+        keys, asked, ix, iy = self._entries(c0, c1, np.arange(len(lo)))
+        first = self.start[keys]
+        count = self.start[keys + 1] - first
         which = np.repeat(np.arange(len(keys)), count)
         at = np.arange(len(which)) + np.repeat(first - np.cumsum(count) + count, count)
         a, b = asked[which], self.items[at]
-        (qx0, qy0), (qx1, qy1) = lo.T, hi.T
-        (fx0, fy0), (fx1, fy1) = self.lo.T, self.hi.T
-        x0, y0, x1, y1 = qx0[a], qy0[a], qx1[a], qy1[a]
-        bx0, by0, bx1, by1 = fx0[b], fy0[b], fx1[b], fy1[b]
-        keep = (x0 <= bx1) & (bx0 <= x1) & (y0 <= by1) & (by0 <= y1)
-        a, b, which = a[keep], b[keep], which[keep]
         # each pair once: in the cell of the low corner of the two boxes' overlap
-        top = self.shape - 1
-        rx = np.floor((np.maximum(x0[keep], bx0[keep]) - self.origin[0]) / self.cell)
-        ry = np.floor((np.maximum(y0[keep], by0[keep]) - self.origin[1]) / self.cell)
-        ref = np.clip(rx, 0, top[0]).astype(np.int64) * self.shape[1]
-        ref += np.clip(ry, 0, top[1]).astype(np.int64)
-        keep = ref == keys[which]
+        low_a, low_b = c0[a], self.low[b]
+        keep = (np.maximum(low_a[:, 0], low_b[:, 0]) == ix[which]) & (
+            np.maximum(low_a[:, 1], low_b[:, 1]) == iy[which]
+        )
+        a, b = a[keep], b[keep]
+        qa, fb = box[a], self.box[b]
+        keep = (qa[:, 0] <= fb[:, 2]) & (fb[:, 0] <= qa[:, 2])
+        keep &= (qa[:, 1] <= fb[:, 3]) & (fb[:, 1] <= qa[:, 3])
         return a[keep], b[keep]
 
 
@@ -951,7 +953,8 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         d = ends[:, :, 1] - ends[:, :, 0]
         pos = (ends[:, :, 0] + ends[:, :, 1]) / 2 - 0.9 * label_h * normal
         angle = _readable(np.degrees(np.arctan2(d[..., 1], d[..., 0])))
-        text = [str(n + 1) for n in range(n_runs) for _ in (0, 1)]
+        text = [""] * (2 * n_runs)
+        text[::2] = text[1::2] = list(map(str, range(1, n_runs + 1)))
         ann.labels.extend(
             Label(xy, t, a, label_h, "tab")
             for xy, t, a in zip(pos.reshape(-1, 2), text, angle.ravel(), strict=True)
@@ -1143,11 +1146,12 @@ class _Greedy:
         self.n_cand = n_cand
         self.meet: dict[int, list] = {}  # candidate -> intersecting candidates, earlier borders
         self.near: dict[int, list] = {}  # candidate -> earlier candidates it might meet
-        self.possible = [True] * (n * n_cand)  # not tested yet, or good
-        self.waits = [False] * n
-        self.placed = [False] * (n * n_cand)
+        # bytes: read one at a time by the loop of `run`, written as arrays through views
+        self.possible = bytearray(b"\x01") * (n * n_cand)  # not tested yet, or good
+        self.waits = bytearray(n)
+        self.placed = bytearray(n * n_cand)
         self.linked = np.zeros(n * n_cand, dtype=bool)  # candidates with a `meet` or `near`
-        self.choice = [-2] * n  # -2 undecided, -1 no tab, else the candidate
+        self.choice = np.full(n, -2, dtype=np.int64)  # -2 undecided, -1 no tab, else it
         self.undecided = np.ones(n, dtype=bool)
 
     def meets(self, later: np.ndarray, earlier: np.ndarray) -> None:
@@ -1164,32 +1168,33 @@ class _Greedy:
 
     def tested(self, cand: np.ndarray, good: np.ndarray) -> None:
         """Record that candidates were tested (``good``: those that may be placed)."""
-        for c in cand[~good].tolist():
-            self.possible[c] = False
+        np.frombuffer(self.possible, dtype=np.uint8)[cand[~good]] = 0
 
     def run(self, undecided: np.ndarray, good: np.ndarray, tested: int) -> np.ndarray:
         """Decide the borders ``undecided`` (in order) that the first ``tested`` candidates of
         each decide; the others, still undecided."""
         nc, placed, choice = self.n_cand, self.placed, self.choice
         meet, near, possible, waits = self.meet, self.near, self.possible, self.waits
+        placed_, waits_ = np.frombuffer(placed, np.uint8), np.frombuffer(waits, np.uint8)
         # first the borders whose first good candidate meets nothing: decided whatever the
-        # others do
+        # others do; and those with no good candidate yet: waiting (or without a tab)
         rows = good[undecided, :tested]
+        any_good = rows.any(axis=1)
         first = undecided * nc + rows.argmax(axis=1)
-        easy = rows.any(axis=1) & ~self.linked[first]
-        for r, c in zip(undecided[easy].tolist(), first[easy].tolist(), strict=True):
-            placed[c], choice[r], waits[r] = True, c, False
+        easy = any_good & ~self.linked[first]
+        placed_[first[easy]] = 1
+        choice[undecided[easy]] = first[easy]
+        waits_[undecided[easy]] = 0
+        idle = undecided[~any_good]
+        waits_[idle] = tested < nc
         if tested == nc:
-            for r in undecided[~rows.any(axis=1)].tolist():
-                choice[r], waits[r] = -1, False
-        hard = rows.any(axis=1) & ~easy if tested == nc else ~easy
-        undecided = undecided[hard]
-        still = []
-        good_rows = good[undecided].tolist()
-        for r, row in zip(undecided.tolist(), good_rows, strict=True):
+            choice[idle] = -1
+        still = [] if tested == nc else idle.tolist()
+        hard = undecided[any_good & ~easy]
+        for r, row in zip(hard.tolist(), good[hard, :tested].tolist(), strict=True):
             base, wait = r * nc, True
-            for j in range(tested):
-                if not row[j]:
+            for j, ok in enumerate(row):
+                if not ok:
                     continue
                 c = base + j
                 met = meet.get(c, ())
@@ -1197,7 +1202,7 @@ class _Greedy:
                     continue
                 if any(waits[x // nc] and possible[x] for x in (*met, *near.get(c, ()))):
                     break  # an earlier border, undecided, may take this place
-                placed[c], choice[r], wait = True, c, False
+                placed[c], choice[r], wait = 1, c, False
                 break
             else:
                 if tested == nc:
@@ -1205,14 +1210,14 @@ class _Greedy:
             waits[r] = wait
             if wait:
                 still.append(r)
-        still = np.asarray(still, dtype=np.int64)
+        still = np.sort(np.asarray(still, dtype=np.int64))
         self.undecided[:] = False
         self.undecided[still] = True
         return still
 
     def picked(self) -> np.ndarray:
         """The placed candidates, in the order of their borders."""
-        return np.asarray([c for c in self.choice if c >= 0], dtype=np.int64)
+        return self.choice[self.choice >= 0]
 
 
 def assembly_text(seams: list[dict]) -> str:
