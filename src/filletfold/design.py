@@ -622,6 +622,7 @@ def round_mesh(
         scale=scale,
         tabs=tabs,
         stage=_stage,
+        timings=timings,
     )
     locate_apices(pattern, res)
     timings["surface"] = time.perf_counter() - t

@@ -3,15 +3,24 @@ its two labels, tabs lie outside every piece and every other tab, on their own b
 
 from __future__ import annotations
 
+import copy
+from itertools import pairwise
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import filletfold
-from filletfold.layout.tabs import assembly_text
+from filletfold.layout import arrange, tabs
+from filletfold.layout.tabs import add_tabs_and_labels, assembly_text
+
+from . import tabs_reference
 
 
-@pytest.fixture(scope="module", params=["cube", "icosahedron", "l-prism"])
+@pytest.fixture(scope="module", params=["cube", "icosahedron", "l-prism", "house", "torus"])
 def tabbed(request):
     return filletfold.round_mesh(request.param, tabs=True)
 
@@ -27,13 +36,14 @@ def test_every_cut_border_is_tabbed_or_labelled(tabbed):
 def test_tabs_overlap_no_piece_and_no_tab(tabbed):
     p = tabbed.pattern
     faces = shapely.union_all([shapely.Polygon(p.vertices_2d[f]) for f in p.faces])
-    tabs = [shapely.Polygon(t) for t in p.annotations.tabs]
+    outlines = [shapely.Polygon(t) for t in p.annotations.tabs]
     scale = np.ptp(p.vertices_2d, axis=0).max() ** 2
-    for k, t in enumerate(tabs):
-        assert t.is_valid and t.area > 0
+    for k, t in enumerate(outlines):
+        assert t.is_valid and t.area > 0 and t.exterior.is_ccw
         assert t.intersection(faces).area <= 1e-9 * scale, k
-        for other in tabs[k + 1 :]:
-            assert t.intersection(other).area <= 1e-9 * scale
+    for a, b in zip(*shapely.STRtree(outlines).query(outlines), strict=True):
+        if a < b:
+            assert outlines[a].intersection(outlines[b]).area <= 1e-9 * scale
 
 
 def test_each_tab_hinges_on_a_cut_border(tabbed):
@@ -58,3 +68,205 @@ def test_labels_pair_up_and_the_assembly_text_lists_them(tabbed):
     assert len(text) == 2 + len(seams)
     for line, seam in zip(text[2:], seams, strict=True):
         assert line.split("\t")[0] == str(seam["label"])
+
+
+# ---------------------------------------------------------------- the arrays and the reference
+
+
+@pytest.fixture(scope="module", params=["cube", "l-prism", "house", "torus", "saddle-patch"])
+def untabbed(request):
+    """A pattern as :func:`add_tabs_and_labels` gets it (laid out for tabs), and its height."""
+    got = {}
+
+    def spy(p, h, **kw):
+        got["p"], got["h"] = copy.deepcopy(p), h
+        return add_tabs_and_labels(p, h, **kw)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(arrange, "add_tabs_and_labels", spy)
+        filletfold.round_mesh(request.param, tabs=True, certify=False)
+    return got["p"], got["h"]
+
+
+def test_the_tabs_are_those_of_the_reference_to_the_bit(untabbed):
+    """The array version places the tabs of the one-geometry-at-a-time version: the same
+    tabs, hinges, labels and seams, bit for bit (so the same files)."""
+    p, h = untabbed
+    old, new = copy.deepcopy(p), copy.deepcopy(p)
+    want, got = tabs_reference.add_tabs_and_labels(old, h), add_tabs_and_labels(new, h)
+    assert got == want
+    a, b = old.annotations, new.annotations
+    for name in ("tabs", "tab_hinges"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert len(x) == len(y) and all(np.array_equal(u, v) for u, v in zip(x, y, strict=True))
+    assert len(a.labels) == len(b.labels)
+    for u, v in zip(a.labels, b.labels, strict=True):
+        assert np.array_equal(u.position, v.position)
+        assert (u.text, u.angle, u.height, u.kind) == (v.text, v.angle, v.height, v.kind)
+
+
+def test_the_segments_are_those_of_the_reference(untabbed):
+    p, _ = untabbed
+    pairs = tabs._seam_pairs(p)
+    assert pairs.tolist() == [list(q) for q in tabs_reference._seam_pairs(p)]
+    side_a, side_b, start = tabs._runs(p, pairs)
+    runs = tabs_reference._runs(p, tabs_reference._seam_pairs(p))
+    assert [list(r[0]) for r in runs] == [side_a[i:j].tolist() for i, j in pairwise(start)]
+    assert [list(r[1]) for r in runs] == [side_b[i:j].tolist() for i, j in pairwise(start)]
+    ends, normal = tabs._segments(p, side_a, start)
+    for k, run in enumerate(runs):
+        e, n = tabs_reference._segment(p, run[0])
+        assert np.array_equal(e, ends[k]) and np.array_equal(n, normal[k])
+
+
+def test_row_dots_have_the_bits_of_the_scalar_ones():
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(2000, 2)) * rng.uniform(1e-3, 1e3, (2000, 1))
+    b = rng.normal(size=(2000, 2))
+    assert np.array_equal(tabs._rowdot(a, b), [x @ y for x, y in zip(a, b, strict=True)])
+    assert np.array_equal(tabs._rownorm(a), [np.linalg.norm(x) for x in a])
+
+
+def test_the_tab_timing_is_reported():
+    assert "tabs" in filletfold.round_mesh("cube", tabs=True, certify=False).timings
+    assert "tabs" not in filletfold.round_mesh("cube", tabs=False, certify=False).timings
+
+
+# ----------------------------------------------------- the array predicates against shapely
+
+
+def _convex_polygon(rng, centre, size, k):
+    """A random convex polygon (counter-clockwise), about ``centre``."""
+    pts = centre + size * rng.normal(size=(3 * k, 2))
+    hull = shapely.convex_hull(shapely.multipoints(pts))
+    return np.asarray(hull.exterior.coords)[:-1][::-1]
+
+
+def _scene(seed, far=False):
+    """Random faces (convex and not) and tabs; some tabs stand on a face's side (touching
+    it), some meet other tabs at a corner: the cases where the shrink decides. ``far``: all
+    of it far from the origin, where round-off leaves every pair to shapely."""
+    rng = np.random.default_rng(seed)
+    faces = [_convex_polygon(rng, rng.uniform(0, 4, 2), rng.uniform(0.2, 1), 4) for _ in range(6)]
+    star = rng.uniform(0, 4, 2) + np.stack(
+        [np.cos(t := np.linspace(0, 2 * np.pi, 7)[:-1]), np.sin(t)], axis=1
+    ) * rng.choice([0.3, 0.8], size=(6, 1))
+    faces.append(star)
+    h = rng.uniform(0.05, 0.5)
+    ends, normal = [], []
+    for f in faces:  # on a side of a face, pointing out or in
+        i = rng.integers(len(f))
+        e = np.array([f[i], f[(i + 1) % len(f)]])
+        d = e[1] - e[0]
+        n = np.array([d[1], -d[0]]) / np.linalg.norm(d)
+        ends.append(e)
+        normal.append(n if rng.random() < 0.7 else -n)
+    for _ in range(8):  # anywhere
+        p0 = rng.uniform(0, 4, 2)
+        ang = rng.uniform(0, 2 * np.pi)
+        e = np.array([p0, p0 + rng.uniform(0.05, 1.5) * np.array([np.cos(ang), np.sin(ang)])])
+        ends.append(e)
+        d = e[1] - e[0]
+        normal.append(np.array([-d[1], d[0]]) / np.linalg.norm(d))
+    ends, normal = np.array(ends), np.array(normal)
+    quads, ok = tabs.tab_outlines(ends, normal, h * rng.choice([1.0, 0.5, 0.25], len(ends)))
+    # and a tab sharing a corner with each of the others
+    turn = rng.uniform(-2.5, 2.5, len(ends))
+    d = np.stack([np.cos(turn), np.sin(turn)], axis=1) * rng.uniform(0.1, 1, (len(ends), 1))
+    d = np.einsum("nij,nj->ni", _rotations(np.arctan2(*(ends[:, 1] - ends[:, 0]).T[::-1])), d)
+    ends2 = np.stack([ends[:, 1], ends[:, 1] + d], axis=1)
+    n2 = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
+    quads2, ok2 = tabs.tab_outlines(ends2, n2 * np.sign(rng.random(len(d)) - 0.3)[:, None], h)
+    quads = np.concatenate([quads[ok], quads2[ok2]])
+    shift = 1e7 if far else 0.0
+    return [f + shift for f in faces], quads + shift, h
+
+
+def _rotations(angle):
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_face_tests_agree_with_shapely(seed, far):
+    faces, quads, h = _scene(seed, far)
+    p = SimpleNamespace(
+        vertices_2d=np.concatenate(faces),
+        faces=[np.arange(len(f)) + sum(map(len, faces[:i])) for i, f in enumerate(faces)],
+    )
+    polys = [shapely.Polygon(f) for f in faces]
+    shapes = [shapely.Polygon(q) for q in quads]
+    keep = [i for i, t in enumerate(shapes) if t.is_valid and t.area > 0]
+    quads, shapes = quads[keep], [shapes[i] for i in keep]
+    area = np.array([t.area for t in shapes])
+    got = tabs._Faces(p, h).clear(quads, area) < 0
+    for k, t in enumerate(shapes):
+        shrunk = t.buffer(-tabs.SHRINK * h)
+        want = not any(
+            polys[i].intersection(shrunk).area > tabs.OVERLAP * t.area
+            for i in shapely.STRtree(polys).query(shrunk)
+        )
+        assert got[k] == want, k
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_tab_conflicts_agree_with_shapely(seed, far):
+    _, quads, h = _scene(seed, far)
+    i, j = np.triu_indices(len(quads), 1)
+    s = tabs.SHRINK * h
+    got = tabs.conflicts(quads[i], quads[j], s)
+    bound = tabs.conflicts(quads[i], quads[j], s, exact=False)
+    shapes = [shapely.Polygon(q) for q in quads]
+    want = [shapes[a].intersects(shapes[b].buffer(-s)) for a, b in zip(i, j, strict=True)]
+    assert got.tolist() == want
+    assert (bound | ~got).all()  # without shapely: a bound
+
+
+def _quads(rng, n):
+    """Random convex quadrilaterals (n, 4, 2): corners on stretched circles."""
+    angle = np.sort(rng.uniform(0, 2 * np.pi, (n, 4)), axis=1)
+    ring = np.stack([np.cos(angle), np.sin(angle)], axis=-1)
+    stretch = rng.normal(size=(n, 2, 2)) * 0.4
+    return rng.uniform(0, 2, (n, 1, 2)) + np.einsum("nij,nkj->nki", stretch, ring)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_separating_axes_and_clipping_agree_with_shapely(seed):
+    rng = np.random.default_rng(seed)
+    a, b = _quads(rng, 40), _quads(rng, 40)
+    pa = [shapely.Polygon(x) for x in a]
+    pb = [shapely.Polygon(x) for x in b]
+    gap = tabs.sat_gap(a, b)
+    for k in range(len(a)):
+        if gap[k] > 1e-9:
+            assert pa[k].distance(pb[k]) >= gap[k] * (1 - 1e-9)
+        elif gap[k] < -1e-9:
+            assert pa[k].intersects(pb[k])
+    normal, offset = tabs.inward_lines(b)
+    area, empty = tabs.clip_area(a, normal, offset)
+    want = np.array([x.intersection(y).area for x, y in zip(pa, pb, strict=True)])
+    np.testing.assert_allclose(area, want, rtol=1e-9, atol=1e-12)
+    assert (want[empty] == 0).all()
+    area, empty, doubt = tabs.convex_overlap(a, b)
+    np.testing.assert_allclose(area[~doubt], want[~doubt], rtol=1e-9, atol=1e-12)
+    assert (want[empty] == 0).all()
+    # a square on a side of the other: corners on its line, left to clip_area (or no overlap)
+    c = np.concatenate([b[:, 1::-1], b[:, :2] + (b[:, 1:2] - b[:, :1]) @ [[0, -1], [1, 0]]], 1)
+    area, empty, doubt = tabs.convex_overlap(c, b)
+    assert (doubt | (np.abs(area) <= 1e-12)).all()
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_grid_finds_every_overlapping_box(seed):
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(0, 10, (200, 2))
+    hi = lo + rng.exponential(0.5, (200, 2)) * rng.choice([1, 1, 20], (200, 1))
+    qlo = rng.uniform(-1, 11, (50, 2))
+    qhi = qlo + rng.exponential(0.3, (50, 2))
+    a, b = tabs._Grid(lo, hi).query(qlo, qhi)
+    want = np.argwhere(((qlo[:, None] <= hi[None]) & (lo[None] <= qhi[:, None])).all(axis=2))
+    assert sorted(zip(a.tolist(), b.tolist(), strict=True)) == sorted(map(tuple, want.tolist()))

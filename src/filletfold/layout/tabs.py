@@ -4,120 +4,897 @@ A *cut border* is a straight run of seam edges: border edges whose folded segmen
 folded segment of another border edge (the other side of the cut, on the same or another
 piece). Every cut border gets one glue tab, on the side where it overlaps nothing, and the
 same label on both sides; every piece gets its part number.
+
+The tabs are chosen greedily, border after border: the first of a border's candidate tabs
+that overlaps no face and no tab placed before it. Every candidate is tested at once, on
+arrays: separating axes and polygon clipping (:func:`clip_area`) decide the pairs of a tab and
+a face (or an earlier tab) that are clearly apart or clearly overlapping, and shapely decides
+the few others, exactly as it would decide them one at a time.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import shapely
+from scipy.sparse import coo_array
+from scipy.sparse.csgraph import connected_components
 
-from ..surface.pattern import Annotations, CreasePattern, Label
+from ..surface.pattern import Annotations, CreasePattern, Label, face_arrays
+
+#: The candidate tabs of a border, in the order they are tried: (share of the full height,
+#: which half of the border or None for all of it); each on side A, then on side B.
+LEVELS = ((1.0, None), (0.5, None), (0.5, 0), (0.5, 1), (0.25, 0), (0.25, 1))
+
+#: A tab is tested shrunk by this share of the full tab height (touching is not overlapping).
+SHRINK = 1e-9
+
+#: Overlap area (a share of the tab's area) above which a tab overlaps a face.
+OVERLAP = 1e-12
+
+#: A candidate that holds each (the same or a larger tab on the same hinge): 1 in 0, 4 in 2,
+#: 5 in 3 (side A, then B).
+COVER = (0, 1, 0, 1, 4, 5, 6, 7, 4, 5, 6, 7)
+
+#: The candidates tested together (each round: on the borders still undecided).
+ROUNDS = ((0,), (1,), (2, 3), (4, 5, 6, 7, 8, 9, 10, 11))
+
+EPS = np.finfo(np.float64).eps
 
 
-def _seam_pairs(p: CreasePattern, decimals: int = 9) -> list[tuple[int, int]]:
-    """Pairs of pattern edges that are the two sides of one cut."""
-    mask = p.cut_mask(decimals)
-    groups: dict[tuple, list[int]] = {}
-    for e in np.nonzero(mask)[0]:
-        a, b = p.edges[e]
-        key = tuple(
-            sorted(
-                (tuple(p.vertices_3d[a].round(decimals)), tuple(p.vertices_3d[b].round(decimals)))
-            )
-        )
-        groups.setdefault(key, []).append(int(e))
-    return [(g[0], g[1]) for g in groups.values() if len(g) == 2]
+def _rowdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products of two (n, 2) arrays, with the bits of the scalar ``a[i] @ b[i]``.
+
+    ``np.matmul`` on stacks of (1, 2) and (2, 1) runs the BLAS kernel of a dot of two vectors,
+    which may fuse the multiply and the add: ``a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]`` would
+    round differently.
+    """
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    b = np.ascontiguousarray(b, dtype=np.float64)
+    return np.matmul(a[:, None, :], b[:, :, None])[:, 0, 0]
 
 
-def _runs(p: CreasePattern, pairs: list[tuple[int, int]], angle_tol: float = 1e-6):
+def _rownorm(a: np.ndarray) -> np.ndarray:
+    """Row-wise ``np.linalg.norm`` of an (n, 2) array, with the bits of the scalar one."""
+    return np.sqrt(_rowdot(a, a))
+
+
+def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
+    """(k, 2) int: pairs of pattern edges that are the two sides of one cut.
+
+    Border edges are matched by their rounded folded end points (as
+    :meth:`CreasePattern.cut_mask` matches them); a pair is the two edges of a segment held
+    by exactly two of them, the lower index first, the pairs in the order of their first edge.
+    """
+    cut = np.flatnonzero(p.edge_assignment == "B")
+    vertex, end = np.unique(p.edges[cut], return_inverse=True)
+    at = np.round(p.vertices_3d[vertex], decimals) + 0.0  # no -0.0
+    nan = np.isnan(at).any(axis=1)  # NaN is equal to nothing: never paired
+    keep = ~nan[end.reshape(-1, 2)].any(axis=1)
+    cut, end = cut[keep], end.reshape(-1, 2)[keep]
+    if len(cut) == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    bits = at.view(np.int64)  # equal values, equal bits
+    order = np.lexsort(bits.T[::-1])
+    step = np.r_[True, (bits[order][1:] != bits[order][:-1]).any(axis=1)]
+    same = np.empty(len(bits), dtype=np.int64)  # the rounded point of each vertex
+    same[order] = np.cumsum(step) - 1
+    point = same[end]
+    key = point.min(axis=1) * (int(point.max()) + 1) + point.max(axis=1)
+    order = np.lexsort((cut, key))  # by segment, then by edge
+    key, edge = key[order], cut[order]
+    first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    size = np.diff(np.r_[first, len(key)])
+    two = first[size == 2]
+    pairs = np.stack([edge[two], edge[two + 1]], axis=1)
+    return pairs[np.argsort(pairs[:, 0], kind="stable")]
+
+
+def _runs(p: CreasePattern, pairs: np.ndarray, angle_tol: float = 1e-6):
     """Group seam pairs into straight runs: consecutive, collinear edges on both sides.
+
+    Two side-A edges join at a vertex that no other side-A edge has when they are collinear
+    and so are their twins on side B. A run is grown from its first edge (in the order of
+    ``pairs``) towards that edge's first vertex, then towards its second; the runs are in the
+    order of their first edges.
 
     Returns
     -------
-    list of (list of int, list of int)
-        The edges of each run on side A and on side B.
+    side_a, side_b : (k,) int
+        The edges of every run on side A and their twins on side B, run after run.
+    start : (n_runs + 1,) int
+        Run ``i`` is ``side_a[start[i]:start[i + 1]]``.
     """
-    side_a = {e: k for k, (e, _) in enumerate(pairs)}
-    at_vertex: dict[int, list[int]] = {}
-    for e in side_a:
-        for v in p.edges[e]:
-            at_vertex.setdefault(int(v), []).append(e)
+    n = len(pairs)
+    if n == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(1, np.int64)
+    ea = p.edges[pairs[:, 0]]  # (n, 2) vertices of side A
+    eb = p.edges[pairs[:, 1]]
 
     def direction(e):
-        a, b = p.edges[e]
-        d = p.vertices_2d[b] - p.vertices_2d[a]
-        return d / np.linalg.norm(d)
+        d = p.vertices_2d[e[:, 1]] - p.vertices_2d[e[:, 0]]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return d / _rownorm(d)[:, None]
 
-    seen, runs = set(), []
-    for e0 in side_a:
-        if e0 in seen:
-            continue
-        run = [e0]
-        seen.add(e0)
-        for end in (0, 1):  # grow from both ends while straight and unbranched
-            v = int(p.edges[e0][end])
-            cur = e0
-            while True:
-                nxt = [e for e in at_vertex.get(v, []) if e != cur and e not in seen]
-                if len(at_vertex.get(v, [])) != 2 or len(nxt) != 1:
-                    break
-                e = nxt[0]
-                if abs(abs(direction(e) @ direction(cur)) - 1) > angle_tol:
-                    break
-                # the twins must run on together too (one straight run on the other side)
-                if (
-                    abs(abs(direction(pairs[side_a[e]][1]) @ direction(pairs[side_a[cur]][1])) - 1)
-                    > angle_tol
-                ):
-                    break
-                run.insert(0, e) if end == 0 else run.append(e)
-                seen.add(e)
-                cur = e
-                a, b = p.edges[e]
-                v = int(b) if int(a) == v else int(a)
-        runs.append((run, [pairs[side_a[e]][1] for e in run]))
-    return runs
+    da, db = direction(ea), direction(eb)
+    # the vertices held by exactly two side-A edges, and those two (the node = index in pairs)
+    flat = ea.ravel()
+    order = np.argsort(flat, kind="stable")
+    sv = flat[order]
+    first = np.flatnonzero(np.r_[True, sv[1:] != sv[:-1]])
+    size = np.diff(np.r_[first, len(sv)])
+    two = first[size == 2]
+    vtx, k1, k2 = sv[two], order[two] // 2, order[two + 1] // 2
+    with np.errstate(invalid="ignore"):  # a NaN direction fails no test, as in a loop
+        join = (k1 != k2) & ~(np.abs(np.abs(_rowdot(da[k1], da[k2])) - 1) > angle_tol)
+        join &= ~(np.abs(np.abs(_rowdot(db[k1], db[k2])) - 1) > angle_tol)
+    vtx, k1, k2 = vtx[join], k1[join], k2[join]
+    # other[v] = k1 + k2 at a joining vertex: the node after `cur` is other[v] - cur
+    other = np.full(len(p.vertices_2d), -1, dtype=np.int64)
+    other[vtx] = k1 + k2
+    graph = coo_array((np.ones(len(k1)), (k1, k2)), shape=(n, n))
+    _, comp = connected_components(graph, directed=False)
+    head = np.full(comp.max() + 1, n, dtype=np.int64)
+    np.minimum.at(head, comp, np.arange(n))
+    head = np.sort(head)  # the first edge of every run, runs in its order
+    run_of = np.empty(n, dtype=np.int64)
+    pos = np.zeros(n, dtype=np.int64)
+    run_of[head] = np.arange(len(head))
+    seen = np.zeros(n, dtype=bool)
+    seen[head] = True
+    for end, sign in ((0, -1), (1, 1)):  # grow from the first vertex, then from the second
+        cur, v, step = head.copy(), ea[head, end], 1
+        while len(cur):
+            nxt = np.where(other[v] >= 0, other[v] - cur, -1)
+            ok = nxt >= 0
+            ok[ok] = ~seen[nxt[ok]]
+            cur, v, nxt = cur[ok], v[ok], nxt[ok]
+            if not len(nxt):
+                break
+            seen[nxt] = True
+            run_of[nxt] = run_of[cur]
+            pos[nxt] = sign * step
+            v = np.where(ea[nxt, 0] == v, ea[nxt, 1], ea[nxt, 0])
+            cur, step = nxt, step + 1
+    nodes = np.lexsort((pos, run_of))
+    start = np.searchsorted(run_of[nodes], np.arange(len(head) + 1))
+    return pairs[nodes, 0], pairs[nodes, 1], start
 
 
-def _segment(p: CreasePattern, edges: list[int]):
-    """End points (2,2) of a straight run of edges, and the outward unit normal."""
-    pts = p.vertices_2d[p.edges[edges].ravel()]
-    d = pts.max(axis=0) - pts.min(axis=0)
-    axis = d / np.linalg.norm(d) if np.linalg.norm(d) > 0 else np.array([1.0, 0.0])
-    t = pts @ axis
-    ends = np.array([pts[np.argmin(t)], pts[np.argmax(t)]])
-    face = p.edge_faces[edges[0]].max()
-    centre = p.vertices_2d[p.faces[face]].mean(axis=0)
-    normal = np.array([-axis[1], axis[0]])
-    if (centre - ends.mean(axis=0)) @ normal > 0:
-        normal = -normal
+def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
+    """End points and outward unit normals of straight runs of edges.
+
+    Parameters
+    ----------
+    p : CreasePattern
+    edges : (k,) int
+        The edges of every run, run after run.
+    start : (n_runs + 1,) int
+        Run ``i`` is ``edges[start[i]:start[i + 1]]`` (none empty).
+
+    Returns
+    -------
+    ends : (n_runs, 2, 2) float
+        The run's extreme points along its direction, the first one first.
+    normal : (n_runs, 2) float
+        The unit normal pointing away from the face of the run's first edge.
+    """
+    n = len(start) - 1
+    pts = p.vertices_2d[p.edges[edges].ravel()]  # two per edge
+    at = 2 * start[:-1]
+    d = np.maximum.reduceat(pts, at, axis=0) - np.minimum.reduceat(pts, at, axis=0)
+    norm = _rownorm(d)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        axis = np.where((norm > 0)[:, None], d / norm[:, None], [1.0, 0.0])
+    count = 2 * np.diff(start)
+    lo, hi = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    for k in np.unique(count).tolist():  # runs of k points together
+        runs = np.flatnonzero(count == k)
+        at_k = at[runs][:, None] + np.arange(k)
+        # the bits of `points @ axis` (a BLAS gemv), and np.argmin's first of the smallest
+        t = np.matmul(pts[at_k], axis[runs][:, :, None])[..., 0]
+        lo[runs], hi[runs] = at_k[:, 0] + t.argmin(axis=1), at_k[:, 0] + t.argmax(axis=1)
+    ends = np.stack([pts[lo], pts[hi]], axis=1)
+    flat, fstart = face_arrays(p.faces)
+    face = p.edge_faces[edges[start[:-1]]].max(axis=1)
+    size = fstart[face + 1] - fstart[face]
+    corner = (
+        fstart[np.repeat(face, size)]
+        + np.arange(size.sum())
+        - np.repeat(np.cumsum(size) - size, size)
+    )
+    centre = np.add.reduceat(p.vertices_2d[flat[corner]], np.cumsum(size) - size, axis=0)
+    centre /= size[:, None]
+    normal = np.stack([-axis[:, 1], axis[:, 0]], axis=1)
+    flip = _rowdot(centre - (ends[:, 0] + ends[:, 1]) / 2, normal) > 0
+    normal[flip] = -normal[flip]
     return ends, normal
 
 
-def _tab_polygon(ends: np.ndarray, normal: np.ndarray, height: float) -> np.ndarray | None:
-    p0, p1 = ends
-    length = np.linalg.norm(p1 - p0)
-    if length <= 1e-9 * height:
-        return None
-    d = (p1 - p0) / length
-    inset = min(height, 0.3 * length)
-    return np.array([p0, p1, p1 + height * normal - inset * d, p0 + height * normal + inset * d])
+def tab_outlines(ends: np.ndarray, normal: np.ndarray, height) -> tuple[np.ndarray, np.ndarray]:
+    """Trapezoidal tabs on segments: the segment, then its far side ``height`` away.
+
+    Parameters
+    ----------
+    ends : (n, 2, 2) float
+        The segments (the tabs' hinges).
+    normal : (n, 2) float
+        Unit normals: where the tabs stand.
+    height : float or (n,) float
+
+    Returns
+    -------
+    quads : (n, 4, 2) float
+        ``p0, p1``, then the far side, inset at both ends by ``min(height, 0.3 * length)``.
+    ok : (n,) bool
+        False where the segment is too short for a tab (no more than ``1e-9 * height``).
+    """
+    height = np.broadcast_to(np.asarray(height, dtype=np.float64), (len(ends),))
+    p0, p1 = ends[:, 0], ends[:, 1]
+    length = _rownorm(p1 - p0)
+    ok = ~(length <= 1e-9 * height)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = (p1 - p0) / length[:, None]
+    inset = np.where(0.3 * length < height, 0.3 * length, height)[:, None]
+    up = height[:, None] * normal
+    return np.stack([p0, p1, p1 + up - inset * d, p0 + up + inset * d], axis=1), ok
 
 
-def _half(ends: np.ndarray, which: int) -> np.ndarray:
-    """The first (0) or second (1) half of a segment (2, 2): a tab clear of a narrow corner."""
-    mid = ends.mean(axis=0)
-    return np.array([ends[0], mid]) if which == 0 else np.array([mid, ends[1]])
+def _halves(ends: np.ndarray, which: int) -> np.ndarray:
+    """The first (0) or second (1) halves of segments (n, 2, 2): tabs clear of a narrow corner."""
+    mid = (ends[:, 0] + ends[:, 1]) / 2
+    return np.stack([ends[:, 0], mid] if which == 0 else [mid, ends[:, 1]], axis=1)
 
 
-def _readable(angle: float) -> float:
-    """Text angle in (-90, 90] so that labels are never upside down."""
+def _readable(angle: np.ndarray) -> np.ndarray:
+    """Text angles in (-90, 90] so that labels are never upside down."""
     a = (angle + 180.0) % 360.0 - 180.0
-    if a <= -90:
-        a += 180
-    elif a > 90:
-        a -= 180
-    return a
+    return np.where(a <= -90, a + 180, np.where(a > 90, a - 180, a))
+
+
+def _closed_polygons(rings: np.ndarray) -> np.ndarray:
+    """Shapely polygons of rings (n, k, 2) (closed here; faster than ``shapely.polygons`` of
+    the bare coordinates)."""
+    return shapely.polygons(shapely.linearrings(np.concatenate([rings, rings[:, :1]], axis=1)))
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """z of the cross products of 2D vectors (..., 2)."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _side_normals(poly: np.ndarray) -> np.ndarray:
+    """Unit normals (n, k, 2) of the sides of polygons (n, k, 2), to the left of each side
+    (NaN for a side of no length)."""
+    edge = _next(poly) - poly
+    u = np.empty_like(edge)
+    u[..., 0], u[..., 1] = -edge[..., 1], edge[..., 0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u /= np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)[..., None]
+    return u
+
+
+def _next(poly: np.ndarray) -> np.ndarray:
+    """``np.roll(poly, -1, axis=1)``, faster: the corner after each corner of polygons."""
+    out = np.empty_like(poly)
+    out[:, :-1], out[:, -1] = poly[:, 1:], poly[:, 0]
+    return out
+
+
+def inward_lines(quads: np.ndarray):
+    """The sides of convex polygons as half-planes.
+
+    Parameters
+    ----------
+    quads : (n, k, 2) float
+        Convex polygons, either orientation.
+
+    Returns
+    -------
+    normal : (n, k, 2) float
+        Unit inward normals of the sides.
+    offset : (n, k) float
+        A point ``x`` is inside side ``j`` of polygon ``i`` where
+        ``normal[i, j] @ x >= offset[i, j]``.
+    """
+    area2 = _cross(quads, _next(quads)).sum(axis=1)
+    normal = _side_normals(quads)
+    normal[~(area2 >= 0)] *= -1
+    return normal, normal[..., 0] * quads[..., 0] + normal[..., 1] * quads[..., 1]
+
+
+def shrink_convex(quads: np.ndarray, by, normal: np.ndarray | None = None) -> np.ndarray:
+    """Convex polygons (n, k, 2) with every side moved inwards by ``by`` (corners mitred);
+    ``normal``: their unit inward normals, if known (:func:`inward_lines`)."""
+    if normal is None:
+        normal, _ = inward_lines(quads)
+    prev = np.roll(normal, 1, axis=1)  # the side before each corner
+    dot = prev[..., 0] * normal[..., 0] + prev[..., 1] * normal[..., 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mitre = (prev + normal) / (1 + dot)[..., None]
+    return quads + np.asarray(by, dtype=np.float64).reshape(-1, 1, 1) * mitre
+
+
+def _project(axes: np.ndarray, poly: np.ndarray):
+    """Smallest and largest projections (n, a) of polygons (n, k, 2) on axes (n, a, 2)."""
+    t = [
+        axes[..., 0] * poly[:, i, None, 0] + axes[..., 1] * poly[:, i, None, 1]
+        for i in range(poly.shape[1])
+    ]
+    return np.minimum.reduce(t), np.maximum.reduce(t)
+
+
+def sat_gap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Signed gap between convex polygons, by separating axes.
+
+    Parameters
+    ----------
+    a, b : (n, ka, 2), (n, kb, 2) float
+        Convex polygons, either orientation (repeated corners allowed).
+
+    Returns
+    -------
+    (n,) float
+        The widest gap between the projections of ``a[i]`` and ``b[i]`` on the unit normals of
+        their sides: > 0, the polygons are that far apart; < 0, they overlap by at least that
+        much along every side normal, so they intersect. Sides of no length are skipped.
+    """
+    axes = np.concatenate([_side_normals(a), _side_normals(b)], axis=1)
+    lo_a, hi_a = _project(axes, a)
+    lo_b, hi_b = _project(axes, b)
+    gap = np.maximum(lo_b - hi_a, lo_a - hi_b)
+    return _fold(np.maximum, np.where(np.isnan(gap), -np.inf, gap))
+
+
+def convex_overlap(a: np.ndarray, b: np.ndarray):
+    """Area of the overlap of convex polygons, by Green's theorem on their clipped sides.
+
+    Parameters
+    ----------
+    a, b : (n, ka, 2), (n, kb, 2) float
+        Convex polygons, either orientation (repeated corners allowed).
+
+    Returns
+    -------
+    area : (n,) float
+        Area of ``a[i]`` and ``b[i]`` overlapping.
+    empty : (n,) bool
+        Whether no side of either has a piece inside the other (they are apart).
+    doubt : (n,) bool
+        Where a corner lies exactly on the line of a side of the other: sides may overlap
+        there, and count twice; ask :func:`clip_area`.
+    """
+    sign_a, sign_b = np.sign(_signed_area2(a)), np.sign(_signed_area2(b))
+    s1, in1, doubt1 = _sides_inside(a, b, sign_b)
+    s2, in2, doubt2 = _sides_inside(b, a, sign_a)
+    return np.abs(sign_a * s1 + sign_b * s2) / 2, ~in1 & ~in2, doubt1 | doubt2
+
+
+def _signed_area2(poly: np.ndarray) -> np.ndarray:
+    """Twice the signed areas (n,) of polygons (n, k, 2), about their first corners."""
+    local = poly - poly[:, :1]
+    return _cross(local, _next(local)).sum(axis=1)
+
+
+def _sides_inside(p: np.ndarray, q: np.ndarray, sign_q: np.ndarray):
+    """The sides of polygons ``p`` clipped to the convex polygons ``q`` (their orientations
+    ``sign_q``): the sums (n,) of ``cross(start, end)`` of the pieces inside, whether any
+    piece is, and whether a corner of ``p`` lies on the line of a side of ``q``."""
+    a = p
+    b = _next(p)
+    lo = np.zeros(a.shape[:2])
+    hi = np.ones(a.shape[:2])
+    out = np.zeros(a.shape[:2], dtype=bool)
+    doubt = np.zeros(a.shape[:2], dtype=bool)
+    q_next = _next(q)
+    for j in range(q.shape[1]):
+        ex, ey = q_next[:, j, 0] - q[:, j, 0], q_next[:, j, 1] - q[:, j, 1]
+        nx, ny = (-ey * sign_q)[:, None], (ex * sign_q)[:, None]  # inward
+        qx, qy = q[:, j, 0, None], q[:, j, 1, None]
+        da = nx * (a[..., 0] - qx) + ny * (a[..., 1] - qy)
+        db = nx * (b[..., 0] - qx) + ny * (b[..., 1] - qy)
+        side = ((ex != 0) | (ey != 0))[:, None]
+        doubt |= side & ((da == 0) | (db == 0))
+        out |= (da < 0) & (db < 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = da / (da - db)
+        enter, leave = (da < 0) & (db >= 0), (db < 0) & (da >= 0)
+        np.maximum(lo, t, out=lo, where=enter)
+        np.minimum(hi, t, out=hi, where=leave)
+    keep = ~out & (lo < hi)
+    d = b - a
+    start, end = a + lo[..., None] * d, a + hi[..., None] * d
+    return np.where(keep, _cross(start, end), 0.0).sum(axis=1), keep.any(axis=1), doubt.any(1)
+
+
+def clip_area(poly: np.ndarray, normal: np.ndarray, offset: np.ndarray):
+    """Area of polygons clipped by half-planes (Sutherland-Hodgman), in batches.
+
+    Parameters
+    ----------
+    poly : (n, k, 2) float
+        Simple polygons (either orientation, convex or not), padded by repeating a corner.
+    normal, offset : (n, h, 2), (n, h) float
+        The half-planes ``normal[i, j] @ x >= offset[i, j]`` clipping ``poly[i]`` (together a
+        convex region).
+
+    Returns
+    -------
+    area : (n,) float
+        Area of each clipped polygon (0 where empty).
+    empty : (n,) bool
+        Whether no corner is left at all.
+    """
+    n = len(poly)
+    rows = np.arange(n)[:, None]
+    cnt = np.full(n, poly.shape[1])
+    for j in range(normal.shape[1]):
+        k = poly.shape[1]
+        if k == 0:
+            break
+        dist = (
+            poly[..., 0] * normal[:, j, None, 0]
+            + poly[..., 1] * normal[:, j, None, 1]
+            - offset[:, j, None]
+        )
+        slot = np.arange(k)
+        live = slot < cnt[:, None]
+        prev_i = np.where(slot == 0, cnt[:, None] - 1, slot - 1) * live
+        prev, dprev = poly[rows, prev_i], dist[rows, prev_i]
+        inside, inside_prev = dist >= 0, dprev >= 0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = dprev / (dprev - dist)  # where used, the two ends are on either side
+            cross = prev + t[..., None] * (poly - prev)
+        out = np.stack([cross, poly], axis=2).reshape(n, 2 * k, 2)
+        keep = np.stack([live & (inside != inside_prev), live & inside], axis=2).reshape(n, -1)
+        cnt = keep.sum(axis=1)
+        dest = np.cumsum(keep, axis=1) - 1
+        new = np.zeros((n, int(cnt.max(initial=0)), 2))
+        r, c = np.nonzero(keep)
+        new[r, dest[r, c]] = out[r, c]
+        poly = new
+    k = poly.shape[1]
+    slot = np.arange(k)
+    live = slot < cnt[:, None]
+    nxt = poly[rows, np.where(slot + 1 >= cnt[:, None], 0, slot + 1)]
+    area = np.abs(np.sum(np.where(live, _cross(poly, nxt), 0.0), axis=1)) / 2
+    return area, cnt == 0
+
+
+def _fold(op, a: np.ndarray, axis: int = 1) -> np.ndarray:
+    """``op.reduce(a, axis)`` over a short axis, a slice at a time (numpy is slow at reducing
+    many short rows; ``op`` is ``np.maximum``, ``np.minimum``, ``np.logical_and``, ...)."""
+    parts = np.moveaxis(a, axis, 0)
+    out = parts[0].copy()
+    for x in parts[1:]:
+        op(out, x, out=out)
+    return out
+
+
+def _colmax(a: np.ndarray) -> np.ndarray:
+    """Row maxima of a narrow (n, k) array."""
+    return _fold(np.maximum, a)
+
+
+def _absmax(a: np.ndarray) -> np.ndarray:
+    """(n,) float: the largest absolute value of every ``a[i]`` (n, k, 2)."""
+    return _fold(np.maximum, np.abs(a).reshape(len(a), -1))
+
+
+def _pad(a: np.ndarray, width: int) -> np.ndarray:
+    """An (n, k) array widened to (n, width) by repeating its last column."""
+    if a.shape[1] == width:
+        return a
+    return np.concatenate([a, np.repeat(a[:, -1:], width - a.shape[1], axis=1)], axis=1)
+
+
+def _bucket(size: np.ndarray) -> np.ndarray:
+    """Corner counts up to 8, larger ones rounded up to a power of two: faces padded together."""
+    up = (2 ** np.ceil(np.log2(np.maximum(size, 1)))).astype(np.int64)
+    return np.where(size <= 8, np.maximum(size, 1), up)
+
+
+def _padded(coords: np.ndarray, flat: np.ndarray, start: np.ndarray, faces: np.ndarray, k: int):
+    """The corners (len(faces), k, 2) of faces of at most ``k`` corners, the last repeated."""
+    size = start[faces + 1] - start[faces]
+    slot = np.minimum(np.arange(k), size[:, None] - 1)
+    return coords[flat[start[faces][:, None] + slot]]
+
+
+def _convex(corners: np.ndarray) -> np.ndarray:
+    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12)."""
+    edge = _next(corners) - corners
+    length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turn = _cross(edge, _next(edge)) / (length * _next(length))
+    turn = np.where(np.isnan(turn), 0.0, turn)  # repeated corners turn by nothing
+    return _fold(np.logical_and, turn >= -1e-12) | _fold(np.logical_and, turn <= 1e-12)
+
+
+def _surely_valid(quads: np.ndarray) -> np.ndarray:
+    """(n,) bool: quadrilaterals that are strictly convex by a margin far above round-off (so
+    valid polygons); False means "ask shapely"."""
+    edge = _next(quads) - quads
+    length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        turn = _cross(edge, _next(edge)) / (length * _next(length))
+        return _fold(np.logical_and, turn > 1e-6) | _fold(np.logical_and, turn < -1e-6)
+
+
+def _area(quads: np.ndarray) -> np.ndarray:
+    """Areas (n,) of polygons (n, k, 2), about their first corners."""
+    local = quads - quads[:, :1]
+    return np.abs(np.sum(_cross(local, _next(local)), axis=1)) / 2
+
+
+class _Grid:
+    """Boxes filed in the cells of a uniform grid, to find the boxes another box overlaps.
+
+    Parameters
+    ----------
+    lo, hi : (n, 2) float
+        Lower and upper corners of the boxes (a box with a corner not finite is left out).
+    """
+
+    def __init__(self, lo: np.ndarray, hi: np.ndarray):
+        self.box = np.concatenate([lo, hi], axis=1)  # (n, 4): x0, y0, x1, y1
+        kept = np.flatnonzero(np.isfinite(self.box).all(axis=1))
+        self.origin, self.cell, self.shape = np.zeros(2), 1.0, np.ones(2, dtype=np.int64)
+        self.low = np.zeros((len(lo), 2), dtype=np.int64)  # the first cell of each box
+        self.items = np.zeros(0, dtype=np.int64)
+        self.start = np.zeros(2, dtype=np.int64)
+        if not len(kept):
+            return
+        lo, hi = lo[kept], hi[kept]
+        self.origin = lo.min(axis=0)
+        span = max(float(np.max(hi.max(axis=0) - self.origin)), 1e-300)
+        # about a box per cell; larger cells while the boxes would fill too many of them
+        cell = max(float(np.median(np.max(hi - lo, axis=1))), span / 4096, 1e-300)
+        while True:
+            self.cell = cell
+            self.shape = np.floor((hi.max(axis=0) - self.origin) / cell).astype(np.int64) + 1
+            c0, c1 = self._cells(lo, hi)
+            if np.prod(c1 - c0 + 1, axis=1).sum() <= 8 * len(kept) + 1024:
+                break
+            cell *= 2
+        self.low[kept] = c0
+        keys, items, _, _ = self._entries(c0, c1, kept)
+        order = np.argsort(keys)
+        self.items = items[order]
+        # the entries of cell k: items[start[k]:start[k + 1]]
+        self.start = np.searchsorted(keys[order], np.arange(int(np.prod(self.shape)) + 1))
+
+    def _cells(self, lo, hi):
+        """The first and last cells (n, 2) that boxes cover, clipped to the grid."""
+        c0 = np.floor((lo - self.origin) / self.cell)
+        c1 = np.floor((hi - self.origin) / self.cell)
+        top = self.shape - 1
+        return np.clip(c0, 0, top).astype(np.int64), np.clip(c1, -1, top).astype(np.int64)
+
+    def _entries(self, c0, c1, items):
+        """(cell key, item, cell x, cell y) of every cell of every box."""
+        w = np.maximum(c1 - c0 + 1, 0)
+        count = w[:, 0] * w[:, 1]
+        item = np.repeat(np.arange(len(c0)), count)
+        k = np.arange(len(item)) - np.repeat(np.cumsum(count) - count, count)
+        wy = np.maximum(w[item, 1], 1)
+        ix, iy = c0[item, 0] + k // wy, c0[item, 1] + k % wy
+        return ix * self.shape[1] + iy, items[item], ix, iy
+
+    def query(self, lo: np.ndarray, hi: np.ndarray):
+        """The pairs of a box (``lo``, ``hi``: (m, 2)) and a filed box that overlap (closed).
+
+        Returns
+        -------
+        (k,) int, (k,) int
+            The boxes asked and the filed ones, in the order of the boxes asked.
+        """
+        if not len(lo) or not len(self.items):
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        box = np.concatenate([lo, hi], axis=1)
+        finite = np.isfinite(box).all(axis=1)
+        c0, c1 = self._cells(np.where(finite[:, None], lo, 0), np.where(finite[:, None], hi, -1))
+        c1[~finite] = -1
+        keys, asked, ix, iy = self._entries(c0, c1, np.arange(len(lo)))
+        first = self.start[keys]
+        count = self.start[keys + 1] - first
+        which = np.repeat(np.arange(len(keys)), count)
+        at = np.arange(len(which)) + np.repeat(first - np.cumsum(count) + count, count)
+        a, b = asked[which], self.items[at]
+        # each pair once: in the cell of the low corner of the two boxes' overlap
+        low_a, low_b = c0[a], self.low[b]
+        keep = (np.maximum(low_a[:, 0], low_b[:, 0]) == ix[which]) & (
+            np.maximum(low_a[:, 1], low_b[:, 1]) == iy[which]
+        )
+        a, b = a[keep], b[keep]
+        qa, fb = box[a], self.box[b]
+        keep = (qa[:, 0] <= fb[:, 2]) & (fb[:, 0] <= qa[:, 2])
+        keep &= (qa[:, 1] <= fb[:, 3]) & (fb[:, 1] <= qa[:, 3])
+        return a[keep], b[keep]
+
+
+def _boxes(quads: np.ndarray):
+    """Lower and upper corners (n, 2) of the boxes of polygons (n, k, 2)."""
+    with np.errstate(invalid="ignore"):
+        return _fold(np.minimum, quads), _fold(np.maximum, quads)
+
+
+class _Faces:
+    """The faces of a pattern, for testing tabs against them (:meth:`clear`).
+
+    Parameters
+    ----------
+    p : CreasePattern
+    tab_height : float
+
+    Notes
+    -----
+    Faces of ``k`` corners (:func:`_bucket`) are held together: their corners ``x, y`` and,
+    for the convex ones, their sides' unit normals ``ux, uy`` and the faces' extents ``lo, hi``
+    along them (separating axes), each (n_k, k). Shapely polygons are made only for the
+    faces that need them: those whose validity is in doubt, and those of pairs that the
+    arrays leave undecided.
+    """
+
+    def __init__(self, p, tab_height):
+        self.h, self.s = tab_height, SHRINK * tab_height
+        self.coords = p.vertices_2d
+        self.flat, self.start = face_arrays(p.faces)
+        n = len(self.start) - 1
+        size = np.diff(self.start)
+        self.bucket = _bucket(size)
+        self.row = np.zeros(n, dtype=np.int64)
+        self.convex = np.zeros(n, dtype=bool)
+        valid = np.zeros(n, dtype=bool)
+        finite = np.zeros(n, dtype=bool)
+        lo, hi = np.full((n, 2), np.nan), np.full((n, 2), np.nan)
+        self.sets = {}
+        for k in np.unique(self.bucket).tolist():
+            faces = np.flatnonzero(self.bucket == k)
+            self.row[faces] = np.arange(len(faces))
+            corners = _padded(self.coords, self.flat, self.start, faces, k)
+            finite[faces] = np.isfinite(corners).all(axis=(1, 2))
+            lo[faces], hi[faces] = _boxes(corners)
+            if k <= 8:  # not padded: strictly convex is valid, no need to ask shapely
+                valid[faces] = _surely_valid(corners)
+            self.convex[faces] = _convex(corners)
+            u = _side_normals(corners)
+            t = [
+                u[..., 0] * corners[:, i, None, 0] + u[..., 1] * corners[:, i, None, 1]
+                for i in range(k)
+            ]
+            self.sets[k] = (corners[..., 0], corners[..., 1], u[..., 0], u[..., 1])
+            self.sets[k] += (np.minimum.reduce(t), np.maximum.reduce(t))
+        self.polys: dict[int, object] = {}
+        doubt = np.flatnonzero(~valid)
+        if len(doubt):  # a face that is not a valid polygon is taken as its valid part
+            shapes = self.polygons(doubt)
+            ok = shapely.is_valid(shapes)
+            valid[doubt] = ok
+            fixed = shapely.make_valid(shapes[~ok])
+            self.polys.update(zip(doubt[~ok].tolist(), fixed, strict=True))
+        self.fast = valid & finite  # the faces that the array tests may decide
+        self.extent = np.max(hi - lo, axis=1)
+        self.grid = _Grid(lo, hi)
+
+    def polygons(self, faces: np.ndarray) -> np.ndarray:
+        """Shapely geometries of faces (made once; an invalid face as its valid part)."""
+        new = [f for f in dict.fromkeys(faces.tolist()) if f not in self.polys]
+        if new:
+            new = np.asarray(new, dtype=np.int64)
+            size = self.start[new + 1] - self.start[new]
+            corner = np.repeat(self.start[new] - np.cumsum(size) + size, size) + np.arange(
+                size.sum()
+            )
+            ring = shapely.linearrings(
+                self.coords[self.flat[corner]], indices=np.repeat(np.arange(len(new)), size)
+            )
+            self.polys.update(zip(new.tolist(), shapely.polygons(ring), strict=True))
+        return np.array([self.polys[f] for f in faces.tolist()], dtype=object)
+
+    def areas(self) -> np.ndarray:
+        """(n_faces,) float: the faces' areas, as shapely gives them within round-off."""
+        area = np.zeros(len(self.bucket))
+        for k, (fx, fy, *_) in self.sets.items():
+            faces = np.flatnonzero(self.bucket == k)
+            x, y = fx - fx[:, :1], fy - fy[:, :1]
+            area[faces] = np.abs(np.sum(x * _next(y) - y * _next(x), axis=1)) / 2
+        fixed = [f for f in self.polys if not self.fast[f]]
+        if fixed:
+            area[fixed] = shapely.area(self.polygons(np.asarray(fixed, dtype=np.int64)))
+        return area
+
+    def clear(self, quads, area, hint=None) -> np.ndarray:
+        """Tabs that overlap no face: shapely's verdict on each, had it been asked.
+
+        Parameters
+        ----------
+        quads : (n, 4, 2) float
+            Tabs (valid convex polygons), their hinge first.
+        area : (n,) float
+            Their areas.
+        hint : (n,) int, optional
+            A face likely to overlap each tab (-1: none), tested first.
+
+        Returns
+        -------
+        (n,) int
+            -1 where the tab shrunk by ``SHRINK`` of the tab height overlaps no face by more
+            than ``OVERLAP`` of its area, else a face it overlaps.
+        """
+        n = len(quads)
+        blocker = np.full(n, -1, dtype=np.int64)
+        if n == 0 or len(self.bucket) == 0:
+            return blocker
+        s = self.s
+        local = quads - quads[:, :1]
+        normal, offset = inward_lines(local)
+        perimeter = np.sum(np.linalg.norm(local - _next(local), axis=-1), axis=1)
+        # the region s / 2 inside the tab: apart from it by s / 4, a face is apart from the
+        # shrunk tab whatever round-off shapely and these figures make (checked by `sure`)
+        frame = {
+            "origin": quads[:, 0],
+            "normal": normal,
+            "offset": offset + s / 2,
+            "inner": shrink_convex(local, s / 2, normal),  # about the origin
+            "least": 1e-9 * area + 2 * s * perimeter,
+            "reach": _absmax(quads) + _absmax(local) + self.h,
+        }
+        if hint is not None:
+            t = np.flatnonzero(hint >= 0)
+            self._pairs(frame, t, hint[t], blocker, None)
+        rest = np.flatnonzero(blocker < 0)
+        i, faces = self.grid.query(*_boxes(quads[rest]))
+        tabs = rest[i]
+        slow = []
+        self._pairs(frame, tabs, faces, blocker, slow)
+        slow = np.concatenate(slow)
+        slow = slow[blocker[tabs[slow]] < 0]
+        if len(slow):
+            hit = self._exact(quads, tabs[slow], faces[slow])
+            blocker[tabs[slow[hit]]] = faces[slow[hit]]
+        return blocker
+
+    def _pairs(self, frame, tabs, faces, blocker, slow):
+        """Test pairs of a tab and a face; set ``blocker`` of the tabs found overlapping.
+
+        With ``slow`` (a list), the pairs are first tested for separating axes, and those the
+        arrays leave undecided are appended to it (as indices into ``tabs``); without, the
+        pairs are only clipped, and the undecided ones dropped.
+        """
+        s = self.s
+        reach = self.extent[faces] + frame["reach"][tabs]
+        sure = self.fast[faces] & (16 * EPS * reach < s / 4)
+        if slow is not None:
+            slow.append(np.flatnonzero(~sure))
+        todo = np.flatnonzero(sure)
+        bucket = self.bucket[faces[todo]]
+        normal, offset = frame["normal"], frame["offset"]
+        kept = []
+        for k in self.sets:
+            pair = todo[bucket == k]
+            if not len(pair):
+                continue
+            fx, fy, ux, uy, lo, hi = self.sets[k]
+            t, row = tabs[pair], self.row[faces[pair]]
+            x = fx[row] - frame["origin"][t, 0, None]
+            y = fy[row] - frame["origin"][t, 1, None]
+            live = np.arange(len(pair))
+            if slow is not None:
+                # apart along a side of the tab (its hinge first: its own piece's faces)
+                for j in range(4):
+                    tl = t[live]
+                    d = _colmax(x[live] * normal[tl, j, 0, None] + y[live] * normal[tl, j, 1, None])
+                    live = live[~(d - offset[tl, j] < -s / 4)]
+                # apart along a side of a convex face
+                conv = live[self.convex[faces[pair[live]]]]
+                if len(conv):
+                    r, tc = row[conv], t[conv]
+                    inner = frame["inner"][tc] + frame["origin"][tc, None]
+                    proj = [
+                        ux[r] * inner[:, i, 0, None] + uy[r] * inner[:, i, 1, None]
+                        for i in range(4)
+                    ]
+                    low, high = np.minimum.reduce(proj), np.maximum.reduce(proj)
+                    gap = np.maximum(low - hi[r], lo[r] - high)
+                    apart = _fold(np.logical_or, gap > s / 4)  # NaN (no length): not apart
+                    drop = np.zeros(len(pair), dtype=bool)
+                    drop[conv[apart]] = True
+                    live = live[~drop[live]]
+            kept.append((pair[live], x[live], y[live]))
+        if not kept:
+            return
+        # a tab is blocked by its first overlapping face: clip the first pair of every tab,
+        # then the others of the tabs still clear (faces padded to as many corners)
+        width = max(x.shape[1] for _, x, _ in kept)
+        pair = np.concatenate([p for p, _, _ in kept])
+        poly = np.concatenate(
+            [np.stack([_pad(x, width), _pad(y, width)], axis=-1) for _, x, y in kept]
+        )
+        t = tabs[pair]
+        first = np.zeros(len(pair), dtype=bool)
+        first[np.unique(t, return_index=True)[1]] = True
+        for part in (np.flatnonzero(first), np.flatnonzero(~first)):
+            part = part[blocker[t[part]] < 0]
+            if not len(part):
+                continue
+            tp = t[part]
+            got, empty, doubt = convex_overlap(poly[part], frame["inner"][tp])
+            doubt |= ~self.convex[faces[pair[part]]]
+            if doubt.any():  # Sutherland-Hodgman: faces not convex, touching sides
+                d = np.flatnonzero(doubt)
+                got[d], empty[d] = clip_area(poly[part[d]], normal[tp[d]], offset[tp[d]])
+            big = ~empty & (got > frame["least"][tp])
+            blocker[tp[big]] = faces[pair[part[big]]]
+            if slow is not None:
+                slow.append(pair[part[~empty & ~big]])
+
+    def _exact(self, quads, tabs, faces):
+        """Blocked pairs of a tab and a face, by shapely on the tab shrunk by ``SHRINK``."""
+        uniq, inv = np.unique(tabs, return_inverse=True)
+        shapes = _closed_polygons(quads[uniq])
+        shrunk, area = _shrunk(shapes, self.s), shapely.area(shapes)
+        polys = self.polygons(faces)
+        blocked = np.zeros(len(tabs), dtype=bool)
+        for i in range(len(tabs)):  # few: faces made valid, far coordinates, grazing pairs
+            g, face = shrunk[inv[i]], polys[i]
+            if g is None:
+                blocked[i] = True
+                continue
+            if not shapely.intersects(shapely.box(*g.bounds), shapely.box(*face.bounds)):
+                continue  # not a pair STRtree.query(shrunk) gives
+            try:
+                blocked[i] = face.intersection(g).area > OVERLAP * area[inv[i]]
+            except shapely.errors.GEOSException:
+                blocked[i] = True
+        return blocked
+
+
+def conflicts(
+    earlier: np.ndarray, later: np.ndarray, shrink: float, *, exact: bool = True
+) -> np.ndarray:
+    """Whether tabs intersect tabs shrunk by ``shrink``: shapely's verdict, had it been asked.
+
+    Parameters
+    ----------
+    earlier, later : (n, 4, 2) float
+        Convex tabs; each ``later[i]`` is shrunk and tested against ``earlier[i]``.
+    shrink : float
+    exact : bool
+        False: the pairs the arrays leave undecided count as intersecting (a bound).
+
+    Returns
+    -------
+    (n,) bool
+    """
+    if not len(later):
+        return np.zeros(0, dtype=bool)
+    origin = later[:, :1]
+    a, b = earlier - origin, shrink_convex(later - origin, shrink)
+    gap = sat_gap(a, b)
+    scale, reach = _absmax(later), _absmax(a)
+    sure = 16 * EPS * (reach + scale + shrink / SHRINK) < shrink / 4
+    hit = ~(sure & (gap > shrink / 4))
+    slow = np.flatnonzero(~sure | ~((gap > shrink / 4) | (gap < -shrink / 4)))
+    if exact and len(slow):
+        tabs = _closed_polygons(earlier[slow])
+        shrunk = _shrunk(_closed_polygons(later[slow]), shrink)
+        for i, k in enumerate(slow.tolist()):
+            try:
+                hit[k] = shrunk[i] is None or bool(tabs[i].intersects(shrunk[i]))
+            except shapely.errors.GEOSException:
+                hit[k] = True
+    return hit
+
+
+def _shrunk(tabs: np.ndarray, by: float) -> list:
+    """Tabs buffered by ``-by``, as shapely buffers one (None where that fails)."""
+    out = []
+    for g in tabs:
+        try:
+            out.append(g.buffer(-by))
+        except shapely.errors.GEOSException:
+            out.append(None)
+    return out
 
 
 def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None) -> dict:
@@ -141,98 +918,306 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         ``untabbed`` (cut borders where no tab fits: they keep their two labels) and ``seams``
         (per label: the two pieces it joins and the piece carrying the tab).
     """
-    polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
-    if polys:  # a face that is not a valid polygon is taken as its valid part (tabs only)
-        valid = shapely.is_valid(polys)
-        if not valid.all():
-            fixed = shapely.make_valid(np.asarray(polys, dtype=object)[~valid])
-            for i, g in zip(np.flatnonzero(~valid).tolist(), fixed, strict=True):
-                polys[i] = g
-    tree = shapely.STRtree(polys)
-    placed_tabs: list = []
+    faces = _Faces(p, tab_height)
     ann = Annotations(sheets=p.annotations.sheets)
     label_h = 0.45 * tab_height
-    stats = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
-    seams = []
-
-    tab_boxes = np.zeros((0, 4))  # bounds of the placed tabs, to test only the nearby ones
-
-    def clear(tab: shapely.Polygon) -> bool:
-        """Whether the tab overlaps no face and no placed tab (False too when its geometry
-        fails: a tab is an annotation, its border then keeps its labels)."""
-        try:
-            return _clear(tab)
-        except shapely.errors.GEOSException:
-            return False
-
-    def _clear(tab: shapely.Polygon) -> bool:
-        shrunk = tab.buffer(-1e-9 * tab_height)
-        for i in tree.query(shrunk):
-            if polys[int(i)].intersection(shrunk).area > 1e-12 * tab.area:
-                return False
-        x0, y0, x1, y1 = shrunk.bounds
-        near = np.nonzero(
-            (tab_boxes[:, 0] <= x1) & (tab_boxes[:, 2] >= x0)
-            & (tab_boxes[:, 1] <= y1) & (tab_boxes[:, 3] >= y0)
-        )[0]  # fmt: skip
-        return not any(placed_tabs[int(i)].intersects(shrunk) for i in near)
-
-    runs, run_edges = [], []
-    for side_a, side_b in _runs(p, _seam_pairs(p)):
-        sides = [_segment(p, side_a), _segment(p, side_b)]
-        if np.linalg.norm(sides[0][0][1] - sides[0][0][0]) > 1e-6 * tab_height:
-            runs.append(sides)  # shorter runs are slivers of round-off, not borders
-            run_edges.append((side_a, side_b))
+    side_a, side_b, start = _runs(p, _seam_pairs(p))
+    ends = np.zeros((0, 2, 2, 2))
+    normal = np.zeros((0, 2, 2))
+    first_a = first_b = np.zeros(0, dtype=np.int64)
+    if len(start) > 1:
+        ea, na = _segments(p, side_a, start)
+        eb, nb = _segments(p, side_b, start)
+        long = _rownorm(ea[:, 1] - ea[:, 0]) > 1e-6 * tab_height  # shorter: round-off slivers
+        ends, normal = np.stack([ea, eb], axis=1)[long], np.stack([na, nb], axis=1)[long]
+        first_a, first_b = side_a[start[:-1][long]], side_b[start[:-1][long]]
+    n_runs = len(ends)
     piece_of_edge = p.face_piece[p.edge_faces.max(axis=1)]
     names = part_names or [f"P{k + 1}" for k in range(p.n_pieces)]
-    for n, sides in enumerate(runs, start=1):
-        stats["cut_borders"] += 1
-        tab_on = None
-        done = False
-        for scale, part in ((1.0, None), (0.5, None), (0.5, 0), (0.5, 1), (0.25, 0), (0.25, 1)):
-            for ends, normal in sides:
-                sub = ends if part is None else _half(ends, part)
-                poly = _tab_polygon(sub, normal, scale * tab_height)
-                if poly is None:
-                    continue
-                tab = shapely.Polygon(poly)
-                if tab.is_valid and tab.area > 1e-3 * (scale * tab_height) ** 2 and clear(tab):
-                    if tab.exterior.is_ccw is False:
-                        poly = poly[::-1]
-                    ann.tabs.append(poly)
-                    ann.tab_hinges.append(sub.copy())
-                    placed_tabs.append(tab)
-                    tab_boxes = np.vstack([tab_boxes, tab.bounds])
-                    stats["tabs"] += 1
-                    stats["tabs_reduced"] += scale < 1
-                    tab_on = 0 if ends is sides[0][0] else 1
-                    done = True
-                    break
-            if done:
-                break
-        if not done:
-            stats["untabbed"] += 1
-        pieces = [names[piece_of_edge[edges[0]]] for edges in run_edges[n - 1]]
-        seams.append(
-            {"label": n, "pieces": pieces, "tab_on": None if tab_on is None else pieces[tab_on]}
+    stats = {"cut_borders": n_runs, "tabs": 0, "tabs_reduced": 0, "untabbed": n_runs}
+    seams = []
+    if n_runs:
+        run, level, side, quads, hinges = _choose(faces, ends, normal, tab_height)
+        stats["tabs"] = len(run)
+        stats["tabs_reduced"] = int(np.count_nonzero(level > 0))
+        stats["untabbed"] = n_runs - len(run)
+        ann.tabs.extend(list(quads))
+        ann.tab_hinges.extend(list(hinges))
+        tab_on = np.full(n_runs, -1)
+        tab_on[run] = side
+        a = [names[k] for k in piece_of_edge[first_a].tolist()]
+        b = [names[k] for k in piece_of_edge[first_b].tolist()]
+        for n, (pa, pb, on) in enumerate(zip(a, b, tab_on.tolist(), strict=True)):
+            tab = None if on < 0 else (pa, pb)[on]
+            seams.append({"label": n + 1, "pieces": [pa, pb], "tab_on": tab})
+        d = ends[:, :, 1] - ends[:, :, 0]
+        pos = (ends[:, :, 0] + ends[:, :, 1]) / 2 - 0.9 * label_h * normal
+        angle = _readable(np.degrees(np.arctan2(d[..., 1], d[..., 0])))
+        text = [""] * (2 * n_runs)
+        text[::2] = text[1::2] = list(map(str, range(1, n_runs + 1)))
+        ann.labels.extend(
+            Label(xy, t, a, label_h, "tab")
+            for xy, t, a in zip(pos.reshape(-1, 2), text, angle.ravel(), strict=True)
         )
-        for ends, normal in sides:
-            d = ends[1] - ends[0]
-            pos = ends.mean(axis=0) - 0.9 * label_h * normal
-            ann.labels.append(
-                Label(pos, f"{n}", _readable(np.degrees(np.arctan2(d[1], d[0]))), label_h, "tab")
-            )
-    area = shapely.area(polys) if polys else np.zeros(0)
-    for k in range(p.n_pieces):
-        faces = np.nonzero(p.face_piece == k)[0]
-        if not len(faces):
-            continue
-        # the part number goes inside the piece's largest face
-        where = polys[int(faces[np.argmax(area[faces])])].representative_point()
-        ann.labels.append(Label(np.array([where.x, where.y]), names[k], 0.0, 2 * label_h, "part"))
+    ann.labels.extend(_part_labels(p, faces, names, label_h))
     p.annotations = ann
     stats["seams"] = seams
     return stats
+
+
+def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list:
+    """Every piece's part number, inside its largest face (the first of the largest, by
+    shapely's areas: asked where two are within round-off)."""
+    n = len(faces.bucket)
+    piece = p.face_piece
+    inside = np.flatnonzero((piece >= 0) & (piece < p.n_pieces))
+    if not len(inside):
+        return []
+    area = faces.areas()
+    best = np.full(p.n_pieces, -np.inf)
+    np.maximum.at(best, piece[inside], area[inside])
+    close = inside[~(area[inside] < best[piece[inside]] * (1 - 1e-6))]  # NaN kept: ask
+    exact = np.full(n, -np.inf)
+    exact[close] = shapely.area(faces.polygons(close))
+    exact = np.where(np.isnan(exact), np.inf, exact)  # np.argmax takes a NaN first
+    order = close[np.lexsort((close, -exact[close], piece[close]))]
+    first = order[np.r_[True, piece[order][1:] != piece[order][:-1]]]
+    where = shapely.get_coordinates(shapely.point_on_surface(faces.polygons(first)))
+    return [
+        Label(xy.copy(), names[k], 0.0, 2 * label_h, "part")
+        for k, xy in zip(piece[first].tolist(), where, strict=True)
+    ]
+
+
+def _candidates(ends, normal, tab_height, cand):
+    """Candidate tabs ``cand`` (``border * 12 + 2 * level + side``, :data:`LEVELS`).
+
+    Returns
+    -------
+    quads : (n, 4, 2) float
+    hinges : (n, 2, 2) float
+    ok : (n,) bool
+        False where the hinge is too short for a tab.
+    height : (n,) float
+    """
+    quads = np.empty((len(cand), 4, 2))
+    hinges = np.empty((len(cand), 2, 2))
+    ok = np.zeros(len(cand), dtype=bool)
+    height = np.zeros(len(cand))
+    border, k = cand // (2 * len(LEVELS)), cand % (2 * len(LEVELS))
+    for level, (scale, part) in enumerate(LEVELS):
+        for side in (0, 1):
+            at = np.flatnonzero(k == 2 * level + side)
+            if not len(at):
+                continue
+            sub = ends[border[at], side]
+            sub = sub if part is None else _halves(sub, part)
+            height[at] = scale * tab_height
+            quads[at], ok[at] = tab_outlines(sub, normal[border[at], side], height[at])
+            hinges[at] = sub
+    return quads, hinges, ok, height
+
+
+def _untested(cand, side, tested, n_cand):
+    """Pairs of a candidate and each candidate not tested yet (beyond the first ``tested``)
+    of a border's side (``2 * border + A or B``), for every (``cand``, ``side``)."""
+    k = np.arange(tested, n_cand)
+    mask = k[None, :] % 2 == side[:, None] % 2
+    i, j = np.nonzero(mask)
+    return cand[i], (side[i] // 2) * n_cand + k[j]
+
+
+def _choose(faces: _Faces, ends, normal, tab_height):
+    """The greedy choice of a tab for every border (see :func:`add_tabs_and_labels`).
+
+    The candidates are tested in rounds (:data:`ROUNDS`) on the borders still undecided;
+    after each round, the greedy choice runs as far as it can: a border is decided when its
+    choice no longer depends on a candidate not tested yet, its own or that of an earlier,
+    undecided border.
+
+    Parameters
+    ----------
+    faces : _Faces
+    ends : (n, 2, 2, 2) float
+        Per border, per side (A, B): the border's end points.
+    normal : (n, 2, 2) float
+        Per border, per side: the outward unit normal.
+    tab_height : float
+
+    Returns
+    -------
+    run, level, side : (t,) int
+        The borders with a tab, and the level (:data:`LEVELS`) and side of their tab.
+    quads : (t, 4, 2) float
+        The tabs, counter-clockwise.
+    hinges : (t, 2, 2) float
+    """
+    n = len(ends)
+    s = SHRINK * tab_height
+    n_cand = 2 * len(LEVELS)  # candidate c of border r: r * n_cand + 2 * level + side
+    quads = np.empty((n * n_cand, 4, 2))  # filled as they are made, at row(c)
+    hinge = np.empty((n * n_cand, 2, 2))
+
+    def row(c):  # a round's candidates together
+        return (c % n_cand) * n + c // n_cand
+
+    # where any candidate of a border's side may lie: the rectangle of the full height on
+    # the border (per side 2 * border + A or B)
+    up = tab_height * normal[..., None, :]
+    envelope = np.concatenate([ends, ends[:, :, ::-1] + up], axis=2).reshape(2 * n, 4, 2)
+    sides = _Grid(*_boxes(envelope))
+    good = np.zeros((n, n_cand), dtype=bool)
+    state = _Greedy(n, n_cand)
+    blocker_of = np.full((n, 2), -1, dtype=np.int64)  # a face that blocked a side's last tab
+    undecided = np.arange(n)
+    for ks in ROUNDS:
+        c = tried = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
+        q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
+        quads[row(c)] = q
+        c, q, height = c[ok], q[ok], height[ok]
+        area, least = _area(q), 1e-3 * height**2
+        valid = _surely_valid(q)
+        doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > 1e-6 * least))
+        if len(doubt):
+            shapes = _closed_polygons(q[doubt])
+            valid[doubt], area[doubt] = shapely.is_valid(shapes), shapely.area(shapes)
+        keep = np.flatnonzero(valid & (area > least))
+        c, q, area = c[keep], q[keep], area[keep]
+        blocked = np.zeros(len(c), dtype=bool)
+        for level in np.unique(c % n_cand // 2).tolist():  # a side's last blocker first
+            at = np.flatnonzero(c % n_cand // 2 == level)
+            found = faces.clear(q[at], area[at], blocker_of[c[at] // n_cand, c[at] % 2])
+            hit = at[found >= 0]
+            blocked[hit] = True
+            blocker_of[c[hit] // n_cand, c[hit] % 2] = found[found >= 0]
+        c = c[~blocked]
+        good.flat[c] = True
+        state.tested(tried, good.flat[tried])
+        # the sides of other borders near the new candidates
+        i, j = sides.query(*_boxes(quads[row(c)]))
+        pc, ps = c[i], j
+        other = ps // 2 != pc // n_cand
+        pc, ps = pc[other], ps[other]
+        # earlier borders still undecided: the candidates not tested yet that each new one
+        # might meet (tested a few together: a full tab holds the half-height one, a half
+        # border's tab the quarter-height one)
+        lo = np.flatnonzero(ps // 2 < pc // n_cand)
+        lo = lo[state.undecided[ps[lo] // 2]]
+        lo = lo[conflicts(envelope[ps[lo]], quads[row(pc[lo])], s, exact=False)]
+        a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
+        holder = np.asarray(COVER)[b % n_cand]
+        cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
+        key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
+        held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
+        maybe = conflicts(held, quads[row(key // (n * n_cand))], s, exact=False) | ~fits
+        state.might_meet(a[maybe[inv]], b[maybe[inv]])
+        # the tested candidates of those sides: which tabs intersect which
+        rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
+        a, b = pc[rows], (ps[rows] // 2) * n_cand + ps[rows] % 2 + 2 * col
+        new_b = np.isin(b, c)
+        a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
+        later = np.where(a // n_cand > b // n_cand, a, b)
+        earlier = a + b - later
+        hit = conflicts(quads[row(earlier)], quads[row(later)], s)
+        state.meets(later[hit], earlier[hit])
+        undecided = state.run(undecided, good, tested=ks[-1] + 1)
+        if not len(undecided):
+            break
+    picked = state.picked()
+    out = quads[row(picked)]
+    ccw = np.sum(_cross(out - out[:, :1], np.roll(out - out[:, :1], -1, axis=1)), axis=1) > 0
+    out[~ccw] = out[~ccw, ::-1]  # far above round-off: shapely's orientation, had it been asked
+    local = picked % n_cand
+    return picked // n_cand, local // 2, local % 2, out, hinge[row(picked)]
+
+
+class _Greedy:
+    """The greedy choice of :func:`_choose`, run as far as the candidates tested allow.
+
+    Parameters
+    ----------
+    n : int
+        Borders.
+    n_cand : int
+        Candidates per border.
+    """
+
+    def __init__(self, n, n_cand):
+        self.n_cand = n_cand
+        self.meet: dict[int, list] = {}  # candidate -> intersecting candidates, earlier borders
+        self.near: dict[int, list] = {}  # candidate -> earlier candidates it might meet
+        # bytes: read one at a time by the loop of `run`, written as arrays through views
+        self.possible = bytearray(b"\x01") * (n * n_cand)  # not tested yet, or good
+        self.waits = bytearray(n)
+        self.placed = bytearray(n * n_cand)
+        self.linked = np.zeros(n * n_cand, dtype=bool)  # candidates with a `meet` or `near`
+        self.choice = np.full(n, -2, dtype=np.int64)  # -2 undecided, -1 no tab, else it
+        self.undecided = np.ones(n, dtype=bool)
+
+    def meets(self, later: np.ndarray, earlier: np.ndarray) -> None:
+        """Record that candidates ``later`` (shrunk) intersect ``earlier``."""
+        self.linked[later] = True
+        for a, b in zip(later.tolist(), earlier.tolist(), strict=True):
+            self.meet.setdefault(a, []).append(b)
+
+    def might_meet(self, cand: np.ndarray, other: np.ndarray) -> None:
+        """Record that candidates may intersect candidates of earlier borders not tested."""
+        self.linked[cand] = True
+        for a, b in zip(cand.tolist(), other.tolist(), strict=True):
+            self.near.setdefault(a, []).append(b)
+
+    def tested(self, cand: np.ndarray, good: np.ndarray) -> None:
+        """Record that candidates were tested (``good``: those that may be placed)."""
+        np.frombuffer(self.possible, dtype=np.uint8)[cand[~good]] = 0
+
+    def run(self, undecided: np.ndarray, good: np.ndarray, tested: int) -> np.ndarray:
+        """Decide the borders ``undecided`` (in order) that the first ``tested`` candidates of
+        each decide; the others, still undecided."""
+        nc, placed, choice = self.n_cand, self.placed, self.choice
+        meet, near, possible, waits = self.meet, self.near, self.possible, self.waits
+        placed_, waits_ = np.frombuffer(placed, np.uint8), np.frombuffer(waits, np.uint8)
+        # first the borders whose first good candidate meets nothing: decided whatever the
+        # others do; and those with no good candidate yet: waiting (or without a tab)
+        rows = good[undecided, :tested]
+        any_good = rows.any(axis=1)
+        first = undecided * nc + rows.argmax(axis=1)
+        easy = any_good & ~self.linked[first]
+        placed_[first[easy]] = 1
+        choice[undecided[easy]] = first[easy]
+        waits_[undecided[easy]] = 0
+        idle = undecided[~any_good]
+        waits_[idle] = tested < nc
+        if tested == nc:
+            choice[idle] = -1
+        still = [] if tested == nc else idle.tolist()
+        hard = undecided[any_good & ~easy]
+        for r, row in zip(hard.tolist(), good[hard, :tested].tolist(), strict=True):
+            base, wait = r * nc, True
+            for j, ok in enumerate(row):
+                if not ok:
+                    continue
+                c = base + j
+                met = meet.get(c, ())
+                if any(placed[x] for x in met):
+                    continue
+                if any(waits[x // nc] and possible[x] for x in (*met, *near.get(c, ()))):
+                    break  # an earlier border, undecided, may take this place
+                placed[c], choice[r], wait = 1, c, False
+                break
+            else:
+                if tested == nc:
+                    choice[r], wait = -1, False
+            waits[r] = wait
+            if wait:
+                still.append(r)
+        still = np.sort(np.asarray(still, dtype=np.int64))
+        self.undecided[:] = False
+        self.undecided[still] = True
+        return still
+
+    def picked(self) -> np.ndarray:
+        """The placed candidates, in the order of their borders."""
+        return self.choice[self.choice >= 0]
 
 
 def assembly_text(seams: list[dict]) -> str:
