@@ -159,6 +159,86 @@ def test_fold_json_still_rejects_non_finite_inside_arrays():
         fold_json({"a": [[1.0, float("nan")]]})
 
 
+FOLD_FLOATS = st.one_of(
+    st.floats(allow_nan=False, allow_infinity=False),
+    st.floats(allow_nan=False, allow_infinity=False, width=32),
+    st.sampled_from(SPECIAL),
+    st.integers(-(10**15), 10**15).map(float),
+    st.floats(-1e-300, 1e-300),
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(FOLD_FLOATS, min_size=0, max_size=40), st.sampled_from([(), (2,), (2, 2)]))
+def test_item_texts_and_fill_are_round_then_repr(values, row):
+    from filletfold.export.fold import _fill, _item_texts, _template
+
+    k = math.prod(row)
+    x = np.array(values[: len(values) // k * k], dtype=float).reshape(-1, *row)
+    items = [json.dumps(ref_plain(r), separators=(",", ":")) for r in x.tolist()]
+    assert _item_texts(x) == items
+    template = "{" + ";".join([_template(row)] * len(x)) + "}"
+    assert _fill(template, x) == "{" + ";".join(items) + "}"
+
+
+def _annotated(tabs, hinges, labels, sheets) -> CreasePattern:
+    from filletfold.surface.pattern import Annotations
+
+    p = dataclasses.replace(design_of("cube").pattern)
+    p.annotations = Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)
+    return p
+
+
+def test_fold_annotations_in_bulk_are_the_plain_documents_text():
+    from filletfold.surface.pattern import Label
+
+    rng = np.random.default_rng(5)
+    tabs = [rng.normal(size=(k, 2)) for k in (4, 0, 3, 4, 1, 6)]
+    tabs[0][1] = [-0.0, 2.0]  # zero, integral
+    tabs += [[[0.5, 1e-320], [3e15, 7.0]], np.array([1.0, 2.0, 3.0, 4.0])]  # lists, flat
+    hinges = [np.reshape(t, (-1, 2))[:2] for t in tabs if np.size(t) >= 4]
+    hinges.append([0.1, 0.2, 0.3, 0.4])
+    labels = [
+        Label(np.array([0.0, 1.0]), "1", 0.0, 0.25, "tab"),
+        Label([2.5, -0.0], 'a "%s" é\u2028', np.float64(-52.771095670080626), 1, "p%d"),
+        Label(np.array([[1e-7, 123456789012.4]]), "", 90, np.float32(0.1), "part"),
+    ]
+    for sheets in (np.zeros((0, 4)), np.array([[0.0, 0.0, 210.0, 297.5]]), [0, 0, 1, 2]):
+        for subset in (slice(None), slice(0, 0)):
+            p = _annotated(tabs[subset], hinges[subset], labels[subset], sheets)
+            files = cut_files(p, "fold", title="t")
+            doc = fold_document(p, title="t")
+            assert files["design.fold"] == fold_json(doc) == ref_fold_json(doc)
+
+
+@pytest.mark.parametrize(
+    ("where", "match"),
+    [
+        ("tab", r"annotations\.tabs\[1\]\[0\]\[1\] is not finite"),
+        ("hinge", r"annotations\.tab_hinges\[0\]\[1\]\[0\] is not finite"),
+        ("angle", r"annotations\.labels\[1\]\.angle is not finite"),
+        ("height", r"annotations\.labels\[0\]\.height is not finite"),
+        ("sheet", r"annotations\.sheets\[0\]\[2\] is not finite"),
+    ],
+)
+def test_fold_annotations_still_name_a_value_not_finite(where, match):
+    from filletfold.surface.pattern import Label
+
+    nan = float("nan")
+    tabs = [np.ones((3, 2)), np.array([[1.0, nan if where == "tab" else 2.0]])]
+    hinges = [np.array([[0.0, 0.0], [np.inf if where == "hinge" else 1.0, 0.0]])]
+    labels = [
+        Label(np.zeros(2), "a", 0.0, nan if where == "height" else 1.0),
+        Label(np.zeros(2), "b", -np.inf if where == "angle" else 0.0, 1.0),
+    ]
+    sheets = np.array([[0.0, 0.0, nan if where == "sheet" else 1.0, 1.0]])
+    p = _annotated(tabs, hinges, labels, sheets)
+    with pytest.raises(ExportError, match=match):
+        cut_files(p, "fold")
+    with pytest.raises(ExportError, match=match):
+        fold_json(fold_document(p))
+
+
 # ---------------------------------------------------------------- OBJ
 
 
