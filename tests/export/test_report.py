@@ -30,6 +30,7 @@ from filletfold.surface.pattern import CreasePattern
 from filletfold.surface.validate import validated_faces
 
 from ..conftest import design_of
+from .test_paths import ref_tab_cut_paths
 
 NAMES = ["cube", "torus", "house", "open-box", "miura"]
 
@@ -310,6 +311,95 @@ def test_svg_numbers_match_the_formatter():
     )
     for d in (0, 1, 3, 7, 9):
         assert _format_all(x, d) == [ref_svg_number(v, d) for v in x.tolist()]
+
+
+def ref_svg_annotations(pattern, lo, hi, margin, decimals, sw) -> list[str]:
+    """The tab, hinge, sheet and label elements as the per-element loops wrote them."""
+    from xml.sax.saxutils import escape
+
+    from filletfold.export import svg
+
+    ann = pattern.annotations
+
+    def fmt(x):
+        return ref_svg_number(x, decimals)
+
+    def xy(pts) -> str:
+        q = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+        return " ".join(f"{fmt(x - lo[0] + margin)},{fmt(hi[1] - y + margin)}" for x, y in q)
+
+    out = []
+    for x0, y0, x1, y1 in np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4):
+        out.append(
+            f'<rect x="{fmt(x0 - lo[0] + margin)}" y="{fmt(hi[1] - y1 + margin)}" '
+            f'width="{fmt(x1 - x0)}" height="{fmt(y1 - y0)}" stroke="{svg.SHEET_COLOR}"/>'
+        )
+    for pts, closed in ref_tab_cut_paths(ann):
+        tag = "polygon" if closed else "polyline"
+        out.append(f'<{tag} points="{xy(pts)}" stroke="{svg.ASSIGNMENT_COLOR["B"]}"/>')
+    for h in ann.tab_hinges:
+        (x1, y1), (x2, y2) = np.asarray(h, dtype=np.float64).reshape(2, 2)
+        out.append(
+            f'<line x1="{fmt(x1 - lo[0] + margin)}" y1="{fmt(hi[1] - y1 + margin)}" '
+            f'x2="{fmt(x2 - lo[0] + margin)}" y2="{fmt(hi[1] - y2 + margin)}" '
+            f'stroke="{svg.TAB_HINGE_COLOR}"/>'
+        )
+    for lb in ann.labels:
+        x, y = np.asarray(lb.position, dtype=np.float64).reshape(2)
+        tx, ty = fmt(x - lo[0] + margin), fmt(hi[1] - y + margin)
+        rot = f' transform="rotate({fmt(-float(lb.angle))} {tx} {ty})"' if lb.angle else ""
+        out.append(
+            f'<text x="{tx}" y="{ty}" font-size="{fmt(float(lb.height))}" '
+            f'class="{escape(str(lb.kind))}"{rot}>{escape(str(lb.text))}</text>'
+        )
+    return out
+
+
+def _svg_elements(text: str) -> list[str]:
+    """The sheet, tab, hinge and label elements of an SVG text, one per line."""
+    lines = "\n".join(text.split("\n")).split("\n")
+    keep = ('<rect x="', "<polygon", "<polyline", "<line", "<text x=")
+    return [
+        ln
+        for ln in lines
+        if ln.startswith(keep)
+        and ('stroke="#00a000"' in ln or not ln.startswith("<line"))
+        and ("stroke=" in ln or not ln.startswith("<rect"))
+        and "font-family" not in ln
+    ]
+
+
+@pytest.mark.parametrize("name", [*NAMES, "odd"])
+@pytest.mark.parametrize("decimals", [None, 0, 3])
+def test_svg_annotations_are_the_loops_elements(name, decimals):
+    from filletfold.export import svg
+    from filletfold.export.paths import pattern_extent
+    from filletfold.surface.pattern import Label
+
+    if name == "odd":
+        labels = [
+            Label(np.array([0.0, 1.0]), "1", 0.0, 0.25, "tab"),
+            Label([2.5, -0.0], 'a <"&"> %s é', np.float64(-52.771095670080626), 1, "p%d"),
+            Label(np.array([[1e-7, -3.0]]), "", 90, np.float32(0.1), "part"),
+            Label(np.array([0.5, 0.5]), "n", float("nan"), -0.0, "angle"),
+            Label(np.array([0.5, 0.5]), "z", -0.0, 1e-12, "angle"),
+        ]
+        tab = np.array([[0.0, 0.0], [0.2, -0.2], [0.8, -0.2], [1.0, 0.0], [0.0, 0.0]])
+        p = _annotated(
+            [tab, tab[:3] + 2.0, np.zeros((0, 2))],
+            [tab[[3, 0]], tab[:2]],
+            labels,
+            np.array([[-1.0, -1.0, 3.0, 2.0], [0.0, 0.0, 0.5, 0.25]]),
+        )
+    else:
+        p = design_of(name).pattern
+    lo, hi = pattern_extent(p)
+    margin = 0.137
+    d = decimals if decimals is not None else 8 - math.floor(math.log10(float((hi - lo).max())))
+    got = svg._annotation_groups(p, lo, hi, margin, d, "0.3")
+    got += svg._label_group(p, lo, hi, margin, d)
+    assert _svg_elements("\n".join(got)) == ref_svg_annotations(p, lo, hi, margin, d, "0.3")
+    assert _svg_elements(pattern_svg(p)) == _svg_elements(cut_files(p, "svg")["pattern.svg"])
 
 
 # ---------------------------------------------------------------- report.json

@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import ExportError, ParameterError
 from ..surface.pattern import Annotations, CreasePattern, face_arrays
 from ..surface.validate import validated_faces
+from .paths import label_positions
 from .report import python_scalar
 
 __all__ = [
@@ -229,7 +230,7 @@ def _annotations_data(annotations: Annotations) -> dict:
         tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in annotations.tabs]
         hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in annotations.tab_hinges]
         labels = annotations.labels
-        position = _label_positions(labels)
+        position = label_positions(labels)
         angle = np.array([float(lb.angle) for lb in labels], dtype=np.float64)
         height = np.array([float(lb.height) for lb in labels], dtype=np.float64)
         sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
@@ -255,18 +256,6 @@ def _annotations_data(annotations: Annotations) -> dict:
         ),
         "sheets": _Raw(_float_text(sheets)),
     }
-
-
-def _label_positions(labels: list) -> np.ndarray:
-    """(n, 2) float: the position of every label (each read as ``reshape(2)``)."""
-    try:
-        position = np.array([lb.position for lb in labels], dtype=np.float64)
-    except ValueError:  # positions of several shapes
-        position = None
-    if position is None or position.shape != (len(labels), 2):
-        rows = [np.asarray(lb.position, dtype=np.float64).reshape(2) for lb in labels]
-        position = np.array(rows, dtype=np.float64).reshape(-1, 2)
-    return position
 
 
 def _round(x: float) -> float:
