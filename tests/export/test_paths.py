@@ -158,6 +158,28 @@ def test_tab_cut_paths_all_at_once_are_the_tab_by_tab_paths(outlines, n_hinges):
     )
 
 
+@pytest.mark.parametrize(
+    "rows",
+    [
+        [],
+        [np.ones((3, 2)), np.zeros((0, 2)), np.arange(4).reshape(2, 2)],
+        [[[0, 1], [2, 3]], np.array([[True, False]])],
+        [np.arange(4.0), np.ones((1, 2))],  # flat and 2-D
+        [np.arange(6.0), np.arange(2)],  # all flat
+        [np.array([["1.5", "2"]])],
+        [np.ones((2, 1, 2))],
+    ],
+)
+def test_point_rows_reads_each_row_as_its_points(rows):
+    from filletfold.export.paths import point_rows
+
+    ref = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rows]
+    got = point_rows(rows)
+    assert got.dtype == np.float64 and np.array_equal(got, np.concatenate([np.zeros((0, 2)), *ref]))
+    with pytest.raises(ValueError):
+        point_rows([*rows, np.ones(3)])
+
+
 def test_tab_cut_paths_leave_the_hinge_out():
     tab = np.array([[0, 0], [0.2, -0.2], [0.8, -0.2], [1, 0]], dtype=float)
     ann = Annotations(

@@ -10,6 +10,7 @@ cut (all of it except the hinge it shares with its piece).
 from __future__ import annotations
 
 import itertools
+import operator
 
 import numpy as np
 
@@ -26,6 +27,7 @@ __all__ = [
     "edge_layer_masks",
     "label_positions",
     "pattern_extent",
+    "point_rows",
     "polyline_length",
     "simplify_polyline",
     "tab_cut_paths",
@@ -306,22 +308,19 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     list of ((k, 2) float, bool)
         One path per tab: its points and whether it is closed.
     """
-    tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in annotations.tabs]
-    hinges = list(annotations.tab_hinges)[: len(tabs)]
+    flat, size = _point_rows(annotations.tabs)
+    n = len(size)
+    hinges = list(annotations.tab_hinges)[:n]
     hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in hinges]
-    if not tabs:
+    if n == 0:
         return []
-    size = np.fromiter(map(len, tabs), dtype=np.int64, count=len(tabs))
     first = np.concatenate([[0], np.cumsum(size)[:-1]])
-    flat = np.concatenate(tabs)
     # a closing point that repeats the first is dropped
     repeat = size > 1
     repeat[repeat] = (flat[first[repeat]] == flat[(first + size - 1)[repeat]]).all(axis=1)
     size = size - repeat
-    paths: list[list[tuple[np.ndarray, bool]]] = [
-        [(t[:k], True)] for t, k in zip(tabs, size.tolist(), strict=True)
-    ]
-    hinged = np.flatnonzero((np.arange(len(tabs)) < len(hinges)) & (size >= 2))
+    paths: list = [None] * n  # of each tab: its paths (the whole outline, closed, when None)
+    hinged = np.flatnonzero((np.arange(n) < len(hinges)) & (size >= 2))
     for k in np.unique(size[hinged]).tolist():
         ids = hinged[size[hinged] == k]
         pts = flat[first[ids, None] + np.arange(k)]  # (m, k, 2)
@@ -340,7 +339,14 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
             paths[i] = [(path, False)]
         for j in np.flatnonzero((count > 1) & (count < k)).tolist():
             paths[ids[j]] = _tab_cut_path(pts[j], is_hinge_edge[j])
-    return [path for tab in paths for path in tab]
+    end = (first + size).tolist()
+    out = []
+    for i, (a, tab) in enumerate(zip(first.tolist(), paths, strict=True)):
+        if tab is None:
+            out.append((flat[a : end[i]], True))
+        else:
+            out += tab
+    return out
 
 
 def _tab_cut_path(p: np.ndarray, is_hinge_edge: np.ndarray) -> list[tuple[np.ndarray, bool]]:
@@ -413,13 +419,40 @@ def _on_segments(p: np.ndarray, seg: np.ndarray, eps: np.ndarray) -> tuple[np.nd
 def annotation_points(annotations: Annotations) -> np.ndarray:
     """(k, 2) float: every point of the annotations (tab corners, hinge ends, label anchors,
     sheet corners), for bounding boxes."""
-    pts = [np.zeros((0, 2))]
-    pts += [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in annotations.tabs]
-    pts += [np.asarray(h, dtype=np.float64).reshape(-1, 2) for h in annotations.tab_hinges]
-    pts.append(label_positions(annotations.labels))
+    return _annotation_points(annotations, label_positions(annotations.labels))
+
+
+def _annotation_points(annotations: Annotations, labels: np.ndarray) -> np.ndarray:
+    """:func:`annotation_points` with the label positions (n, 2) given."""
     sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
-    pts += [sheets[:, :2], sheets[:, 2:]]
-    return np.concatenate(pts)
+    return np.concatenate(
+        [
+            point_rows(annotations.tabs),
+            point_rows(annotations.tab_hinges),
+            labels,
+            sheets[:, :2],
+            sheets[:, 2:],
+        ]
+    )
+
+
+def point_rows(rows: list) -> np.ndarray:
+    """(k, 2) float: the points of a list of point arrays (tab outlines, hinges), one after
+    the other, each read as ``np.asarray(row, dtype=np.float64).reshape(-1, 2)``."""
+    return _point_rows(rows)[0]
+
+
+def _point_rows(rows: list) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`point_rows` and (n,) int the number of points of each row."""
+    try:
+        flat = np.concatenate(rows) if rows else np.zeros((0, 2))
+    except ValueError:  # rows of several dimensions
+        flat = None
+    if flat is None or flat.ndim != 2 or flat.shape[1] != 2 or flat.dtype.kind not in "biuf":
+        parts = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rows]
+        flat = np.concatenate([np.zeros((0, 2)), *parts])
+        return flat, np.fromiter(map(len, parts), dtype=np.int64, count=len(parts))
+    return np.asarray(flat, dtype=np.float64), np.fromiter(map(len, rows), np.int64, len(rows))
 
 
 def label_positions(labels: list) -> np.ndarray:
@@ -446,12 +479,13 @@ def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
     """
     labels = pattern.annotations.labels
     centre = label_positions(labels)
-    height = np.array([float(lb.height) for lb in labels], dtype=np.float64)
-    chars = np.array([max(len(lb.text), 1) for lb in labels], dtype=np.float64)
-    half = (0.5 * height * chars * 0.6)[:, None]
+    n = len(labels)
+    height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
+    chars = np.fromiter(map(len, map(operator.attrgetter("text"), labels)), np.int64, n)
+    half = (0.5 * height * np.maximum(chars, 1).astype(np.float64) * 0.6)[:, None]
     pts = [
         np.asarray(pattern.vertices_2d, dtype=np.float64).reshape(-1, 2),
-        annotation_points(pattern.annotations),
+        _annotation_points(pattern.annotations, centre),
         centre - half,
         centre + half,
     ]
