@@ -341,7 +341,7 @@ def _fill(template: str, x: np.ndarray) -> str:
     ----------
     template : str
         Text with one slot :data:`_SLOT` (``%.12g``) per value of ``x`` and no other ``%``
-        (no text from the data: JSON punctuation and whitespace only).
+        (no text from the data: JSON punctuation and whitespace only, never ``nan``).
     x : array_like of float
         Finite values, in the order of the slots (read in C order).
 
@@ -354,19 +354,15 @@ def _fill(template: str, x: np.ndarray) -> str:
     special = (np.abs(x - np.rint(x)) <= 1e-11 * mag) | (mag >= 1e11) | (mag < 1e-300)
     if not special.any():
         return template % tuple(x.tolist())
-    zero = x == 0
-    other = special & ~zero
-    values = x[~zero].tolist()  # zeros are written as the literal 0.0
-    for i in (np.cumsum(~zero) - 1)[other].tolist():
-        values[i] = _round(values[i])
-    spec = np.full(len(x), _SLOT, dtype=object)
-    spec[zero], spec[other] = "0.0", "%r"
-    parts = template.split(_SLOT)
-    if len(parts) != len(x) + 1:
-        raise ExportError(f"{len(parts) - 1} number slots for {len(x)} values")
-    pieces = np.empty(2 * len(x) + 1, dtype=object)
-    pieces[0::2], pieces[1::2] = parts, spec
-    return "".join(pieces.tolist()) % tuple(values)
+    # the special values are written NaN ("nan", in no other slot or text), then replaced
+    texts = ["0.0" if v == 0 else repr(_round(v)) for v in x[special].tolist()]
+    x[special] = np.nan
+    parts = (template % tuple(x.tolist())).split("nan")
+    if len(parts) != len(texts) + 1:
+        raise ExportError(f"a template with text in its slots for {len(texts)} values")
+    pieces = [""] * (2 * len(texts) + 1)
+    pieces[0::2], pieces[1::2] = parts, texts
+    return "".join(pieces)
 
 
 def _template(shape: tuple[int, ...]) -> str:
