@@ -174,7 +174,8 @@ def test_point_rows_reads_each_row_as_its_points(rows):
     from filletfold.export.paths import point_rows
 
     ref = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rows]
-    got = point_rows(rows)
+    got, sizes = point_rows(rows)
+    assert sizes.tolist() == [len(r) for r in ref]
     assert got.dtype == np.float64 and np.array_equal(got, np.concatenate([np.zeros((0, 2)), *ref]))
     with pytest.raises(ValueError):
         point_rows([*rows, np.ones(3)])

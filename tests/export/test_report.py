@@ -240,6 +240,18 @@ def test_fold_annotations_still_name_a_value_not_finite(where, match):
         fold_json(fold_document(p))
 
 
+@pytest.mark.parametrize(
+    ("tabs", "hinges"),
+    [([np.ones(3)], []), ([np.ones((2, 2))], [np.ones(6)]), ([np.ones((3, 3))], [])],
+)
+def test_fold_annotations_malformed_fail_as_the_plain_document(tabs, hinges):
+    p = _annotated(tabs, hinges, [], np.zeros((0, 4)))
+    with pytest.raises(ValueError, match="reshape"):
+        fold_document(p)
+    with pytest.raises(ValueError, match="reshape"):
+        cut_files(p, "fold")
+
+
 # ---------------------------------------------------------------- OBJ
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import operator
 from collections.abc import Mapping
 from json.encoder import encode_basestring_ascii as _quote
 
@@ -21,7 +22,7 @@ import numpy as np
 from ..errors import ExportError, ParameterError
 from ..surface.pattern import Annotations, CreasePattern, face_arrays
 from ..surface.validate import validated_faces
-from .paths import label_positions
+from .paths import label_positions, point_rows
 from .report import python_scalar
 
 __all__ = [
@@ -226,24 +227,28 @@ def _annotations_data(annotations: Annotations) -> dict:
     When a number is not finite (or a value is malformed), the plain document instead, for
     :func:`_plain` (or this function's checks) to name it.
     """
+    labels = annotations.labels
+    n = len(labels)
     try:
-        tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in annotations.tabs]
-        hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in annotations.tab_hinges]
-        labels = annotations.labels
+        tab_points, tab_size = point_rows(annotations.tabs)
+        hinge_points, hinge_size = point_rows(annotations.tab_hinges)
+        if (hinge_size != 2).any():  # each hinge is read as reshape(2, 2)
+            for h in annotations.tab_hinges:
+                np.asarray(h, dtype=np.float64).reshape(2, 2)
+        hinge_points = hinge_points.reshape(-1, 2, 2)
         position = label_positions(labels)
-        angle = np.array([float(lb.angle) for lb in labels], dtype=np.float64)
-        height = np.array([float(lb.height) for lb in labels], dtype=np.float64)
+        angle = np.fromiter(map(float, map(operator.attrgetter("angle"), labels)), np.float64, n)
+        height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
         sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
     except (TypeError, ValueError):
         return annotations_document(annotations)
-    tab_points = np.concatenate([np.zeros((0, 2)), *tabs])
-    hinge_points = np.array(hinges, dtype=np.float64).reshape(-1, 2, 2)
     numbers = (tab_points, hinge_points, position, angle, height, sheets)
     if not all(np.isfinite(a).all() for a in numbers):
         return annotations_document(annotations)
-    tab_template = {k: _template((k, 2)) for k in set(map(len, tabs))}
+    sizes = tab_size.tolist()
+    tab_template = {k: _template((k, 2)) for k in set(sizes)}
     return {
-        "tabs": _Raw(_fill("[" + ",".join([tab_template[len(t)] for t in tabs]) + "]", tab_points)),
+        "tabs": _Raw(_fill("[" + ",".join(map(tab_template.__getitem__, sizes)) + "]", tab_points)),
         "tab_hinges": _Raw(_float_text(hinge_points)),
         "labels": _RecordList(
             {

@@ -308,7 +308,7 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     list of ((k, 2) float, bool)
         One path per tab: its points and whether it is closed.
     """
-    flat, size = _point_rows(annotations.tabs)
+    flat, size = point_rows(annotations.tabs)
     n = len(size)
     hinges = list(annotations.tab_hinges)[:n]
     hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in hinges]
@@ -427,8 +427,8 @@ def _annotation_points(annotations: Annotations, labels: np.ndarray) -> np.ndarr
     sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
     return np.concatenate(
         [
-            point_rows(annotations.tabs),
-            point_rows(annotations.tab_hinges),
+            point_rows(annotations.tabs)[0],
+            point_rows(annotations.tab_hinges)[0],
             labels,
             sheets[:, :2],
             sheets[:, 2:],
@@ -436,14 +436,22 @@ def _annotation_points(annotations: Annotations, labels: np.ndarray) -> np.ndarr
     )
 
 
-def point_rows(rows: list) -> np.ndarray:
-    """(k, 2) float: the points of a list of point arrays (tab outlines, hinges), one after
-    the other, each read as ``np.asarray(row, dtype=np.float64).reshape(-1, 2)``."""
-    return _point_rows(rows)[0]
+def point_rows(rows: list) -> tuple[np.ndarray, np.ndarray]:
+    """The points of a list of point arrays (tab outlines, hinges), each row read as
+    ``np.asarray(row, dtype=np.float64).reshape(-1, 2)``, all at once when they are (k, 2)
+    arrays of numbers.
 
+    Parameters
+    ----------
+    rows : list of array_like
 
-def _point_rows(rows: list) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`point_rows` and (n,) int the number of points of each row."""
+    Returns
+    -------
+    points : (k, 2) float
+        The points of every row, one row after the other.
+    sizes : (n,) int
+        The number of points of each row.
+    """
     try:
         flat = np.concatenate(rows) if rows else np.zeros((0, 2))
     except ValueError:  # rows of several dimensions
