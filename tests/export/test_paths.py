@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from filletfold.export.paths import (
@@ -85,6 +87,98 @@ def test_chain_runs_split_at_corners_and_spacing_jumps():
     # a full circle is one closed spline whose last point repeats the first
     ((pts, spline, closed),) = chain_runs(arc(6.0, 60), closed=True)
     assert spline and closed and np.array_equal(pts[0], pts[-1])
+
+
+def ref_tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
+    """tab_cut_paths one tab at a time, as it was written before it took all tabs at once."""
+    from filletfold.export.paths import _HINGE_RTOL, _on_segment
+
+    out = []
+    hinges = list(annotations.tab_hinges)
+    for t, tab in enumerate(annotations.tabs):
+        p = np.asarray(tab, dtype=np.float64).reshape(-1, 2)
+        if len(p) > 1 and np.array_equal(p[0], p[-1]):
+            p = p[:-1]
+        hinge = np.asarray(hinges[t], dtype=np.float64).reshape(2, 2) if t < len(hinges) else None
+        if hinge is None or len(p) < 2:
+            out.append((p, True))
+            continue
+        size = max(float(np.ptp(p, axis=0).max()), 1.0)
+        on_hinge = _on_segment(p, hinge, _HINGE_RTOL * size)
+        is_hinge_edge = on_hinge & np.roll(on_hinge, -1)
+        if not is_hinge_edge.any() or is_hinge_edge.all():
+            out.append((p, True))
+            continue
+        k = len(p)
+        start = (int(np.flatnonzero(is_hinge_edge)[-1]) + 1) % k
+        order = [(start + i) % k for i in range(k + 1)]
+        pieces, current = [], [p[order[0]]]
+        for i in range(k):
+            if is_hinge_edge[order[i]]:
+                if len(current) > 1:
+                    pieces.append(np.array(current))
+                current = [p[order[i + 1]]]
+            else:
+                current.append(p[order[i + 1]])
+        if len(current) > 1:
+            pieces.append(np.array(current))
+        out.extend((piece, False) for piece in pieces)
+    return out
+
+
+@st.composite
+def tab_outlines(draw):
+    """A tab outline and its hinge: points on a line (the hinge) and off it, some repeated,
+    some within a hair of the tolerance, a closing point that repeats the first."""
+    k = draw(st.integers(0, 7))
+    scale = draw(st.sampled_from([1e-3, 1.0, 250.0]))
+    a = np.array(draw(st.tuples(*[st.floats(-5, 5)] * 2))) * scale
+    d = np.array(draw(st.sampled_from([(1.0, 0.0), (0.6, 0.8), (0.0, 0.0)]))) * scale
+    normal = np.array([-d[1], d[0]]) / max(float(np.hypot(*d)), 1e-300)
+    eps = 1e-7 * max(scale, 1.0)
+    pts = []
+    for _ in range(k):
+        t = draw(st.sampled_from([0.0, 1.0, 0.3, 1.5, -0.2]))
+        off = draw(st.sampled_from([0.0, 0.0, 0.2 * scale, eps, eps * (1 + 1e-15), 0.5 * eps]))
+        pts.append(a + t * d + off * normal)
+    if pts and draw(st.booleans()):
+        pts.append(pts[0])
+    hinge = np.array([a, a + d])
+    return np.array(pts).reshape(-1, 2), hinge
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(tab_outlines(), max_size=12), st.integers(0, 12))
+def test_tab_cut_paths_all_at_once_are_the_tab_by_tab_paths(outlines, n_hinges):
+    ann = Annotations(tabs=[p for p, _ in outlines], tab_hinges=[h for _, h in outlines][:n_hinges])
+    got, ref = tab_cut_paths(ann), ref_tab_cut_paths(ann)
+    assert [c for _, c in got] == [c for _, c in ref]
+    assert all(
+        np.array_equal(a, b) and a.shape == b.shape for (a, _), (b, _) in zip(got, ref, strict=True)
+    )
+
+
+@pytest.mark.parametrize(
+    "rows",
+    [
+        [],
+        [np.ones((3, 2)), np.zeros((0, 2)), np.arange(4).reshape(2, 2)],
+        [[[0, 1], [2, 3]], np.array([[True, False]])],
+        [np.arange(4.0), np.ones((1, 2))],  # flat and 2-D
+        [np.arange(6.0), np.arange(2)],  # all flat
+        [np.array([["1.5", "2"]])],
+        [np.ones((2, 1, 2))],
+    ],
+)
+def test_point_rows_reads_each_row_as_its_points(rows):
+    from filletfold.export.paths import point_rows
+
+    ref = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rows]
+    got, sizes = point_rows(rows)
+    assert sizes.tolist() == [len(r) for r in ref]
+    assert got.dtype == np.float64 and np.array_equal(got, np.concatenate([np.zeros((0, 2)), *ref]))
+    with pytest.raises(ValueError):
+        point_rows([*rows, np.ones(3)])
 
 
 def test_tab_cut_paths_leave_the_hinge_out():

@@ -30,6 +30,7 @@ from filletfold.surface.pattern import CreasePattern
 from filletfold.surface.validate import validated_faces
 
 from ..conftest import design_of
+from .test_paths import ref_tab_cut_paths
 
 NAMES = ["cube", "torus", "house", "open-box", "miura"]
 
@@ -159,6 +160,98 @@ def test_fold_json_still_rejects_non_finite_inside_arrays():
         fold_json({"a": [[1.0, float("nan")]]})
 
 
+FOLD_FLOATS = st.one_of(
+    st.floats(allow_nan=False, allow_infinity=False),
+    st.floats(allow_nan=False, allow_infinity=False, width=32),
+    st.sampled_from(SPECIAL),
+    st.integers(-(10**15), 10**15).map(float),
+    st.floats(-1e-300, 1e-300),
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(FOLD_FLOATS, min_size=0, max_size=40), st.sampled_from([(), (2,), (2, 2)]))
+def test_item_texts_and_fill_are_round_then_repr(values, row):
+    from filletfold.export.fold import _fill, _item_texts, _template
+
+    k = math.prod(row)
+    x = np.array(values[: len(values) // k * k], dtype=float).reshape(-1, *row)
+    items = [json.dumps(ref_plain(r), separators=(",", ":")) for r in x.tolist()]
+    assert _item_texts(x) == items
+    template = "{" + ";".join([_template(row)] * len(x)) + "}"
+    assert _fill(template, x) == "{" + ";".join(items) + "}"
+
+
+def _annotated(tabs, hinges, labels, sheets) -> CreasePattern:
+    from filletfold.surface.pattern import Annotations
+
+    p = dataclasses.replace(design_of("cube").pattern)
+    p.annotations = Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)
+    return p
+
+
+def test_fold_annotations_in_bulk_are_the_plain_documents_text():
+    from filletfold.surface.pattern import Label
+
+    rng = np.random.default_rng(5)
+    tabs = [rng.normal(size=(k, 2)) for k in (4, 0, 3, 4, 1, 6)]
+    tabs[0][1] = [-0.0, 2.0]  # zero, integral
+    tabs += [[[0.5, 1e-320], [3e15, 7.0]], np.array([1.0, 2.0, 3.0, 4.0])]  # lists, flat
+    hinges = [np.reshape(t, (-1, 2))[:2] for t in tabs if np.size(t) >= 4]
+    hinges.append([0.1, 0.2, 0.3, 0.4])
+    labels = [
+        Label(np.array([0.0, 1.0]), "1", 0.0, 0.25, "tab"),
+        Label([2.5, -0.0], 'a "%s" é\u2028', np.float64(-52.771095670080626), 1, "p%d"),
+        Label(np.array([[1e-7, 123456789012.4]]), "", 90, np.float32(0.1), "part"),
+    ]
+    for sheets in (np.zeros((0, 4)), np.array([[0.0, 0.0, 210.0, 297.5]]), [0, 0, 1, 2]):
+        for subset in (slice(None), slice(0, 0)):
+            p = _annotated(tabs[subset], hinges[subset], labels[subset], sheets)
+            files = cut_files(p, "fold", title="t")
+            doc = fold_document(p, title="t")
+            assert files["design.fold"] == fold_json(doc) == ref_fold_json(doc)
+
+
+@pytest.mark.parametrize(
+    ("where", "match"),
+    [
+        ("tab", r"annotations\.tabs\[1\]\[0\]\[1\] is not finite"),
+        ("hinge", r"annotations\.tab_hinges\[0\]\[1\]\[0\] is not finite"),
+        ("angle", r"annotations\.labels\[1\]\.angle is not finite"),
+        ("height", r"annotations\.labels\[0\]\.height is not finite"),
+        ("sheet", r"annotations\.sheets\[0\]\[2\] is not finite"),
+    ],
+)
+def test_fold_annotations_still_name_a_value_not_finite(where, match):
+    from filletfold.surface.pattern import Label
+
+    nan = float("nan")
+    tabs = [np.ones((3, 2)), np.array([[1.0, nan if where == "tab" else 2.0]])]
+    hinges = [np.array([[0.0, 0.0], [np.inf if where == "hinge" else 1.0, 0.0]])]
+    labels = [
+        Label(np.zeros(2), "a", 0.0, nan if where == "height" else 1.0),
+        Label(np.zeros(2), "b", -np.inf if where == "angle" else 0.0, 1.0),
+    ]
+    sheets = np.array([[0.0, 0.0, nan if where == "sheet" else 1.0, 1.0]])
+    p = _annotated(tabs, hinges, labels, sheets)
+    with pytest.raises(ExportError, match=match):
+        cut_files(p, "fold")
+    with pytest.raises(ExportError, match=match):
+        fold_json(fold_document(p))
+
+
+@pytest.mark.parametrize(
+    ("tabs", "hinges"),
+    [([np.ones(3)], []), ([np.ones((2, 2))], [np.ones(6)]), ([np.ones((3, 3))], [])],
+)
+def test_fold_annotations_malformed_fail_as_the_plain_document(tabs, hinges):
+    p = _annotated(tabs, hinges, [], np.zeros((0, 4)))
+    with pytest.raises(ValueError, match="reshape"):
+        fold_document(p)
+    with pytest.raises(ValueError, match="reshape"):
+        cut_files(p, "fold")
+
+
 # ---------------------------------------------------------------- OBJ
 
 
@@ -230,6 +323,95 @@ def test_svg_numbers_match_the_formatter():
     )
     for d in (0, 1, 3, 7, 9):
         assert _format_all(x, d) == [ref_svg_number(v, d) for v in x.tolist()]
+
+
+def ref_svg_annotations(pattern, lo, hi, margin, decimals, sw) -> list[str]:
+    """The tab, hinge, sheet and label elements as the per-element loops wrote them."""
+    from xml.sax.saxutils import escape
+
+    from filletfold.export import svg
+
+    ann = pattern.annotations
+
+    def fmt(x):
+        return ref_svg_number(x, decimals)
+
+    def xy(pts) -> str:
+        q = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+        return " ".join(f"{fmt(x - lo[0] + margin)},{fmt(hi[1] - y + margin)}" for x, y in q)
+
+    out = []
+    for x0, y0, x1, y1 in np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4):
+        out.append(
+            f'<rect x="{fmt(x0 - lo[0] + margin)}" y="{fmt(hi[1] - y1 + margin)}" '
+            f'width="{fmt(x1 - x0)}" height="{fmt(y1 - y0)}" stroke="{svg.SHEET_COLOR}"/>'
+        )
+    for pts, closed in ref_tab_cut_paths(ann):
+        tag = "polygon" if closed else "polyline"
+        out.append(f'<{tag} points="{xy(pts)}" stroke="{svg.ASSIGNMENT_COLOR["B"]}"/>')
+    for h in ann.tab_hinges:
+        (x1, y1), (x2, y2) = np.asarray(h, dtype=np.float64).reshape(2, 2)
+        out.append(
+            f'<line x1="{fmt(x1 - lo[0] + margin)}" y1="{fmt(hi[1] - y1 + margin)}" '
+            f'x2="{fmt(x2 - lo[0] + margin)}" y2="{fmt(hi[1] - y2 + margin)}" '
+            f'stroke="{svg.TAB_HINGE_COLOR}"/>'
+        )
+    for lb in ann.labels:
+        x, y = np.asarray(lb.position, dtype=np.float64).reshape(2)
+        tx, ty = fmt(x - lo[0] + margin), fmt(hi[1] - y + margin)
+        rot = f' transform="rotate({fmt(-float(lb.angle))} {tx} {ty})"' if lb.angle else ""
+        out.append(
+            f'<text x="{tx}" y="{ty}" font-size="{fmt(float(lb.height))}" '
+            f'class="{escape(str(lb.kind))}"{rot}>{escape(str(lb.text))}</text>'
+        )
+    return out
+
+
+def _svg_elements(text: str) -> list[str]:
+    """The sheet, tab, hinge and label elements of an SVG text, one per line."""
+    lines = "\n".join(text.split("\n")).split("\n")
+    keep = ('<rect x="', "<polygon", "<polyline", "<line", "<text x=")
+    return [
+        ln
+        for ln in lines
+        if ln.startswith(keep)
+        and ('stroke="#00a000"' in ln or not ln.startswith("<line"))
+        and ("stroke=" in ln or not ln.startswith("<rect"))
+        and "font-family" not in ln
+    ]
+
+
+@pytest.mark.parametrize("name", [*NAMES, "odd"])
+@pytest.mark.parametrize("decimals", [None, 0, 3])
+def test_svg_annotations_are_the_loops_elements(name, decimals):
+    from filletfold.export import svg
+    from filletfold.export.paths import pattern_extent
+    from filletfold.surface.pattern import Label
+
+    if name == "odd":
+        labels = [
+            Label(np.array([0.0, 1.0]), "1", 0.0, 0.25, "tab"),
+            Label([2.5, -0.0], 'a <"&"> %s é', np.float64(-52.771095670080626), 1, "p%d"),
+            Label(np.array([[1e-7, -3.0]]), "", 90, np.float32(0.1), "part"),
+            Label(np.array([0.5, 0.5]), "n", float("nan"), -0.0, "angle"),
+            Label(np.array([0.5, 0.5]), "z", -0.0, 1e-12, "angle"),
+        ]
+        tab = np.array([[0.0, 0.0], [0.2, -0.2], [0.8, -0.2], [1.0, 0.0], [0.0, 0.0]])
+        p = _annotated(
+            [tab, tab[:3] + 2.0, np.zeros((0, 2))],
+            [tab[[3, 0]], tab[:2]],
+            labels,
+            np.array([[-1.0, -1.0, 3.0, 2.0], [0.0, 0.0, 0.5, 0.25]]),
+        )
+    else:
+        p = design_of(name).pattern
+    lo, hi = pattern_extent(p)
+    margin = 0.137
+    d = decimals if decimals is not None else 8 - math.floor(math.log10(float((hi - lo).max())))
+    got = svg._annotation_groups(p, lo, hi, margin, d, "0.3")
+    got += svg._label_group(p, lo, hi, margin, d)
+    assert _svg_elements("\n".join(got)) == ref_svg_annotations(p, lo, hi, margin, d, "0.3")
+    assert _svg_elements(pattern_svg(p)) == _svg_elements(cut_files(p, "svg")["pattern.svg"])
 
 
 # ---------------------------------------------------------------- report.json

@@ -13,13 +13,16 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import operator
 from collections.abc import Mapping
+from json.encoder import encode_basestring_ascii as _quote
 
 import numpy as np
 
 from ..errors import ExportError, ParameterError
 from ..surface.pattern import Annotations, CreasePattern, face_arrays
 from ..surface.validate import validated_faces
+from .paths import label_positions, point_rows
 from .report import python_scalar
 
 __all__ = [
@@ -147,7 +150,11 @@ def _fold_document(
         ],
     }
     if has_annotations(pattern.annotations):
-        doc[NAMESPACE + "annotations"] = annotations_document(pattern.annotations)
+        doc[NAMESPACE + "annotations"] = (
+            _annotations_data(pattern.annotations)
+            if arrays
+            else annotations_document(pattern.annotations)
+        )
     for key, value in (extra or {}).items():
         if not isinstance(key, str) or not key.startswith(NAMESPACE) or key == NAMESPACE:
             raise ParameterError(
@@ -213,6 +220,49 @@ def annotations_document(annotations: Annotations) -> dict:
     }
 
 
+def _annotations_data(annotations: Annotations) -> dict:
+    """:func:`annotations_document` for :func:`fold_json`, its numbers formatted in bulk: tabs,
+    hinges and sheets as :class:`_Raw` text, labels as a :class:`_RecordList`.
+
+    When a number is not finite (or a value is malformed), the plain document instead, for
+    :func:`_plain` (or this function's checks) to name it.
+    """
+    labels = annotations.labels
+    n = len(labels)
+    try:
+        tab_points, tab_size = point_rows(annotations.tabs)
+        hinge_points, hinge_size = point_rows(annotations.tab_hinges)
+        if (hinge_size != 2).any():  # each hinge is read as reshape(2, 2)
+            for h in annotations.tab_hinges:
+                np.asarray(h, dtype=np.float64).reshape(2, 2)
+        hinge_points = hinge_points.reshape(-1, 2, 2)
+        position = label_positions(labels)
+        angle = np.fromiter(map(float, map(operator.attrgetter("angle"), labels)), np.float64, n)
+        height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
+        sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
+    except (TypeError, ValueError):
+        return annotations_document(annotations)
+    numbers = (tab_points, hinge_points, position, angle, height, sheets)
+    if not all(np.isfinite(a).all() for a in numbers):
+        return annotations_document(annotations)
+    sizes = tab_size.tolist()
+    tab_template = {k: _template((k, 2)) for k in set(sizes)}
+    return {
+        "tabs": _Raw(_fill("[" + ",".join(map(tab_template.__getitem__, sizes)) + "]", tab_points)),
+        "tab_hinges": _Raw(_float_text(hinge_points)),
+        "labels": _RecordList(
+            {
+                "position": _item_texts(position),
+                "text": [_quote(str(lb.text)) for lb in labels],
+                "angle": _item_texts(angle),
+                "height": _item_texts(height),
+                "kind": [_quote(str(lb.kind)) for lb in labels],
+            }
+        ),
+        "sheets": _Raw(_float_text(sheets)),
+    }
+
+
 def _round(x: float) -> float:
     """``x`` rounded to :data:`FOLD_DIGITS` significant digits; ``-0.0`` becomes ``0.0``."""
     if not math.isfinite(x):
@@ -245,51 +295,102 @@ class _Raw:
         self.text = text
 
 
+class _RecordList:
+    """A list of dicts with the same keys, each value already compact JSON text, written by
+    :func:`_dump` a column at a time as it writes a list of dicts.
+
+    Parameters
+    ----------
+    columns : dict of str to list of str
+        Key -> (n,) the JSON text of the key's value in every record.
+    """
+
+    __slots__ = ("columns",)
+
+    def __init__(self, columns: dict[str, list[str]]):
+        self.columns = columns
+
+    def text(self, depth: int) -> str:
+        """The list as :func:`_dump` writes it at ``depth``."""
+        n = len(next(iter(self.columns.values()), []))
+        if n == 0:
+            return "[]"
+        pad = "  " * depth
+        fields = ",\n".join(
+            pad + "    " + json.dumps(k).replace("%", "%%") + ": %s" for k in self.columns
+        )
+        record = pad + "  {\n" + fields + "\n" + pad + "  }"
+        values = tuple(itertools.chain.from_iterable(zip(*self.columns.values(), strict=True)))
+        return "[\n" + ",\n".join([record] * n) % values + "\n" + pad + "]"
+
+
 #: Exact types :func:`_plain` passes through unchanged.
 _AS_IS = frozenset({int, str, bool, type(None)})
 
 
-def _float_text(a: np.ndarray) -> str:
-    """Compact JSON of a finite float array (1-D or 2-D), each value as :func:`_round` and
-    ``json.dumps`` would write it, formatted in bulk.
+#: The slot of one number in the templates of :func:`_fill`.
+_SLOT = "%.12g"
+
+
+def _fill(template: str, x: np.ndarray) -> str:
+    """``template`` with its number slots filled in bulk, each value as :func:`_round` and
+    ``json.dumps`` write it.
 
     ``%.12g`` writes a normal float's 12-digit rounding with the digits of ``repr`` of that
     rounding (two different 12-digit decimals are never one double). It differs from ``repr``
     only for integral values (no ``.0``), from ``1e12`` on (exponent form) and below the normal
     range (subnormals keep fewer digits): zeros are written ``0.0``, the other few with
-    ``repr`` of :func:`_round` itself.
+    ``repr`` of :func:`_round` itself (the values near those, too, to be safe).
+
+    Parameters
+    ----------
+    template : str
+        Text with one slot :data:`_SLOT` (``%.12g``) per value of ``x`` and no other ``%``
+        (no text from the data: JSON punctuation and whitespace only, never ``nan``).
+    x : array_like of float
+        Finite values, in the order of the slots (read in C order).
+
+    Returns
+    -------
+    str
     """
-    x = np.asarray(a, dtype=np.float64).ravel() + 0.0  # -0.0 becomes 0.0
-    k = a.shape[1] if a.ndim == 2 else 1
-    open_, sep, close = ("[[", "],[", "]]") if a.ndim == 2 else ("[", ",", "]")
+    x = np.asarray(x, dtype=np.float64).ravel() + 0.0  # -0.0 becomes 0.0
     mag = np.abs(x)
     special = (np.abs(x - np.rint(x)) <= 1e-11 * mag) | (mag >= 1e11) | (mag < 1e-300)
     if not special.any():
-        row = ",".join(["%.12g"] * k)
-        return (open_ + sep.join([row] * (len(x) // k)) + close) % tuple(x.tolist())
-    zero = x == 0
-    other = special & ~zero
-    values = x[~zero].tolist()  # zeros are written as the literal 0.0
-    for i in (np.cumsum(~zero) - 1)[other].tolist():
-        values[i] = _round(values[i])
-    kind = np.zeros(len(x), dtype=np.int8)  # 0: %.12g, 1: 0.0, 2: %r
-    kind[zero], kind[other] = 1, 2
-    specs = ("%.12g", "0.0", "%r")
-    if a.ndim == 2:
-        rows = np.unique(np.flatnonzero(special) // k)
-        if 8 * len(rows) < len(a):  # few rows to change: a template per row
-            template = ["[" + ",".join(["%.12g"] * k) + "]"] * len(a)
-            for r, row in zip(rows.tolist(), kind.reshape(-1, k)[rows].tolist(), strict=True):
-                template[r] = "[" + ",".join([specs[j] for j in row]) + "]"
-            return ("[" + ",".join(template) + "]") % tuple(values)
-    spec = np.array(specs, dtype=object)[kind]
-    if a.ndim == 1:
-        return ("[" + ",".join(spec.tolist()) + "]") % tuple(values)
-    after = np.full(len(x), ",", dtype=object)
-    after[k - 1 :: k] = sep
-    parts = np.empty(2 * len(x), dtype=object)
-    parts[0::2], parts[1::2] = spec, after
-    return (open_ + "".join(parts[:-1].tolist()) + close) % tuple(values)
+        return template % tuple(x.tolist())
+    # the special values are written NaN ("nan", in no other slot or text), then replaced
+    texts = ["0.0" if v == 0 else repr(_round(v)) for v in x[special].tolist()]
+    x[special] = np.nan
+    parts = (template % tuple(x.tolist())).split("nan")
+    if len(parts) != len(texts) + 1:
+        raise ExportError(f"a template with text in its slots for {len(texts)} values")
+    pieces = [""] * (2 * len(texts) + 1)
+    pieces[0::2], pieces[1::2] = parts, texts
+    return "".join(pieces)
+
+
+def _template(shape: tuple[int, ...]) -> str:
+    """Compact JSON template (see :func:`_fill`) of a float array of ``shape``."""
+    if not shape:
+        return _SLOT
+    if shape[0] == 0:
+        return "[]"
+    return "[" + ",".join([_template(shape[1:])] * shape[0]) + "]"
+
+
+def _float_text(a: np.ndarray) -> str:
+    """Compact JSON of a finite float array, each value as :func:`_round` and ``json.dumps``
+    would write it, formatted in bulk (see :func:`_fill`)."""
+    return _fill(_template(a.shape), a)
+
+
+def _item_texts(a: np.ndarray) -> list[str]:
+    """(n,) the compact JSON of each item ``a[i]`` of a finite float array (n, ...), as
+    :func:`_float_text` writes it, all formatted at once."""
+    if len(a) == 0:
+        return []
+    return _fill("\n".join([_template(a.shape[1:])] * len(a)), a).split("\n")
 
 
 def _int_text(a: np.ndarray) -> str:
@@ -335,7 +436,7 @@ def _plain(obj, where: str):
         obj = obj.tolist()
     elif isinstance(obj, _RaggedInts):
         return _Raw(obj.text())
-    elif isinstance(obj, _Raw):
+    elif isinstance(obj, _Raw | _RecordList):
         return obj
     obj = python_scalar(obj)
     if obj is None or isinstance(obj, bool | str | int):
@@ -379,7 +480,9 @@ def _dump(obj, depth: int, out: list[str]) -> list[str]:
     """Dicts and lists of dicts one entry per line, everything else compact on one line: the
     text's pieces appended to ``out`` (joined once by :func:`fold_json`), which is returned."""
     pad = "  " * depth
-    if isinstance(obj, dict) and obj:
+    if isinstance(obj, _RecordList):
+        out.append(obj.text(depth))
+    elif isinstance(obj, dict) and obj:
         out.append("{\n")
         for k, v in obj.items():
             out += (pad, "  ", json.dumps(k), ": ")

@@ -10,6 +10,7 @@ cut (all of it except the hinge it shares with its piece).
 from __future__ import annotations
 
 import itertools
+import operator
 
 import numpy as np
 
@@ -24,7 +25,9 @@ __all__ = [
     "chain_runs",
     "edge_chains",
     "edge_layer_masks",
+    "label_positions",
     "pattern_extent",
+    "point_rows",
     "polyline_length",
     "simplify_polyline",
     "tab_cut_paths",
@@ -305,39 +308,69 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     list of ((k, 2) float, bool)
         One path per tab: its points and whether it is closed.
     """
+    flat, size = point_rows(annotations.tabs)
+    n = len(size)
+    hinges = list(annotations.tab_hinges)[:n]
+    hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in hinges]
+    if n == 0:
+        return []
+    first = np.concatenate([[0], np.cumsum(size)[:-1]])
+    # a closing point that repeats the first is dropped
+    repeat = size > 1
+    repeat[repeat] = (flat[first[repeat]] == flat[(first + size - 1)[repeat]]).all(axis=1)
+    size = size - repeat
+    paths: list = [None] * n  # of each tab: its paths (the whole outline, closed, when None)
+    hinged = np.flatnonzero((np.arange(n) < len(hinges)) & (size >= 2))
+    for k in np.unique(size[hinged]).tolist():
+        ids = hinged[size[hinged] == k]
+        pts = flat[first[ids, None] + np.arange(k)]  # (m, k, 2)
+        hinge = np.array([hinges[i] for i in ids.tolist()])  # (m, 2, 2)
+        eps = _HINGE_RTOL * np.maximum(np.ptp(pts, axis=1).max(axis=1), 1.0)
+        on_hinge, unsure = _on_segments(pts, hinge, eps)
+        for j in np.flatnonzero(unsure).tolist():  # a point at the tolerance: as before
+            on_hinge[j] = _on_segment(pts[j], hinge[j], float(eps[j]))
+        is_hinge_edge = on_hinge & np.roll(on_hinge, -1, axis=1)  # edge i -> i + 1
+        count = is_hinge_edge.sum(axis=1)
+        # one hinge edge: the path is the outline from the point after it, once round
+        one = np.flatnonzero(count == 1)
+        start = (np.argmax(is_hinge_edge[one], axis=1) + 1)[:, None]
+        rolled = pts[one[:, None], (start + np.arange(k)) % k]
+        for i, path in zip(ids[one].tolist(), rolled, strict=True):
+            paths[i] = [(path, False)]
+        for j in np.flatnonzero((count > 1) & (count < k)).tolist():
+            paths[ids[j]] = _tab_cut_path(pts[j], is_hinge_edge[j])
+    end = (first + size).tolist()
     out = []
-    hinges = list(annotations.tab_hinges)
-    for t, tab in enumerate(annotations.tabs):
-        p = np.asarray(tab, dtype=np.float64).reshape(-1, 2)
-        if len(p) > 1 and np.array_equal(p[0], p[-1]):
-            p = p[:-1]
-        hinge = np.asarray(hinges[t], dtype=np.float64).reshape(2, 2) if t < len(hinges) else None
-        if hinge is None or len(p) < 2:
-            out.append((p, True))
-            continue
-        size = max(float(np.ptp(p, axis=0).max()), 1.0)
-        on_hinge = _on_segment(p, hinge, _HINGE_RTOL * size)
-        is_hinge_edge = on_hinge & np.roll(on_hinge, -1)  # edge i -> i + 1
-        if not is_hinge_edge.any() or is_hinge_edge.all():
-            out.append((p, True))
-            continue
-        # start right after the last hinge edge, walk the non-hinge edges
-        k = len(p)
-        start = (int(np.flatnonzero(is_hinge_edge)[-1]) + 1) % k
-        order = [(start + i) % k for i in range(k + 1)]
-        pieces, current = [], [p[order[0]]]
-        for i in range(k):
-            a = order[i]
-            if is_hinge_edge[a]:
-                if len(current) > 1:
-                    pieces.append(np.array(current))
-                current = [p[order[i + 1]]]
-            else:
-                current.append(p[order[i + 1]])
-        if len(current) > 1:
-            pieces.append(np.array(current))
-        out.extend((piece, False) for piece in pieces)
+    for i, (a, tab) in enumerate(zip(first.tolist(), paths, strict=True)):
+        if tab is None:
+            out.append((flat[a : end[i]], True))
+        else:
+            out += tab
     return out
+
+
+def _tab_cut_path(p: np.ndarray, is_hinge_edge: np.ndarray) -> list[tuple[np.ndarray, bool]]:
+    """The cut paths of one tab outline ``p`` (k, 2): the runs of the edges that are not its
+    hinge (``is_hinge_edge`` (k,) bool: edge i -> i + 1), from right after the last hinge edge;
+    the whole outline, closed, when none or every edge is the hinge."""
+    if not is_hinge_edge.any() or is_hinge_edge.all():
+        return [(p, True)]
+    # start right after the last hinge edge, walk the non-hinge edges
+    k = len(p)
+    start = (int(np.flatnonzero(is_hinge_edge)[-1]) + 1) % k
+    order = [(start + i) % k for i in range(k + 1)]
+    pieces, current = [], [p[order[0]]]
+    for i in range(k):
+        a = order[i]
+        if is_hinge_edge[a]:
+            if len(current) > 1:
+                pieces.append(np.array(current))
+            current = [p[order[i + 1]]]
+        else:
+            current.append(p[order[i + 1]])
+    if len(current) > 1:
+        pieces.append(np.array(current))
+    return [(piece, False) for piece in pieces]
 
 
 def _on_segment(p: np.ndarray, seg: np.ndarray, eps: float) -> np.ndarray:
@@ -349,16 +382,97 @@ def _on_segment(p: np.ndarray, seg: np.ndarray, eps: float) -> np.ndarray:
     return np.linalg.norm(p - (a + t[:, None] * d), axis=1) <= eps
 
 
+def _on_segments(p: np.ndarray, seg: np.ndarray, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_on_segment` of many outlines at once.
+
+    Parameters
+    ----------
+    p : (m, k, 2) float
+        The points of ``m`` outlines.
+    seg : (m, 2, 2) float
+        Each outline's segment.
+    eps : (m,) float
+        Each outline's tolerance.
+
+    Returns
+    -------
+    on : (m, k) bool
+        The points within ``eps`` of their segment.
+    unsure : (m,) bool
+        The outlines with a point whose distance is within round-off of ``eps`` (or not
+        finite): there ``on`` may differ from :func:`_on_segment`'s in the last bit.
+    """
+    a = seg[:, None, 0]
+    d = seg[:, None, 1] - a  # (m, 1, 2)
+    dd = d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]
+    q = p - a
+    ok = dd > 0
+    t = np.clip((q[..., 0] * d[..., 0] + q[..., 1] * d[..., 1]) / np.where(ok, dd, 1.0), 0.0, 1.0)
+    r = p - (a + np.where(ok, t, 0.0)[..., None] * d)
+    dist = np.sqrt(r[..., 0] * r[..., 0] + r[..., 1] * r[..., 1])
+    scale = np.maximum(np.abs(p).max(axis=(1, 2)), np.abs(seg).max(axis=(1, 2)))
+    margin = 1e-9 * (eps + scale)
+    unsure = ~(np.abs(dist - eps[:, None]) > margin[:, None]).all(axis=1)
+    return dist <= eps[:, None], unsure
+
+
 def annotation_points(annotations: Annotations) -> np.ndarray:
     """(k, 2) float: every point of the annotations (tab corners, hinge ends, label anchors,
     sheet corners), for bounding boxes."""
-    pts = [np.zeros((0, 2))]
-    pts += [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in annotations.tabs]
-    pts += [np.asarray(h, dtype=np.float64).reshape(-1, 2) for h in annotations.tab_hinges]
-    pts += [np.asarray(lb.position, dtype=np.float64).reshape(1, 2) for lb in annotations.labels]
+    return _annotation_points(annotations, label_positions(annotations.labels))
+
+
+def _annotation_points(annotations: Annotations, labels: np.ndarray) -> np.ndarray:
+    """:func:`annotation_points` with the label positions (n, 2) given."""
     sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
-    pts += [sheets[:, :2], sheets[:, 2:]]
-    return np.vstack(pts)
+    return np.concatenate(
+        [
+            point_rows(annotations.tabs)[0],
+            point_rows(annotations.tab_hinges)[0],
+            labels,
+            sheets[:, :2],
+            sheets[:, 2:],
+        ]
+    )
+
+
+def point_rows(rows: list) -> tuple[np.ndarray, np.ndarray]:
+    """The points of a list of point arrays (tab outlines, hinges), each row read as
+    ``np.asarray(row, dtype=np.float64).reshape(-1, 2)``, all at once when they are (k, 2)
+    arrays of numbers.
+
+    Parameters
+    ----------
+    rows : list of array_like
+
+    Returns
+    -------
+    points : (k, 2) float
+        The points of every row, one row after the other.
+    sizes : (n,) int
+        The number of points of each row.
+    """
+    try:
+        flat = np.concatenate(rows) if rows else np.zeros((0, 2))
+    except ValueError:  # rows of several dimensions
+        flat = None
+    if flat is None or flat.ndim != 2 or flat.shape[1] != 2 or flat.dtype.kind not in "biuf":
+        parts = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rows]
+        flat = np.concatenate([np.zeros((0, 2)), *parts])
+        return flat, np.fromiter(map(len, parts), dtype=np.int64, count=len(parts))
+    return np.asarray(flat, dtype=np.float64), np.fromiter(map(len, rows), np.int64, len(rows))
+
+
+def label_positions(labels: list) -> np.ndarray:
+    """(n, 2) float: the position of every label (each read as ``reshape(2)``)."""
+    try:
+        position = np.array([lb.position for lb in labels], dtype=np.float64)
+    except ValueError:  # positions of several shapes
+        position = None
+    if position is None or position.shape != (len(labels), 2):
+        rows = [np.asarray(lb.position, dtype=np.float64).reshape(2) for lb in labels]
+        position = np.array(rows, dtype=np.float64).reshape(-1, 2)
+    return position
 
 
 def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
@@ -371,12 +485,19 @@ def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
     lo, hi : (2,) float
         ``(0, 0)`` and ``(1, 1)`` for an empty pattern.
     """
-    pts = [pattern.vertices_2d, annotation_points(pattern.annotations)]
-    for lb in pattern.annotations.labels:
-        half = 0.5 * float(lb.height) * max(len(lb.text), 1) * 0.6
-        c = np.asarray(lb.position, dtype=np.float64).reshape(2)
-        pts.append(np.array([c - half, c + half]))
-    allp = np.vstack(pts)
+    labels = pattern.annotations.labels
+    centre = label_positions(labels)
+    n = len(labels)
+    height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
+    chars = np.fromiter(map(len, map(operator.attrgetter("text"), labels)), np.int64, n)
+    half = (0.5 * height * np.maximum(chars, 1).astype(np.float64) * 0.6)[:, None]
+    pts = [
+        np.asarray(pattern.vertices_2d, dtype=np.float64).reshape(-1, 2),
+        _annotation_points(pattern.annotations, centre),
+        centre - half,
+        centre + half,
+    ]
+    allp = np.concatenate(pts)
     if len(allp) == 0:
         return np.zeros(2), np.ones(2)
     return allp.min(axis=0), allp.max(axis=0)

@@ -15,6 +15,7 @@ the labels as filled text, rotated, in the ``annotation`` group (``labels``).
 
 from __future__ import annotations
 
+import itertools
 import math
 from xml.sax.saxutils import escape
 
@@ -25,7 +26,7 @@ from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
-from .paths import pattern_extent, tab_cut_paths
+from .paths import label_positions, pattern_extent, tab_cut_paths
 
 __all__ = ["nice_length", "pattern_svg"]
 
@@ -184,7 +185,7 @@ def _pattern_svg(pattern, units="", stroke_mm=0.3, flat_edges=False, angle_opaci
             values = np.stack(cols, axis=1).ravel().tolist()
             body.append((line * len(sel))[:-1] % tuple(values))
         body.append("</g>")
-    body.extend(_annotation_groups(pattern, lo, hi, margin, fmt, sw))
+    body.extend(_annotation_groups(pattern, lo, hi, margin, decimals, sw))
 
     # scale bar and legend below the drawing
     draw_w = float(size[0]) + 2 * margin
@@ -218,7 +219,7 @@ def _pattern_svg(pattern, units="", stroke_mm=0.3, flat_edges=False, angle_opaci
         )
         xcur += (0.62 * _FONT_MM * len(text) + 6.0) * user
     ann.append("</g>")
-    ann.extend(_label_group(pattern, lo, hi, margin, fmt))
+    ann.extend(_label_group(pattern, lo, hi, margin, decimals))
     ann.append("</g>")
 
     total_w = max(
@@ -236,23 +237,31 @@ def _pattern_svg(pattern, units="", stroke_mm=0.3, flat_edges=False, angle_opaci
     return "\n".join([*head, *body, *ann, "</svg>"]) + "\n"
 
 
-def _annotation_groups(pattern, lo, hi, margin, fmt, sw) -> list[str]:
-    """SVG groups of the sheet outlines, tab cut paths and tab hinges (empty when none)."""
+def _annotation_groups(pattern, lo, hi, margin, decimals, sw) -> list[str]:
+    """SVG groups of the sheet outlines, tab cut paths and tab hinges (empty when none), their
+    numbers formatted in bulk (:func:`_format_all`)."""
     ann = pattern.annotations
+    fmt = _formatter(decimals)
 
-    def xy(pts) -> str:
-        q = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
-        return " ".join(f"{fmt(x - lo[0] + margin)},{fmt(hi[1] - y + margin)}" for x, y in q)
+    def x_of(x: np.ndarray) -> list[str]:
+        return _format_all(x - lo[0] + margin, decimals)
+
+    def y_of(y: np.ndarray) -> list[str]:
+        return _format_all(hi[1] - y + margin, decimals)
 
     out = []
     sheets = np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4)
     if len(sheets):
         out.append(f'<g id="sheets" stroke="{SHEET_COLOR}" stroke-width="{sw}" fill="none">')
-        for x0, y0, x1, y1 in sheets:
-            out.append(
-                f'<rect x="{fmt(x0 - lo[0] + margin)}" y="{fmt(hi[1] - y1 + margin)}" '
-                f'width="{fmt(x1 - x0)}" height="{fmt(y1 - y0)}" stroke="{SHEET_COLOR}"/>'
-            )
+        x0, y0, x1, y1 = sheets.T
+        rect = f'<rect x="%s" y="%s" width="%s" height="%s" stroke="{SHEET_COLOR}"/>'
+        columns = (
+            x_of(x0),
+            y_of(y1),
+            _format_all(x1 - x0, decimals),
+            _format_all(y1 - y0, decimals),
+        )
+        out.append(_rows(rect, columns))
         out.append("</g>")
     paths = tab_cut_paths(ann)
     if paths:
@@ -261,27 +270,42 @@ def _annotation_groups(pattern, lo, hi, margin, fmt, sw) -> list[str]:
             f'<g id="tab-cut" stroke-width="{sw}" stroke-linecap="round" '
             'stroke-linejoin="round" fill="none">'
         )
-        for pts, closed in paths:
-            tag = "polygon" if closed else "polyline"
-            out.append(f'<{tag} points="{xy(pts)}" stroke="{color}"/>')
+        q = np.concatenate([pts for pts, _ in paths])
+        shapes = [(closed, len(pts)) for pts, closed in paths]
+        template = {
+            (closed, k): f'<{"polygon" if closed else "polyline"} points="'
+            + " ".join(["%s,%s"] * k)
+            + f'" stroke="{color}"/>'
+            for closed, k in set(shapes)
+        }
+        values = tuple(
+            itertools.chain.from_iterable(zip(x_of(q[:, 0]), y_of(q[:, 1]), strict=True))
+        )
+        out.append("\n".join(map(template.__getitem__, shapes)) % values)
         out.append("</g>")
     if len(ann.tab_hinges):
         out.append(
             f'<g id="tab-hinge" stroke-width="{sw}" stroke-dasharray="{fmt(6 * float(sw))} '
             f'{fmt(4 * float(sw))}" fill="none">'
         )
-        for h in ann.tab_hinges:
-            (x1, y1), (x2, y2) = np.asarray(h, dtype=np.float64).reshape(2, 2)
-            out.append(
-                f'<line x1="{fmt(x1 - lo[0] + margin)}" y1="{fmt(hi[1] - y1 + margin)}" '
-                f'x2="{fmt(x2 - lo[0] + margin)}" y2="{fmt(hi[1] - y2 + margin)}" '
-                f'stroke="{TAB_HINGE_COLOR}"/>'
-            )
+        h = np.array([np.asarray(h, dtype=np.float64).reshape(2, 2) for h in ann.tab_hinges])
+        line = f'<line x1="%s" y1="%s" x2="%s" y2="%s" stroke="{TAB_HINGE_COLOR}"/>'
+        columns = (x_of(h[:, 0, 0]), y_of(h[:, 0, 1]), x_of(h[:, 1, 0]), y_of(h[:, 1, 1]))
+        out.append(_rows(line, columns))
         out.append("</g>")
     return out
 
 
-def _label_group(pattern, lo, hi, margin, fmt) -> list[str]:
+def _rows(template: str, columns) -> str:
+    """``template`` (``%s`` slots, one per column) filled with each row of ``columns`` (lists
+    of texts of one length), one line per row."""
+    n = len(columns[0])
+    return "\n".join([template] * n) % tuple(
+        itertools.chain.from_iterable(zip(*columns, strict=True))
+    )
+
+
+def _label_group(pattern, lo, hi, margin, decimals) -> list[str]:
     """The ``labels`` group: filled text, centred on each anchor, rotated (empty when none)."""
     labels = pattern.annotations.labels
     if not labels:
@@ -290,13 +314,22 @@ def _label_group(pattern, lo, hi, margin, fmt) -> list[str]:
         f'<g id="labels" font-family="sans-serif" fill="{LABEL_COLOR}" text-anchor="middle" '
         'dominant-baseline="central">'
     ]
-    for lb in labels:
-        x, y = np.asarray(lb.position, dtype=np.float64).reshape(2)
-        tx, ty = fmt(x - lo[0] + margin), fmt(hi[1] - y + margin)
-        rot = f' transform="rotate({fmt(-float(lb.angle))} {tx} {ty})"' if lb.angle else ""
-        out.append(
-            f'<text x="{tx}" y="{ty}" font-size="{fmt(float(lb.height))}" '
-            f'class="{escape(str(lb.kind))}"{rot}>{escape(str(lb.text))}</text>'
-        )
+    position = label_positions(labels)
+    tx = _format_all(position[:, 0] - lo[0] + margin, decimals)
+    ty = _format_all(hi[1] - position[:, 1] + margin, decimals)
+    size = _format_all(np.array([float(lb.height) for lb in labels], dtype=np.float64), decimals)
+    angle = np.array([lb.angle for lb in labels], dtype=object)
+    turned = np.flatnonzero(angle.astype(bool))  # the truth of each angle, as it is
+    rot = [""] * len(labels)
+    turns = _format_all(np.array([-float(a) for a in angle[turned]], dtype=np.float64), decimals)
+    for i, r in zip(turned.tolist(), turns, strict=True):
+        rot[i] = f' transform="rotate({r} {tx[i]} {ty[i]})"'
+    kinds = [str(lb.kind) for lb in labels]
+    texts = [str(lb.text) for lb in labels]
+    escaped = {t: escape(t) for t in {*kinds, *texts}}
+    out.extend(
+        f'<text x="{x}" y="{y}" font-size="{h}" class="{escaped[k]}"{r}>{escaped[t]}</text>'
+        for x, y, h, k, r, t in zip(tx, ty, size, kinds, rot, texts, strict=True)
+    )
     out.append("</g>")
     return out
