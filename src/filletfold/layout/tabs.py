@@ -480,6 +480,12 @@ def _absmax(a: np.ndarray) -> np.ndarray:
     return _fold(np.maximum, np.abs(a).reshape(len(a), -1))
 
 
+def _rows(a: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``a[index]`` for an int array ``index``, much faster for an ``a`` of several
+    dimensions (``np.take`` along the first axis)."""
+    return np.take(a, index, axis=0)
+
+
 def _pad(a: np.ndarray, width: int) -> np.ndarray:
     """An (n, k) array widened to (n, width) by repeating its last column."""
     if a.shape[1] == width:
@@ -537,10 +543,11 @@ class _Grid:
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray):
         self.box = np.concatenate([lo, hi], axis=1)  # (n, 4): x0, y0, x1, y1
+        self.cols = [np.ascontiguousarray(x) for x in self.box.T]
         kept = np.flatnonzero(np.isfinite(self.box).all(axis=1))
         self.origin, self.cell, self.shape = np.zeros(2), 1.0, np.ones(2, dtype=np.int64)
-        self.low = np.zeros((len(lo), 2), dtype=np.int64)  # the first cell of each box
         self.items = np.zeros(0, dtype=np.int64)
+        self.first = np.zeros(0, dtype=np.uint8)  # 1: a box's first column, 2: first row
         self.start = np.zeros(2, dtype=np.int64)
         if not len(kept):
             return
@@ -556,10 +563,9 @@ class _Grid:
             if np.prod(c1 - c0 + 1, axis=1).sum() <= 8 * len(kept) + 1024:
                 break
             cell *= 2
-        self.low[kept] = c0
-        keys, items, _, _ = self._entries(c0, c1, kept)
+        keys, items, first = self._entries(c0, c1, kept)
         order = np.argsort(keys)
-        self.items = items[order]
+        self.items, self.first = items[order], first[order]
         # the entries of cell k: items[start[k]:start[k + 1]]
         self.start = np.searchsorted(keys[order], np.arange(int(np.prod(self.shape)) + 1))
 
@@ -571,14 +577,16 @@ class _Grid:
         return np.clip(c0, 0, top).astype(np.int64), np.clip(c1, -1, top).astype(np.int64)
 
     def _entries(self, c0, c1, items):
-        """(cell key, item, cell x, cell y) of every cell of every box."""
+        """(cell key, item, whether the cell is in the box's first column (1) and row (2))
+        of every cell of every box."""
         w = np.maximum(c1 - c0 + 1, 0)
         count = w[:, 0] * w[:, 1]
         item = np.repeat(np.arange(len(c0)), count)
         k = np.arange(len(item)) - np.repeat(np.cumsum(count) - count, count)
         wy = np.maximum(w[item, 1], 1)
-        ix, iy = c0[item, 0] + k // wy, c0[item, 1] + k % wy
-        return ix * self.shape[1] + iy, items[item], ix, iy
+        dx, dy = k // wy, k % wy
+        first = (dx == 0).astype(np.uint8) | ((dy == 0).astype(np.uint8) << 1)
+        return (c0[item, 0] + dx) * self.shape[1] + c0[item, 1] + dy, items[item], first
 
     def query(self, lo: np.ndarray, hi: np.ndarray):
         """The pairs of a box (``lo``, ``hi``: (m, 2)) and a filed box that overlap (closed).
@@ -594,21 +602,17 @@ class _Grid:
         finite = np.isfinite(box).all(axis=1)
         c0, c1 = self._cells(np.where(finite[:, None], lo, 0), np.where(finite[:, None], hi, -1))
         c1[~finite] = -1
-        keys, asked, ix, iy = self._entries(c0, c1, np.arange(len(lo)))
+        keys, asked, low = self._entries(c0, c1, np.arange(len(lo)))
         first = self.start[keys]
         count = self.start[keys + 1] - first
         which = np.repeat(np.arange(len(keys)), count)
         at = np.arange(len(which)) + np.repeat(first - np.cumsum(count) + count, count)
-        a, b = asked[which], self.items[at]
-        # each pair once: in the cell of the low corner of the two boxes' overlap
-        low_a, low_b = c0[a], self.low[b]
-        keep = (np.maximum(low_a[:, 0], low_b[:, 0]) == ix[which]) & (
-            np.maximum(low_a[:, 1], low_b[:, 1]) == iy[which]
-        )
-        a, b = a[keep], b[keep]
-        qa, fb = box[a], self.box[b]
-        keep = (qa[:, 0] <= fb[:, 2]) & (fb[:, 0] <= qa[:, 2])
-        keep &= (qa[:, 1] <= fb[:, 3]) & (fb[:, 1] <= qa[:, 3])
+        # each pair once: in the cell of the low corner of the two boxes' overlap, which is
+        # in the first column of one of them and in the first row of one of them
+        keep = np.flatnonzero((np.take(low, which) | np.take(self.first, at)) == 3)
+        a, b = np.take(asked, np.take(which, keep)), np.take(self.items, np.take(at, keep))
+        qa, fb = [np.take(x, a) for x in box.T], [np.take(x, b) for x in self.cols]
+        keep = (qa[0] <= fb[2]) & (fb[0] <= qa[2]) & (qa[1] <= fb[3]) & (fb[1] <= qa[3])
         return a[keep], b[keep]
 
 
@@ -733,8 +737,13 @@ class _Faces:
         # shrunk tab whatever round-off shapely and these figures make (checked by `sure`)
         frame = {
             "origin": quads[:, 0],
+            "ox": quads[:, 0, 0].copy(),
+            "oy": quads[:, 0, 1].copy(),
             "normal": normal,
             "offset": offset + s / 2,
+            "nx": np.ascontiguousarray(normal[..., 0].T),  # (4, n): side after side
+            "ny": np.ascontiguousarray(normal[..., 1].T),
+            "off": np.ascontiguousarray(offset.T + s / 2),
             "inner": shrink_convex(local, s / 2, normal),  # about the origin
             "least": 1e-9 * area + 2 * s * perimeter,
             "reach": _absmax(quads) + _absmax(local) + self.h,
@@ -743,8 +752,8 @@ class _Faces:
             t = np.flatnonzero(hint >= 0)
             self._pairs(frame, t, hint[t], blocker, None)
         rest = np.flatnonzero(blocker < 0)
-        i, faces = self.grid.query(*_boxes(quads[rest]))
-        tabs = rest[i]
+        i, faces = self.grid.query(*_boxes(_rows(quads, rest)))
+        tabs = np.take(rest, i)
         slow = []
         self._pairs(frame, tabs, faces, blocker, slow)
         slow = np.concatenate(slow)
@@ -762,45 +771,45 @@ class _Faces:
         pairs are only clipped, and the undecided ones dropped.
         """
         s = self.s
-        reach = self.extent[faces] + frame["reach"][tabs]
-        sure = self.fast[faces] & (16 * EPS * reach < s / 4)
+        reach = np.take(self.extent, faces) + np.take(frame["reach"], tabs)
+        sure = np.take(self.fast, faces) & (16 * EPS * reach < s / 4)
         if slow is not None:
             slow.append(np.flatnonzero(~sure))
         todo = np.flatnonzero(sure)
-        bucket = self.bucket[faces[todo]]
-        normal, offset = frame["normal"], frame["offset"]
+        bucket = np.take(self.bucket, np.take(faces, todo))
+        nx, ny, off = frame["nx"], frame["ny"], frame["off"]
         kept = []
         for k in self.sets:
             pair = todo[bucket == k]
             if not len(pair):
                 continue
             fx, fy, ux, uy, lo, hi = self.sets[k]
-            t, row = tabs[pair], self.row[faces[pair]]
-            x = fx[row] - frame["origin"][t, 0, None]
-            y = fy[row] - frame["origin"][t, 1, None]
+            t, f = np.take(tabs, pair), np.take(faces, pair)
+            row = np.take(self.row, f)
+            x = _rows(fx, row) - np.take(frame["ox"], t)[:, None]
+            y = _rows(fy, row) - np.take(frame["oy"], t)[:, None]
             live = np.arange(len(pair))
             if slow is not None:
                 # apart along a side of the tab (its hinge first: its own piece's faces)
                 for j in range(4):
-                    tl = t[live]
-                    d = _colmax(x[live] * normal[tl, j, 0, None] + y[live] * normal[tl, j, 1, None])
-                    live = live[~(d - offset[tl, j] < -s / 4)]
+                    tl = np.take(t, live)
+                    xl, yl = _rows(x, live), _rows(y, live)
+                    d = _colmax(xl * np.take(nx[j], tl)[:, None] + yl * np.take(ny[j], tl)[:, None])
+                    live = live[~(d - np.take(off[j], tl) < -s / 4)]
                 # apart along a side of a convex face
-                conv = live[self.convex[faces[pair[live]]]]
+                conv = live[np.take(self.convex, np.take(f, live))]
                 if len(conv):
-                    r, tc = row[conv], t[conv]
-                    inner = frame["inner"][tc] + frame["origin"][tc, None]
-                    proj = [
-                        ux[r] * inner[:, i, 0, None] + uy[r] * inner[:, i, 1, None]
-                        for i in range(4)
-                    ]
+                    r, tc = np.take(row, conv), np.take(t, conv)
+                    inner = _rows(frame["inner"], tc) + _rows(frame["origin"], tc)[:, None]
+                    ur, vr = _rows(ux, r), _rows(uy, r)
+                    proj = [ur * inner[:, i, 0, None] + vr * inner[:, i, 1, None] for i in range(4)]
                     low, high = np.minimum.reduce(proj), np.maximum.reduce(proj)
-                    gap = np.maximum(low - hi[r], lo[r] - high)
+                    gap = np.maximum(low - _rows(hi, r), _rows(lo, r) - high)
                     apart = _fold(np.logical_or, gap > s / 4)  # NaN (no length): not apart
                     drop = np.zeros(len(pair), dtype=bool)
                     drop[conv[apart]] = True
                     live = live[~drop[live]]
-            kept.append((pair[live], x[live], y[live]))
+            kept.append((np.take(pair, live), _rows(x, live), _rows(y, live)))
         if not kept:
             return
         # a tab is blocked by its first overlapping face: clip the first pair of every tab,
@@ -810,23 +819,27 @@ class _Faces:
         poly = np.concatenate(
             [np.stack([_pad(x, width), _pad(y, width)], axis=-1) for _, x, y in kept]
         )
-        t = tabs[pair]
+        t = np.take(tabs, pair)
         first = np.zeros(len(pair), dtype=bool)
         first[np.unique(t, return_index=True)[1]] = True
         for part in (np.flatnonzero(first), np.flatnonzero(~first)):
-            part = part[blocker[t[part]] < 0]
+            part = part[np.take(blocker, np.take(t, part)) < 0]
             if not len(part):
                 continue
-            tp = t[part]
-            got, empty, doubt = convex_overlap(poly[part], frame["inner"][tp])
-            doubt |= ~self.convex[faces[pair[part]]]
+            tp, fp = np.take(t, part), np.take(faces, np.take(pair, part))
+            pp = _rows(poly, part)
+            got, empty, doubt = convex_overlap(pp, _rows(frame["inner"], tp))
+            doubt |= ~np.take(self.convex, fp)
             if doubt.any():  # Sutherland-Hodgman: faces not convex, touching sides
                 d = np.flatnonzero(doubt)
-                got[d], empty[d] = clip_area(poly[part[d]], normal[tp[d]], offset[tp[d]])
-            big = ~empty & (got > frame["least"][tp])
-            blocker[tp[big]] = faces[pair[part[big]]]
+                td = np.take(tp, d)
+                got[d], empty[d] = clip_area(
+                    _rows(pp, d), _rows(frame["normal"], td), _rows(frame["offset"], td)
+                )
+            big = ~empty & (got > np.take(frame["least"], tp))
+            blocker[tp[big]] = fp[big]
             if slow is not None:
-                slow.append(pair[part[~empty & ~big]])
+                slow.append(np.take(pair, part[~empty & ~big]))
 
     def _exact(self, quads, tabs, faces):
         """Blocked pairs of a tab and a face, by shapely on the tab shrunk by ``SHRINK``."""
@@ -1010,10 +1023,10 @@ def _candidates(ends, normal, tab_height, cand):
             at = np.flatnonzero(k == 2 * level + side)
             if not len(at):
                 continue
-            sub = ends[border[at], side]
+            sub = _rows(ends, border[at])[:, side]
             sub = sub if part is None else _halves(sub, part)
             height[at] = scale * tab_height
-            quads[at], ok[at] = tab_outlines(sub, normal[border[at], side], height[at])
+            quads[at], ok[at] = tab_outlines(sub, _rows(normal, border[at])[:, side], height[at])
             hinges[at] = sub
     return quads, hinges, ok, height
 
@@ -1074,7 +1087,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         c = tried = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
         q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
         quads[row(c)] = q
-        c, q, height = c[ok], q[ok], height[ok]
+        c, q, height = c[ok], np.compress(ok, q, axis=0), height[ok]
         area, least = _area(q), 1e-3 * height**2
         valid = _surely_valid(q)
         doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > 1e-6 * least))
@@ -1082,11 +1095,11 @@ def _choose(faces: _Faces, ends, normal, tab_height):
             shapes = _closed_polygons(q[doubt])
             valid[doubt], area[doubt] = shapely.is_valid(shapes), shapely.area(shapes)
         keep = np.flatnonzero(valid & (area > least))
-        c, q, area = c[keep], q[keep], area[keep]
+        c, q, area = c[keep], _rows(q, keep), area[keep]
         blocked = np.zeros(len(c), dtype=bool)
         for level in np.unique(c % n_cand // 2).tolist():  # a side's last blocker first
             at = np.flatnonzero(c % n_cand // 2 == level)
-            found = faces.clear(q[at], area[at], blocker_of[c[at] // n_cand, c[at] % 2])
+            found = faces.clear(_rows(q, at), area[at], blocker_of[c[at] // n_cand, c[at] % 2])
             hit = at[found >= 0]
             blocked[hit] = True
             blocker_of[c[hit] // n_cand, c[hit] % 2] = found[found >= 0]
@@ -1094,7 +1107,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
         # the sides of other borders near the new candidates
-        i, j = sides.query(*_boxes(quads[row(c)]))
+        i, j = sides.query(*_boxes(_rows(quads, row(c))))
         pc, ps = c[i], j
         other = ps // 2 != pc // n_cand
         pc, ps = pc[other], ps[other]
@@ -1103,13 +1116,13 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         # border's tab the quarter-height one)
         lo = np.flatnonzero(ps // 2 < pc // n_cand)
         lo = lo[state.undecided[ps[lo] // 2]]
-        lo = lo[conflicts(envelope[ps[lo]], quads[row(pc[lo])], s, exact=False)]
+        lo = lo[conflicts(_rows(envelope, ps[lo]), _rows(quads, row(pc[lo])), s, exact=False)]
         a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
         holder = np.asarray(COVER)[b % n_cand]
         cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
         key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
         held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
-        maybe = conflicts(held, quads[row(key // (n * n_cand))], s, exact=False) | ~fits
+        maybe = conflicts(held, _rows(quads, row(key // (n * n_cand))), s, exact=False) | ~fits
         state.might_meet(a[maybe[inv]], b[maybe[inv]])
         # the tested candidates of those sides: which tabs intersect which
         rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
@@ -1118,7 +1131,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
         later = np.where(a // n_cand > b // n_cand, a, b)
         earlier = a + b - later
-        hit = conflicts(quads[row(earlier)], quads[row(later)], s)
+        hit = conflicts(_rows(quads, row(earlier)), _rows(quads, row(later)), s)
         state.meets(later[hit], earlier[hit])
         undecided = state.run(undecided, good, tested=ks[-1] + 1)
         if not len(undecided):
