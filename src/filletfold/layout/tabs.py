@@ -14,6 +14,9 @@ the few others, exactly as it would decide them one at a time.
 
 from __future__ import annotations
 
+import gc
+from contextlib import contextmanager
+
 import numpy as np
 import shapely
 from scipy.sparse import coo_array
@@ -931,6 +934,12 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         ``untabbed`` (cut borders where no tab fits: they keep their two labels) and ``seams``
         (per label: the two pieces it joins and the piece carrying the tab).
     """
+    with _no_gc():
+        return _tabs_and_labels(p, tab_height, part_names)
+
+
+def _tabs_and_labels(p, tab_height, part_names):
+    """The work of :func:`add_tabs_and_labels`."""
     faces = _Faces(p, tab_height)
     ann = Annotations(sheets=p.annotations.sheets)
     label_h = 0.45 * tab_height
@@ -976,6 +985,20 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
     p.annotations = ann
     stats["seams"] = seams
     return stats
+
+
+@contextmanager
+def _no_gc():
+    """No automatic garbage collection inside: the labels and seams made here live on, and
+    each of the collections their numbers would set off (some 70 on hull1000, some
+    walking every object of the design) finds nothing to free."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list:
