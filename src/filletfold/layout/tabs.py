@@ -597,7 +597,7 @@ class _Grid:
         Returns
         -------
         (k,) int, (k,) int
-            The boxes asked and the filed ones, in the order of the boxes asked.
+            The boxes asked and the filed ones.
         """
         if not len(lo) or not len(self.items):
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
@@ -886,7 +886,10 @@ def conflicts(
         return np.zeros(0, dtype=bool)
     origin = later[:, :1]
     a, b = earlier - origin, shrink_convex(later - origin, shrink)
-    gap = sat_gap(a, b)
+    (alo, ahi), (blo, bhi) = _boxes(a), _boxes(b)
+    gap = _fold(np.maximum, np.maximum(blo - ahi, alo - bhi))  # apart along x or y
+    sat = np.flatnonzero(~(gap > shrink / 4))
+    gap[sat] = sat_gap(_rows(a, sat), _rows(b, sat))
     scale, reach = _absmax(later), _absmax(a)
     sure = 16 * EPS * (reach + scale + shrink / SHRINK) < shrink / 4
     hit = ~(sure & (gap > shrink / 4))
@@ -1014,7 +1017,9 @@ def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list
     np.maximum.at(best, piece[inside], area[inside])
     close = inside[~(area[inside] < best[piece[inside]] * (1 - 1e-6))]  # NaN kept: ask
     exact = np.full(n, -np.inf)
-    exact[close] = shapely.area(faces.polygons(close))
+    exact[close] = area[close]
+    tie = close[np.bincount(piece[close], minlength=p.n_pieces)[piece[close]] > 1]
+    exact[tie] = shapely.area(faces.polygons(tie))
     exact = np.where(np.isnan(exact), np.inf, exact)  # np.argmax takes a NaN first
     order = close[np.lexsort((close, -exact[close], piece[close]))]
     first = order[np.r_[True, piece[order][1:] != piece[order][:-1]]]
