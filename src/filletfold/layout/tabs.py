@@ -506,7 +506,8 @@ def _padded(coords: np.ndarray, flat: np.ndarray, start: np.ndarray, faces: np.n
     """The corners (len(faces), k, 2) of faces of at most ``k`` corners, the last repeated."""
     size = start[faces + 1] - start[faces]
     slot = np.minimum(np.arange(k), size[:, None] - 1)
-    return coords[flat[start[faces][:, None] + slot]]
+    at = np.take(flat, (start[faces][:, None] + slot).ravel())
+    return np.take(coords, at, axis=0).reshape(len(faces), k, coords.shape[1])
 
 
 def _convex(corners: np.ndarray) -> np.ndarray:
@@ -567,10 +568,11 @@ class _Grid:
                 break
             cell *= 2
         keys, items, first = self._entries(c0, c1, kept)
-        order = np.argsort(keys)
+        order = _argsort_small(keys, int(np.prod(self.shape)))
         self.items, self.first = items[order], first[order]
         # the entries of cell k: items[start[k]:start[k + 1]]
-        self.start = np.searchsorted(keys[order], np.arange(int(np.prod(self.shape)) + 1))
+        self.start = np.zeros(int(np.prod(self.shape)) + 1, dtype=np.int64)
+        np.cumsum(np.bincount(keys, minlength=len(self.start) - 1), out=self.start[1:])
 
     def _cells(self, lo, hi):
         """The first and last cells (n, 2) that boxes cover, clipped to the grid."""
@@ -617,6 +619,16 @@ class _Grid:
         qa, fb = [np.take(x, a) for x in box.T], [np.take(x, b) for x in self.cols]
         keep = (qa[0] <= fb[2]) & (fb[0] <= qa[2]) & (qa[1] <= fb[3]) & (fb[1] <= qa[3])
         return a[keep], b[keep]
+
+
+def _argsort_small(keys: np.ndarray, bound: int) -> np.ndarray:
+    """Stable ``np.argsort`` of integers in ``[0, bound)``: radix passes on 16 bits."""
+    if bound <= 1 << 16:
+        return np.argsort(keys.astype(np.uint16), kind="stable")
+    if bound <= 1 << 32:
+        low = np.argsort((keys & 0xFFFF).astype(np.uint16), kind="stable")
+        return low[np.argsort((keys[low] >> 16).astype(np.uint16), kind="stable")]
+    return np.argsort(keys, kind="stable")
 
 
 def _boxes(quads: np.ndarray):
