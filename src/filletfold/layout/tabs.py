@@ -71,7 +71,7 @@ def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     cut = np.flatnonzero(p.edge_assignment == "B")
     vertex, end = np.unique(p.edges[cut], return_inverse=True)
     at = np.round(p.vertices_3d[vertex], decimals) + 0.0  # no -0.0
-    nan = np.isnan(at).any(axis=1)  # NaN is equal to nothing: never paired
+    nan = _fold(np.logical_or, np.isnan(at))  # NaN is equal to nothing: never paired
     keep = ~nan[end.reshape(-1, 2)].any(axis=1)
     cut, end = cut[keep], end.reshape(-1, 2)[keep]
     if len(cut) == 0:
@@ -82,7 +82,8 @@ def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     same = np.empty(len(bits), dtype=np.int64)  # the rounded point of each vertex
     same[order] = np.cumsum(step) - 1
     point = same[end]
-    key = point.min(axis=1) * (int(point.max()) + 1) + point.max(axis=1)
+    a, b = point[:, 0], point[:, 1]
+    key = np.minimum(a, b) * (len(bits) + 1) + np.maximum(a, b)
     order = np.lexsort((cut, key))  # by segment, then by edge
     key, edge = key[order], cut[order]
     first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
@@ -182,7 +183,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         The unit normal pointing away from the face of the run's first edge.
     """
     n = len(start) - 1
-    pts = p.vertices_2d[p.edges[edges].ravel()]  # two per edge
+    pts = _rows(p.vertices_2d, _rows(p.edges, edges).ravel())  # two per edge
     at = 2 * start[:-1]
     d = np.maximum.reduceat(pts, at, axis=0) - np.minimum.reduceat(pts, at, axis=0)
     norm = _rownorm(d)
@@ -196,7 +197,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         # the bits of `points @ axis` (a BLAS gemv), and np.argmin's first of the smallest
         t = np.matmul(pts[at_k], axis[runs][:, :, None])[..., 0]
         lo[runs], hi[runs] = at_k[:, 0] + t.argmin(axis=1), at_k[:, 0] + t.argmax(axis=1)
-    ends = np.stack([pts[lo], pts[hi]], axis=1)
+    ends = np.stack([_rows(pts, lo), _rows(pts, hi)], axis=1)
     flat, fstart = face_arrays(p.faces)
     face = p.edge_faces[edges[start[:-1]]].max(axis=1)
     size = fstart[face + 1] - fstart[face]
@@ -205,7 +206,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         + np.arange(size.sum())
         - np.repeat(np.cumsum(size) - size, size)
     )
-    centre = np.add.reduceat(p.vertices_2d[flat[corner]], np.cumsum(size) - size, axis=0)
+    centre = np.add.reduceat(_rows(p.vertices_2d, flat[corner]), np.cumsum(size) - size, axis=0)
     centre /= size[:, None]
     normal = np.stack([-axis[:, 1], axis[:, 0]], axis=1)
     flip = _rowdot(centre - (ends[:, 0] + ends[:, 1]) / 2, normal) > 0
@@ -510,23 +511,28 @@ def _padded(coords: np.ndarray, flat: np.ndarray, start: np.ndarray, faces: np.n
     return np.take(coords, at, axis=0).reshape(len(faces), k, coords.shape[1])
 
 
-def _convex(corners: np.ndarray) -> np.ndarray:
-    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12)."""
+def _turns(corners: np.ndarray) -> np.ndarray:
+    """(n, k) float: the sines of the turns at the corners of polygons (n, k, 2) (NaN at a
+    side of no length)."""
     edge = _next(corners) - corners
     length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        turn = _cross(edge, _next(edge)) / (length * _next(length))
+        return _cross(edge, _next(edge)) / (length * _next(length))
+
+
+def _convex(corners: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
+    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12);
+    ``turn``: their :func:`_turns`, if known."""
+    turn = _turns(corners) if turn is None else turn
     turn = np.where(np.isnan(turn), 0.0, turn)  # repeated corners turn by nothing
     return _fold(np.logical_and, turn >= -1e-12) | _fold(np.logical_and, turn <= 1e-12)
 
 
-def _surely_valid(quads: np.ndarray) -> np.ndarray:
-    """(n,) bool: quadrilaterals that are strictly convex by a margin far above round-off (so
-    valid polygons); False means "ask shapely"."""
-    edge = _next(quads) - quads
-    length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        turn = _cross(edge, _next(edge)) / (length * _next(length))
+def _surely_valid(quads: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
+    """(n,) bool: polygons that are strictly convex by a margin far above round-off (so
+    valid polygons); False means "ask shapely". ``turn``: their :func:`_turns`, if known."""
+    turn = _turns(quads) if turn is None else turn
+    with np.errstate(invalid="ignore"):
         return _fold(np.logical_and, turn > 1e-6) | _fold(np.logical_and, turn < -1e-6)
 
 
@@ -673,9 +679,10 @@ class _Faces:
             corners = _padded(self.coords, self.flat, self.start, faces, k)
             finite[faces] = np.isfinite(corners).all(axis=(1, 2))
             lo[faces], hi[faces] = _boxes(corners)
+            turn = _turns(corners)
             if k <= 8:  # not padded: strictly convex is valid, no need to ask shapely
-                valid[faces] = _surely_valid(corners)
-            self.convex[faces] = _convex(corners)
+                valid[faces] = _surely_valid(corners, turn)
+            self.convex[faces] = _convex(corners, turn)
             u = _side_normals(corners)
             t = [
                 u[..., 0] * corners[:, i, None, 0] + u[..., 1] * corners[:, i, None, 1]
@@ -969,7 +976,6 @@ def _tabs_and_labels(p, tab_height, part_names):
         ends, normal = np.stack([ea, eb], axis=1)[long], np.stack([na, nb], axis=1)[long]
         first_a, first_b = side_a[start[:-1][long]], side_b[start[:-1][long]]
     n_runs = len(ends)
-    piece_of_edge = p.face_piece[p.edge_faces.max(axis=1)]
     names = part_names or [f"P{k + 1}" for k in range(p.n_pieces)]
     stats = {"cut_borders": n_runs, "tabs": 0, "tabs_reduced": 0, "untabbed": n_runs}
     seams = []
@@ -982,8 +988,8 @@ def _tabs_and_labels(p, tab_height, part_names):
         ann.tab_hinges.extend(list(hinges))
         tab_on = np.full(n_runs, -1)
         tab_on[run] = side
-        a = [names[k] for k in piece_of_edge[first_a].tolist()]
-        b = [names[k] for k in piece_of_edge[first_b].tolist()]
+        a = [names[k] for k in _piece_of(p, first_a).tolist()]
+        b = [names[k] for k in _piece_of(p, first_b).tolist()]
         for n, (pa, pb, on) in enumerate(zip(a, b, tab_on.tolist(), strict=True)):
             tab = None if on < 0 else (pa, pb)[on]
             seams.append({"label": n + 1, "pieces": [pa, pb], "tab_on": tab})
@@ -1014,6 +1020,11 @@ def _no_gc():
     finally:
         if enabled:
             gc.enable()
+
+
+def _piece_of(p: CreasePattern, edges: np.ndarray) -> np.ndarray:
+    """The piece of the face of each (border) edge."""
+    return np.take(p.face_piece, _fold(np.maximum, _rows(p.edge_faces, edges)))
 
 
 def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list:
