@@ -38,6 +38,10 @@ OVERLAP = 1e-12
 #: 5 in 3 (side A, then B).
 COVER = (0, 1, 0, 1, 4, 5, 6, 7, 4, 5, 6, 7)
 
+#: The order levels are tested in within a round: a tab held in another first (if it
+#: overlaps a face widely, so does the other).
+HOLDS_FIRST = (0, 1, 4, 5, 2, 3)
+
 #: The candidates tested together (each round: on the borders still undecided).
 ROUNDS = ((0,), (1,), (2, 3), (4, 5, 6, 7, 8, 9, 10, 11))
 
@@ -743,14 +747,17 @@ class _Faces:
 
         Returns
         -------
-        (n,) int
+        blocker : (n,) int
             -1 where the tab shrunk by ``SHRINK`` of the tab height overlaps no face by more
             than ``OVERLAP`` of its area, else a face it overlaps.
+        wide : (n,) bool
+            The tabs that the arrays find overlapping their blocker by far more than that
+            (so does any larger tab that holds them).
         """
         n = len(quads)
         blocker = np.full(n, -1, dtype=np.int64)
         if n == 0 or len(self.bucket) == 0:
-            return blocker
+            return blocker, np.zeros(n, dtype=bool)
         s = self.s
         local = quads - quads[:, :1]
         normal, offset = inward_lines(local)
@@ -769,6 +776,7 @@ class _Faces:
             "inner": shrink_convex(local, s / 2, normal),  # about the origin
             "least": 1e-9 * area + 2 * s * perimeter,
             "reach": _absmax(quads) + _absmax(local) + self.h,
+            "wide": np.zeros(n, dtype=bool),
         }
         if hint is not None:
             t = np.flatnonzero(hint >= 0)
@@ -783,7 +791,7 @@ class _Faces:
         if len(slow):
             hit = self._exact(quads, tabs[slow], faces[slow])
             blocker[tabs[slow[hit]]] = faces[slow[hit]]
-        return blocker
+        return blocker, frame["wide"]
 
     def _pairs(self, frame, tabs, faces, blocker, slow):
         """Test pairs of a tab and a face; set ``blocker`` of the tabs found overlapping.
@@ -860,6 +868,7 @@ class _Faces:
                 )
             big = ~empty & (got > np.take(frame["least"], tp))
             blocker[tp[big]] = fp[big]
+            frame["wide"][tp[big]] = True
             if slow is not None:
                 slow.append(np.take(pair, part[~empty & ~big]))
 
@@ -1148,12 +1157,21 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         keep = np.flatnonzero(valid & (area > least))
         c, q, area = c[keep], _rows(q, keep), area[keep]
         blocked = np.zeros(len(c), dtype=bool)
-        for level in np.unique(c % n_cand // 2).tolist():  # a side's last blocker first
-            at = np.flatnonzero(c % n_cand // 2 == level)
-            found = faces.clear(_rows(q, at), area[at], blocker_of[c[at] // n_cand, c[at] % 2])
+        level = c % n_cand // 2
+        held = np.zeros(n * n_cand, dtype=bool)  # held by a tab found wide of its blocker
+        for lv in sorted(set(level.tolist()), key=HOLDS_FIRST.index):
+            at = np.flatnonzero(level == lv)
+            sure = held[c[at]]
+            blocked[at[sure]] = True  # their blockers stay those of their held tabs
+            at = at[~sure]
+            found, wide = faces.clear(
+                _rows(q, at), area[at], blocker_of[c[at] // n_cand, c[at] % 2]
+            )
             hit = at[found >= 0]
             blocked[hit] = True
             blocker_of[c[hit] // n_cand, c[hit] % 2] = found[found >= 0]
+            holder = c[at[wide]] - c[at[wide]] % n_cand + np.asarray(COVER)[c[at[wide]] % n_cand]
+            held[holder[holder != c[at[wide]]]] = True
         c = c[~blocked]
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
