@@ -200,7 +200,7 @@ def test_face_tests_agree_with_shapely(seed, far):
     keep = [i for i, t in enumerate(shapes) if t.is_valid and t.area > 0]
     quads, shapes = quads[keep], [shapes[i] for i in keep]
     area = np.array([t.area for t in shapes])
-    got = tabs._Faces(p, h).clear(quads, area) < 0
+    got = tabs._Faces(p, h).clear(quads, area)[0] < 0
     for k, t in enumerate(shapes):
         shrunk = t.buffer(-tabs.SHRINK * h)
         want = not any(

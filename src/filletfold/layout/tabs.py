@@ -14,6 +14,9 @@ the few others, exactly as it would decide them one at a time.
 
 from __future__ import annotations
 
+import gc
+from contextlib import contextmanager
+
 import numpy as np
 import shapely
 from scipy.sparse import coo_array
@@ -34,6 +37,10 @@ OVERLAP = 1e-12
 #: A candidate that holds each (the same or a larger tab on the same hinge): 1 in 0, 4 in 2,
 #: 5 in 3 (side A, then B).
 COVER = (0, 1, 0, 1, 4, 5, 6, 7, 4, 5, 6, 7)
+
+#: The order levels are tested in within a round: a tab held in another first (if it
+#: overlaps a face widely, so does the other).
+HOLDS_FIRST = (0, 1, 4, 5, 2, 3)
 
 #: The candidates tested together (each round: on the borders still undecided).
 ROUNDS = ((0,), (1,), (2, 3), (4, 5, 6, 7, 8, 9, 10, 11))
@@ -68,7 +75,7 @@ def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     cut = np.flatnonzero(p.edge_assignment == "B")
     vertex, end = np.unique(p.edges[cut], return_inverse=True)
     at = np.round(p.vertices_3d[vertex], decimals) + 0.0  # no -0.0
-    nan = np.isnan(at).any(axis=1)  # NaN is equal to nothing: never paired
+    nan = _fold(np.logical_or, np.isnan(at))  # NaN is equal to nothing: never paired
     keep = ~nan[end.reshape(-1, 2)].any(axis=1)
     cut, end = cut[keep], end.reshape(-1, 2)[keep]
     if len(cut) == 0:
@@ -79,7 +86,8 @@ def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     same = np.empty(len(bits), dtype=np.int64)  # the rounded point of each vertex
     same[order] = np.cumsum(step) - 1
     point = same[end]
-    key = point.min(axis=1) * (int(point.max()) + 1) + point.max(axis=1)
+    a, b = point[:, 0], point[:, 1]
+    key = np.minimum(a, b) * (len(bits) + 1) + np.maximum(a, b)
     order = np.lexsort((cut, key))  # by segment, then by edge
     key, edge = key[order], cut[order]
     first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
@@ -179,7 +187,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         The unit normal pointing away from the face of the run's first edge.
     """
     n = len(start) - 1
-    pts = p.vertices_2d[p.edges[edges].ravel()]  # two per edge
+    pts = _rows(p.vertices_2d, _rows(p.edges, edges).ravel())  # two per edge
     at = 2 * start[:-1]
     d = np.maximum.reduceat(pts, at, axis=0) - np.minimum.reduceat(pts, at, axis=0)
     norm = _rownorm(d)
@@ -193,7 +201,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         # the bits of `points @ axis` (a BLAS gemv), and np.argmin's first of the smallest
         t = np.matmul(pts[at_k], axis[runs][:, :, None])[..., 0]
         lo[runs], hi[runs] = at_k[:, 0] + t.argmin(axis=1), at_k[:, 0] + t.argmax(axis=1)
-    ends = np.stack([pts[lo], pts[hi]], axis=1)
+    ends = np.stack([_rows(pts, lo), _rows(pts, hi)], axis=1)
     flat, fstart = face_arrays(p.faces)
     face = p.edge_faces[edges[start[:-1]]].max(axis=1)
     size = fstart[face + 1] - fstart[face]
@@ -202,7 +210,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         + np.arange(size.sum())
         - np.repeat(np.cumsum(size) - size, size)
     )
-    centre = np.add.reduceat(p.vertices_2d[flat[corner]], np.cumsum(size) - size, axis=0)
+    centre = np.add.reduceat(_rows(p.vertices_2d, flat[corner]), np.cumsum(size) - size, axis=0)
     centre /= size[:, None]
     normal = np.stack([-axis[:, 1], axis[:, 0]], axis=1)
     flip = _rowdot(centre - (ends[:, 0] + ends[:, 1]) / 2, normal) > 0
@@ -480,6 +488,12 @@ def _absmax(a: np.ndarray) -> np.ndarray:
     return _fold(np.maximum, np.abs(a).reshape(len(a), -1))
 
 
+def _rows(a: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``a[index]`` for an int array ``index``, much faster for an ``a`` of several
+    dimensions (``np.take`` along the first axis)."""
+    return np.take(a, index, axis=0)
+
+
 def _pad(a: np.ndarray, width: int) -> np.ndarray:
     """An (n, k) array widened to (n, width) by repeating its last column."""
     if a.shape[1] == width:
@@ -497,26 +511,32 @@ def _padded(coords: np.ndarray, flat: np.ndarray, start: np.ndarray, faces: np.n
     """The corners (len(faces), k, 2) of faces of at most ``k`` corners, the last repeated."""
     size = start[faces + 1] - start[faces]
     slot = np.minimum(np.arange(k), size[:, None] - 1)
-    return coords[flat[start[faces][:, None] + slot]]
+    at = np.take(flat, (start[faces][:, None] + slot).ravel())
+    return np.take(coords, at, axis=0).reshape(len(faces), k, coords.shape[1])
 
 
-def _convex(corners: np.ndarray) -> np.ndarray:
-    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12)."""
+def _turns(corners: np.ndarray) -> np.ndarray:
+    """(n, k) float: the sines of the turns at the corners of polygons (n, k, 2) (NaN at a
+    side of no length)."""
     edge = _next(corners) - corners
     length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        turn = _cross(edge, _next(edge)) / (length * _next(length))
+        return _cross(edge, _next(edge)) / (length * _next(length))
+
+
+def _convex(corners: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
+    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12);
+    ``turn``: their :func:`_turns`, if known."""
+    turn = _turns(corners) if turn is None else turn
     turn = np.where(np.isnan(turn), 0.0, turn)  # repeated corners turn by nothing
     return _fold(np.logical_and, turn >= -1e-12) | _fold(np.logical_and, turn <= 1e-12)
 
 
-def _surely_valid(quads: np.ndarray) -> np.ndarray:
-    """(n,) bool: quadrilaterals that are strictly convex by a margin far above round-off (so
-    valid polygons); False means "ask shapely"."""
-    edge = _next(quads) - quads
-    length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        turn = _cross(edge, _next(edge)) / (length * _next(length))
+def _surely_valid(quads: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
+    """(n,) bool: polygons that are strictly convex by a margin far above round-off (so
+    valid polygons); False means "ask shapely". ``turn``: their :func:`_turns`, if known."""
+    turn = _turns(quads) if turn is None else turn
+    with np.errstate(invalid="ignore"):
         return _fold(np.logical_and, turn > 1e-6) | _fold(np.logical_and, turn < -1e-6)
 
 
@@ -537,10 +557,11 @@ class _Grid:
 
     def __init__(self, lo: np.ndarray, hi: np.ndarray):
         self.box = np.concatenate([lo, hi], axis=1)  # (n, 4): x0, y0, x1, y1
+        self.cols = [np.ascontiguousarray(x) for x in self.box.T]
         kept = np.flatnonzero(np.isfinite(self.box).all(axis=1))
         self.origin, self.cell, self.shape = np.zeros(2), 1.0, np.ones(2, dtype=np.int64)
-        self.low = np.zeros((len(lo), 2), dtype=np.int64)  # the first cell of each box
         self.items = np.zeros(0, dtype=np.int64)
+        self.first = np.zeros(0, dtype=np.uint8)  # 1: a box's first column, 2: first row
         self.start = np.zeros(2, dtype=np.int64)
         if not len(kept):
             return
@@ -556,12 +577,12 @@ class _Grid:
             if np.prod(c1 - c0 + 1, axis=1).sum() <= 8 * len(kept) + 1024:
                 break
             cell *= 2
-        self.low[kept] = c0
-        keys, items, _, _ = self._entries(c0, c1, kept)
-        order = np.argsort(keys)
-        self.items = items[order]
+        keys, items, first = self._entries(c0, c1, kept)
+        order = _argsort_small(keys, int(np.prod(self.shape)))
+        self.items, self.first = items[order], first[order]
         # the entries of cell k: items[start[k]:start[k + 1]]
-        self.start = np.searchsorted(keys[order], np.arange(int(np.prod(self.shape)) + 1))
+        self.start = np.zeros(int(np.prod(self.shape)) + 1, dtype=np.int64)
+        np.cumsum(np.bincount(keys, minlength=len(self.start) - 1), out=self.start[1:])
 
     def _cells(self, lo, hi):
         """The first and last cells (n, 2) that boxes cover, clipped to the grid."""
@@ -571,14 +592,16 @@ class _Grid:
         return np.clip(c0, 0, top).astype(np.int64), np.clip(c1, -1, top).astype(np.int64)
 
     def _entries(self, c0, c1, items):
-        """(cell key, item, cell x, cell y) of every cell of every box."""
+        """(cell key, item, whether the cell is in the box's first column (1) and row (2))
+        of every cell of every box."""
         w = np.maximum(c1 - c0 + 1, 0)
         count = w[:, 0] * w[:, 1]
         item = np.repeat(np.arange(len(c0)), count)
         k = np.arange(len(item)) - np.repeat(np.cumsum(count) - count, count)
         wy = np.maximum(w[item, 1], 1)
-        ix, iy = c0[item, 0] + k // wy, c0[item, 1] + k % wy
-        return ix * self.shape[1] + iy, items[item], ix, iy
+        dx, dy = k // wy, k % wy
+        first = (dx == 0).astype(np.uint8) | ((dy == 0).astype(np.uint8) << 1)
+        return (c0[item, 0] + dx) * self.shape[1] + c0[item, 1] + dy, items[item], first
 
     def query(self, lo: np.ndarray, hi: np.ndarray):
         """The pairs of a box (``lo``, ``hi``: (m, 2)) and a filed box that overlap (closed).
@@ -586,7 +609,7 @@ class _Grid:
         Returns
         -------
         (k,) int, (k,) int
-            The boxes asked and the filed ones, in the order of the boxes asked.
+            The boxes asked and the filed ones.
         """
         if not len(lo) or not len(self.items):
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
@@ -594,22 +617,28 @@ class _Grid:
         finite = np.isfinite(box).all(axis=1)
         c0, c1 = self._cells(np.where(finite[:, None], lo, 0), np.where(finite[:, None], hi, -1))
         c1[~finite] = -1
-        keys, asked, ix, iy = self._entries(c0, c1, np.arange(len(lo)))
+        keys, asked, low = self._entries(c0, c1, np.arange(len(lo)))
         first = self.start[keys]
         count = self.start[keys + 1] - first
         which = np.repeat(np.arange(len(keys)), count)
         at = np.arange(len(which)) + np.repeat(first - np.cumsum(count) + count, count)
-        a, b = asked[which], self.items[at]
-        # each pair once: in the cell of the low corner of the two boxes' overlap
-        low_a, low_b = c0[a], self.low[b]
-        keep = (np.maximum(low_a[:, 0], low_b[:, 0]) == ix[which]) & (
-            np.maximum(low_a[:, 1], low_b[:, 1]) == iy[which]
-        )
-        a, b = a[keep], b[keep]
-        qa, fb = box[a], self.box[b]
-        keep = (qa[:, 0] <= fb[:, 2]) & (fb[:, 0] <= qa[:, 2])
-        keep &= (qa[:, 1] <= fb[:, 3]) & (fb[:, 1] <= qa[:, 3])
+        # each pair once: in the cell of the low corner of the two boxes' overlap, which is
+        # in the first column of one of them and in the first row of one of them
+        keep = np.flatnonzero((np.take(low, which) | np.take(self.first, at)) == 3)
+        a, b = np.take(asked, np.take(which, keep)), np.take(self.items, np.take(at, keep))
+        qa, fb = [np.take(x, a) for x in box.T], [np.take(x, b) for x in self.cols]
+        keep = (qa[0] <= fb[2]) & (fb[0] <= qa[2]) & (qa[1] <= fb[3]) & (fb[1] <= qa[3])
         return a[keep], b[keep]
+
+
+def _argsort_small(keys: np.ndarray, bound: int) -> np.ndarray:
+    """Stable ``np.argsort`` of integers in ``[0, bound)``: radix passes on 16 bits."""
+    if bound <= 1 << 16:
+        return np.argsort(keys.astype(np.uint16), kind="stable")
+    if bound <= 1 << 32:
+        low = np.argsort((keys & 0xFFFF).astype(np.uint16), kind="stable")
+        return low[np.argsort((keys[low] >> 16).astype(np.uint16), kind="stable")]
+    return np.argsort(keys, kind="stable")
 
 
 def _boxes(quads: np.ndarray):
@@ -654,9 +683,10 @@ class _Faces:
             corners = _padded(self.coords, self.flat, self.start, faces, k)
             finite[faces] = np.isfinite(corners).all(axis=(1, 2))
             lo[faces], hi[faces] = _boxes(corners)
+            turn = _turns(corners)
             if k <= 8:  # not padded: strictly convex is valid, no need to ask shapely
-                valid[faces] = _surely_valid(corners)
-            self.convex[faces] = _convex(corners)
+                valid[faces] = _surely_valid(corners, turn)
+            self.convex[faces] = _convex(corners, turn)
             u = _side_normals(corners)
             t = [
                 u[..., 0] * corners[:, i, None, 0] + u[..., 1] * corners[:, i, None, 1]
@@ -717,14 +747,17 @@ class _Faces:
 
         Returns
         -------
-        (n,) int
+        blocker : (n,) int
             -1 where the tab shrunk by ``SHRINK`` of the tab height overlaps no face by more
             than ``OVERLAP`` of its area, else a face it overlaps.
+        wide : (n,) bool
+            The tabs that the arrays find overlapping their blocker by far more than that
+            (so does any larger tab that holds them).
         """
         n = len(quads)
         blocker = np.full(n, -1, dtype=np.int64)
         if n == 0 or len(self.bucket) == 0:
-            return blocker
+            return blocker, np.zeros(n, dtype=bool)
         s = self.s
         local = quads - quads[:, :1]
         normal, offset = inward_lines(local)
@@ -733,18 +766,24 @@ class _Faces:
         # shrunk tab whatever round-off shapely and these figures make (checked by `sure`)
         frame = {
             "origin": quads[:, 0],
+            "ox": quads[:, 0, 0].copy(),
+            "oy": quads[:, 0, 1].copy(),
             "normal": normal,
             "offset": offset + s / 2,
+            "nx": np.ascontiguousarray(normal[..., 0].T),  # (4, n): side after side
+            "ny": np.ascontiguousarray(normal[..., 1].T),
+            "off": np.ascontiguousarray(offset.T + s / 2),
             "inner": shrink_convex(local, s / 2, normal),  # about the origin
             "least": 1e-9 * area + 2 * s * perimeter,
             "reach": _absmax(quads) + _absmax(local) + self.h,
+            "wide": np.zeros(n, dtype=bool),
         }
         if hint is not None:
             t = np.flatnonzero(hint >= 0)
             self._pairs(frame, t, hint[t], blocker, None)
         rest = np.flatnonzero(blocker < 0)
-        i, faces = self.grid.query(*_boxes(quads[rest]))
-        tabs = rest[i]
+        i, faces = self.grid.query(*_boxes(_rows(quads, rest)))
+        tabs = np.take(rest, i)
         slow = []
         self._pairs(frame, tabs, faces, blocker, slow)
         slow = np.concatenate(slow)
@@ -752,7 +791,7 @@ class _Faces:
         if len(slow):
             hit = self._exact(quads, tabs[slow], faces[slow])
             blocker[tabs[slow[hit]]] = faces[slow[hit]]
-        return blocker
+        return blocker, frame["wide"]
 
     def _pairs(self, frame, tabs, faces, blocker, slow):
         """Test pairs of a tab and a face; set ``blocker`` of the tabs found overlapping.
@@ -762,45 +801,45 @@ class _Faces:
         pairs are only clipped, and the undecided ones dropped.
         """
         s = self.s
-        reach = self.extent[faces] + frame["reach"][tabs]
-        sure = self.fast[faces] & (16 * EPS * reach < s / 4)
+        reach = np.take(self.extent, faces) + np.take(frame["reach"], tabs)
+        sure = np.take(self.fast, faces) & (16 * EPS * reach < s / 4)
         if slow is not None:
             slow.append(np.flatnonzero(~sure))
         todo = np.flatnonzero(sure)
-        bucket = self.bucket[faces[todo]]
-        normal, offset = frame["normal"], frame["offset"]
+        bucket = np.take(self.bucket, np.take(faces, todo))
+        nx, ny, off = frame["nx"], frame["ny"], frame["off"]
         kept = []
         for k in self.sets:
             pair = todo[bucket == k]
             if not len(pair):
                 continue
             fx, fy, ux, uy, lo, hi = self.sets[k]
-            t, row = tabs[pair], self.row[faces[pair]]
-            x = fx[row] - frame["origin"][t, 0, None]
-            y = fy[row] - frame["origin"][t, 1, None]
+            t, f = np.take(tabs, pair), np.take(faces, pair)
+            row = np.take(self.row, f)
+            x = _rows(fx, row) - np.take(frame["ox"], t)[:, None]
+            y = _rows(fy, row) - np.take(frame["oy"], t)[:, None]
             live = np.arange(len(pair))
             if slow is not None:
                 # apart along a side of the tab (its hinge first: its own piece's faces)
                 for j in range(4):
-                    tl = t[live]
-                    d = _colmax(x[live] * normal[tl, j, 0, None] + y[live] * normal[tl, j, 1, None])
-                    live = live[~(d - offset[tl, j] < -s / 4)]
+                    tl = np.take(t, live)
+                    xl, yl = _rows(x, live), _rows(y, live)
+                    d = _colmax(xl * np.take(nx[j], tl)[:, None] + yl * np.take(ny[j], tl)[:, None])
+                    live = live[~(d - np.take(off[j], tl) < -s / 4)]
                 # apart along a side of a convex face
-                conv = live[self.convex[faces[pair[live]]]]
+                conv = live[np.take(self.convex, np.take(f, live))]
                 if len(conv):
-                    r, tc = row[conv], t[conv]
-                    inner = frame["inner"][tc] + frame["origin"][tc, None]
-                    proj = [
-                        ux[r] * inner[:, i, 0, None] + uy[r] * inner[:, i, 1, None]
-                        for i in range(4)
-                    ]
+                    r, tc = np.take(row, conv), np.take(t, conv)
+                    inner = _rows(frame["inner"], tc) + _rows(frame["origin"], tc)[:, None]
+                    ur, vr = _rows(ux, r), _rows(uy, r)
+                    proj = [ur * inner[:, i, 0, None] + vr * inner[:, i, 1, None] for i in range(4)]
                     low, high = np.minimum.reduce(proj), np.maximum.reduce(proj)
-                    gap = np.maximum(low - hi[r], lo[r] - high)
+                    gap = np.maximum(low - _rows(hi, r), _rows(lo, r) - high)
                     apart = _fold(np.logical_or, gap > s / 4)  # NaN (no length): not apart
                     drop = np.zeros(len(pair), dtype=bool)
                     drop[conv[apart]] = True
                     live = live[~drop[live]]
-            kept.append((pair[live], x[live], y[live]))
+            kept.append((np.take(pair, live), _rows(x, live), _rows(y, live)))
         if not kept:
             return
         # a tab is blocked by its first overlapping face: clip the first pair of every tab,
@@ -810,23 +849,28 @@ class _Faces:
         poly = np.concatenate(
             [np.stack([_pad(x, width), _pad(y, width)], axis=-1) for _, x, y in kept]
         )
-        t = tabs[pair]
+        t = np.take(tabs, pair)
         first = np.zeros(len(pair), dtype=bool)
         first[np.unique(t, return_index=True)[1]] = True
         for part in (np.flatnonzero(first), np.flatnonzero(~first)):
-            part = part[blocker[t[part]] < 0]
+            part = part[np.take(blocker, np.take(t, part)) < 0]
             if not len(part):
                 continue
-            tp = t[part]
-            got, empty, doubt = convex_overlap(poly[part], frame["inner"][tp])
-            doubt |= ~self.convex[faces[pair[part]]]
+            tp, fp = np.take(t, part), np.take(faces, np.take(pair, part))
+            pp = _rows(poly, part)
+            got, empty, doubt = convex_overlap(pp, _rows(frame["inner"], tp))
+            doubt |= ~np.take(self.convex, fp)
             if doubt.any():  # Sutherland-Hodgman: faces not convex, touching sides
                 d = np.flatnonzero(doubt)
-                got[d], empty[d] = clip_area(poly[part[d]], normal[tp[d]], offset[tp[d]])
-            big = ~empty & (got > frame["least"][tp])
-            blocker[tp[big]] = faces[pair[part[big]]]
+                td = np.take(tp, d)
+                got[d], empty[d] = clip_area(
+                    _rows(pp, d), _rows(frame["normal"], td), _rows(frame["offset"], td)
+                )
+            big = ~empty & (got > np.take(frame["least"], tp))
+            blocker[tp[big]] = fp[big]
+            frame["wide"][tp[big]] = True
             if slow is not None:
-                slow.append(pair[part[~empty & ~big]])
+                slow.append(np.take(pair, part[~empty & ~big]))
 
     def _exact(self, quads, tabs, faces):
         """Blocked pairs of a tab and a face, by shapely on the tab shrunk by ``SHRINK``."""
@@ -870,7 +914,10 @@ def conflicts(
         return np.zeros(0, dtype=bool)
     origin = later[:, :1]
     a, b = earlier - origin, shrink_convex(later - origin, shrink)
-    gap = sat_gap(a, b)
+    (alo, ahi), (blo, bhi) = _boxes(a), _boxes(b)
+    gap = _fold(np.maximum, np.maximum(blo - ahi, alo - bhi))  # apart along x or y
+    sat = np.flatnonzero(~(gap > shrink / 4))
+    gap[sat] = sat_gap(_rows(a, sat), _rows(b, sat))
     scale, reach = _absmax(later), _absmax(a)
     sure = 16 * EPS * (reach + scale + shrink / SHRINK) < shrink / 4
     hit = ~(sure & (gap > shrink / 4))
@@ -918,6 +965,12 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         ``untabbed`` (cut borders where no tab fits: they keep their two labels) and ``seams``
         (per label: the two pieces it joins and the piece carrying the tab).
     """
+    with _no_gc():
+        return _tabs_and_labels(p, tab_height, part_names)
+
+
+def _tabs_and_labels(p, tab_height, part_names):
+    """The work of :func:`add_tabs_and_labels`."""
     faces = _Faces(p, tab_height)
     ann = Annotations(sheets=p.annotations.sheets)
     label_h = 0.45 * tab_height
@@ -932,7 +985,6 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         ends, normal = np.stack([ea, eb], axis=1)[long], np.stack([na, nb], axis=1)[long]
         first_a, first_b = side_a[start[:-1][long]], side_b[start[:-1][long]]
     n_runs = len(ends)
-    piece_of_edge = p.face_piece[p.edge_faces.max(axis=1)]
     names = part_names or [f"P{k + 1}" for k in range(p.n_pieces)]
     stats = {"cut_borders": n_runs, "tabs": 0, "tabs_reduced": 0, "untabbed": n_runs}
     seams = []
@@ -945,8 +997,8 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
         ann.tab_hinges.extend(list(hinges))
         tab_on = np.full(n_runs, -1)
         tab_on[run] = side
-        a = [names[k] for k in piece_of_edge[first_a].tolist()]
-        b = [names[k] for k in piece_of_edge[first_b].tolist()]
+        a = [names[k] for k in _piece_of(p, first_a).tolist()]
+        b = [names[k] for k in _piece_of(p, first_b).tolist()]
         for n, (pa, pb, on) in enumerate(zip(a, b, tab_on.tolist(), strict=True)):
             tab = None if on < 0 else (pa, pb)[on]
             seams.append({"label": n + 1, "pieces": [pa, pb], "tab_on": tab})
@@ -965,6 +1017,25 @@ def add_tabs_and_labels(p: CreasePattern, tab_height: float, *, part_names=None)
     return stats
 
 
+@contextmanager
+def _no_gc():
+    """No automatic garbage collection inside: the labels and seams made here live on, and
+    each of the collections their numbers would set off (some 70 on hull1000, some
+    walking every object of the design) finds nothing to free."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _piece_of(p: CreasePattern, edges: np.ndarray) -> np.ndarray:
+    """The piece of the face of each (border) edge."""
+    return np.take(p.face_piece, _fold(np.maximum, _rows(p.edge_faces, edges)))
+
+
 def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list:
     """Every piece's part number, inside its largest face (the first of the largest, by
     shapely's areas: asked where two are within round-off)."""
@@ -978,7 +1049,9 @@ def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list
     np.maximum.at(best, piece[inside], area[inside])
     close = inside[~(area[inside] < best[piece[inside]] * (1 - 1e-6))]  # NaN kept: ask
     exact = np.full(n, -np.inf)
-    exact[close] = shapely.area(faces.polygons(close))
+    exact[close] = area[close]
+    tie = close[np.bincount(piece[close], minlength=p.n_pieces)[piece[close]] > 1]
+    exact[tie] = shapely.area(faces.polygons(tie))
     exact = np.where(np.isnan(exact), np.inf, exact)  # np.argmax takes a NaN first
     order = close[np.lexsort((close, -exact[close], piece[close]))]
     first = order[np.r_[True, piece[order][1:] != piece[order][:-1]]]
@@ -1010,10 +1083,10 @@ def _candidates(ends, normal, tab_height, cand):
             at = np.flatnonzero(k == 2 * level + side)
             if not len(at):
                 continue
-            sub = ends[border[at], side]
+            sub = _rows(ends, border[at])[:, side]
             sub = sub if part is None else _halves(sub, part)
             height[at] = scale * tab_height
-            quads[at], ok[at] = tab_outlines(sub, normal[border[at], side], height[at])
+            quads[at], ok[at] = tab_outlines(sub, _rows(normal, border[at])[:, side], height[at])
             hinges[at] = sub
     return quads, hinges, ok, height
 
@@ -1074,7 +1147,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         c = tried = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
         q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
         quads[row(c)] = q
-        c, q, height = c[ok], q[ok], height[ok]
+        c, q, height = c[ok], np.compress(ok, q, axis=0), height[ok]
         area, least = _area(q), 1e-3 * height**2
         valid = _surely_valid(q)
         doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > 1e-6 * least))
@@ -1082,19 +1155,28 @@ def _choose(faces: _Faces, ends, normal, tab_height):
             shapes = _closed_polygons(q[doubt])
             valid[doubt], area[doubt] = shapely.is_valid(shapes), shapely.area(shapes)
         keep = np.flatnonzero(valid & (area > least))
-        c, q, area = c[keep], q[keep], area[keep]
+        c, q, area = c[keep], _rows(q, keep), area[keep]
         blocked = np.zeros(len(c), dtype=bool)
-        for level in np.unique(c % n_cand // 2).tolist():  # a side's last blocker first
-            at = np.flatnonzero(c % n_cand // 2 == level)
-            found = faces.clear(q[at], area[at], blocker_of[c[at] // n_cand, c[at] % 2])
+        level = c % n_cand // 2
+        held = np.zeros(n * n_cand, dtype=bool)  # held by a tab found wide of its blocker
+        for lv in sorted(set(level.tolist()), key=HOLDS_FIRST.index):
+            at = np.flatnonzero(level == lv)
+            sure = held[c[at]]
+            blocked[at[sure]] = True  # their blockers stay those of their held tabs
+            at = at[~sure]
+            found, wide = faces.clear(
+                _rows(q, at), area[at], blocker_of[c[at] // n_cand, c[at] % 2]
+            )
             hit = at[found >= 0]
             blocked[hit] = True
             blocker_of[c[hit] // n_cand, c[hit] % 2] = found[found >= 0]
+            holder = c[at[wide]] - c[at[wide]] % n_cand + np.asarray(COVER)[c[at[wide]] % n_cand]
+            held[holder[holder != c[at[wide]]]] = True
         c = c[~blocked]
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
         # the sides of other borders near the new candidates
-        i, j = sides.query(*_boxes(quads[row(c)]))
+        i, j = sides.query(*_boxes(_rows(quads, row(c))))
         pc, ps = c[i], j
         other = ps // 2 != pc // n_cand
         pc, ps = pc[other], ps[other]
@@ -1103,13 +1185,13 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         # border's tab the quarter-height one)
         lo = np.flatnonzero(ps // 2 < pc // n_cand)
         lo = lo[state.undecided[ps[lo] // 2]]
-        lo = lo[conflicts(envelope[ps[lo]], quads[row(pc[lo])], s, exact=False)]
+        lo = lo[conflicts(_rows(envelope, ps[lo]), _rows(quads, row(pc[lo])), s, exact=False)]
         a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
         holder = np.asarray(COVER)[b % n_cand]
         cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
         key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
         held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
-        maybe = conflicts(held, quads[row(key // (n * n_cand))], s, exact=False) | ~fits
+        maybe = conflicts(held, _rows(quads, row(key // (n * n_cand))), s, exact=False) | ~fits
         state.might_meet(a[maybe[inv]], b[maybe[inv]])
         # the tested candidates of those sides: which tabs intersect which
         rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
@@ -1118,7 +1200,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
         later = np.where(a // n_cand > b // n_cand, a, b)
         earlier = a + b - later
-        hit = conflicts(quads[row(earlier)], quads[row(later)], s)
+        hit = conflicts(_rows(quads, row(earlier)), _rows(quads, row(later)), s)
         state.meets(later[hit], earlier[hit])
         undecided = state.run(undecided, good, tested=ks[-1] + 1)
         if not len(undecided):
