@@ -73,9 +73,22 @@ def test_labels_pair_up_and_the_assembly_text_lists_them(tabbed):
 # ---------------------------------------------------------------- the arrays and the reference
 
 
-@pytest.fixture(scope="module", params=["cube", "l-prism", "house", "torus", "saddle-patch"])
+@pytest.fixture(
+    scope="module",
+    params=[
+        ("cube", {}),
+        ("l-prism", {}),
+        ("house", {}),
+        ("torus", {}),
+        ("saddle-patch", {}),
+        ("torus", {"layout": "net"}),  # a run's face centre on its "normal": bits decide
+        ("dodecahedron", {"layout": "net", "sheet": "A4", "scale": 60}),
+    ],
+    ids=lambda param: " ".join([param[0], *map(str, param[1].values())]),
+)
 def untabbed(request):
     """A pattern as :func:`add_tabs_and_labels` gets it (laid out for tabs), and its height."""
+    name, options = request.param
     got = {}
 
     def spy(p, h, **kw):
@@ -84,7 +97,7 @@ def untabbed(request):
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(arrange, "add_tabs_and_labels", spy)
-        filletfold.round_mesh(request.param, tabs=True, certify=False)
+        filletfold.round_mesh(name, tabs=True, certify=False, **options)
     return got["p"], got["h"]
 
 
@@ -113,10 +126,11 @@ def test_the_segments_are_those_of_the_reference(untabbed):
     runs = tabs_reference._runs(p, tabs_reference._seam_pairs(p))
     assert [list(r[0]) for r in runs] == [side_a[i:j].tolist() for i, j in pairwise(start)]
     assert [list(r[1]) for r in runs] == [side_b[i:j].tolist() for i, j in pairwise(start)]
-    ends, normal = tabs._segments(p, side_a, start)
-    for k, run in enumerate(runs):
-        e, n = tabs_reference._segment(p, run[0])
-        assert np.array_equal(e, ends[k]) and np.array_equal(n, normal[k])
+    for side, edges in enumerate((side_a, side_b)):
+        ends, normal = tabs._segments(p, edges, start)
+        for k, run in enumerate(runs):
+            e, n = tabs_reference._segment(p, run[side])
+            assert np.array_equal(e, ends[k]) and np.array_equal(n, normal[k]), (side, k)
 
 
 def test_row_dots_have_the_bits_of_the_scalar_ones():

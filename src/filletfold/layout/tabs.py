@@ -205,13 +205,14 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
     flat, fstart = face_arrays(p.faces)
     face = p.edge_faces[edges[start[:-1]]].max(axis=1)
     size = fstart[face + 1] - fstart[face]
-    corner = (
-        fstart[np.repeat(face, size)]
-        + np.arange(size.sum())
-        - np.repeat(np.cumsum(size) - size, size)
-    )
-    centre = np.add.reduceat(_rows(p.vertices_2d, flat[corner]), np.cumsum(size) - size, axis=0)
-    centre /= size[:, None]
+    centre = np.empty((n, 2))
+    for k in np.unique(size).tolist():  # the bits of `corners.mean(axis=0)`: a sum in order
+        runs = np.flatnonzero(size == k)
+        corners = _padded(p.vertices_2d, flat, fstart, face[runs], k)
+        total = corners[:, 0].copy()
+        for i in range(1, k):
+            total += corners[:, i]
+        centre[runs] = total / k
     normal = np.stack([-axis[:, 1], axis[:, 0]], axis=1)
     flip = _rowdot(centre - (ends[:, 0] + ends[:, 1]) / 2, normal) > 0
     normal[flip] = -normal[flip]
