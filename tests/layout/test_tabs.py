@@ -17,7 +17,7 @@ import filletfold
 from filletfold.layout import arrange, tabs
 from filletfold.layout.tabs import add_tabs_and_labels, assembly_text
 
-from . import tabs_reference
+from ..reference import tabs as tabs_reference
 
 
 @pytest.fixture(scope="module", params=["cube", "icosahedron", "l-prism", "house", "torus"])
