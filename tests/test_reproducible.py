@@ -70,3 +70,25 @@ def test_timings_are_kept_apart(tmp_path):
     assert all(isinstance(v, float) and v >= 0 for v in timings.values())
     assert timings["total"] >= sum(timings[s] for s in stages[:-1])
     assert timings["tabs"] <= timings["surface"]
+
+
+def test_a_design_is_the_same_first_or_after_a_large_one(tmp_path):
+    """In one process, a small design built before and after a large one (which loads the
+    numba kernel) writes the same bytes: the solver's path does not depend on the past."""
+    code = f"""
+import sys, filletfold
+from pathlib import Path
+def build(name):
+    d = filletfold.round_mesh("miura", material_loss=True, tabs=False)
+    d.export(Path({str(tmp_path)!r}) / name, formats=["fold", "json"])
+    return [p.read_bytes() for p in sorted((Path({str(tmp_path)!r}) / name).iterdir())
+            if p.name != "timings.json"]
+first = build("first")
+filletfold.round_mesh("geodesic-sphere:level=3", tabs=False)
+sys.exit(0 if build("second") == first else 3)
+"""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600
+    )
+    assert done.returncode == 0, done.stderr or "the second build differs from the first"

@@ -63,13 +63,13 @@ from .settings import (
     T_CAP,
 )
 
-#: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, about 6x
-#: faster) when numba is installed (the ``fast`` extra); ``FILLETFOLD_NUMBA=0`` turns it off.
-#: Its first use compiles it (about 15 s, once: the result is cached on disk), so it is used
-#: for batches of at least :data:`KERNEL_MIN_PROBLEMS` problems only: a small design (the
-#: demo, the app's examples) never waits for the compiler, a large one does once. Once the
-#: kernel is loaded in this process (by a large batch or :func:`warm_kernel`), every batch
-#: uses it.
+#: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, 3-6x
+#: faster) when numba is installed; ``FILLETFOLD_NUMBA=0`` turns it off. Its first use ever
+#: compiles it (about 15 s, once: the result is cached on disk) and every process pays about
+#: 1 s to load it, so it solves batches of at least :data:`KERNEL_MIN_PROBLEMS` problems only:
+#: a small design (the demo, the app's examples) never waits for it. Which path solves a batch
+#: depends on the batch's size alone, never on what the process solved before, so a design
+#: gives the same bytes first or last in a long process (the two paths agree only to rounding).
 #: (numba itself is imported on that first use, not with filletfold.)
 USE_KERNEL = (
     importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
@@ -209,8 +209,8 @@ def pack(rows: Sequence[tuple], n: int) -> RowBlock:
 def interior_point(rows: RowBlock, q, c, y, **kwargs) -> tuple[np.ndarray, np.ndarray]:
     """:func:`interior_point_numpy`, or its compiled twin
     :func:`~filletfold.vertex.batch_kernel.interior_point_numba` when :data:`USE_KERNEL` and
-    the batch has at least :data:`KERNEL_MIN_PROBLEMS` problems."""
-    if USE_KERNEL and (_kernel_loaded or len(rows.a) >= KERNEL_MIN_PROBLEMS):
+    the batch has at least :data:`KERNEL_MIN_PROBLEMS` problems (its size alone decides)."""
+    if USE_KERNEL and len(rows.a) >= KERNEL_MIN_PROBLEMS:
         return _kernel(rows, q, c, y, **kwargs)
     return interior_point_numpy(rows, q, c, y, **kwargs)
 
@@ -262,7 +262,8 @@ def kernel_pending(n_problems: int) -> bool:
 
 def warm_kernel() -> bool:
     """Load (or compile, the first time ever: about 15 s) the numba kernel now, e.g. in a
-    background thread of the app, so that from then on every batch uses it.
+    background thread of the app, so that the first large batch does not wait for it (small
+    batches stay with numpy: see :data:`USE_KERNEL`).
 
     Returns
     -------
