@@ -6,10 +6,11 @@ piece). Every cut border gets one glue tab, on the side where it overlaps nothin
 same label on both sides; every piece gets its part number.
 
 The tabs are chosen greedily, border after border: the first of a border's candidate tabs
-that overlaps no face and no tab placed before it. Every candidate is tested at once, on
-arrays: separating axes and polygon clipping (:func:`clip_area`) decide the pairs of a tab and
-a face (or an earlier tab) that are clearly apart or clearly overlapping, and shapely decides
-the few others, exactly as it would decide them one at a time.
+that overlaps no face and no tab placed before it. The candidates are tested on arrays, a
+round at a time (:func:`_choose`): a grid of boxes finds the faces and tabs near each, and
+separating axes and overlap areas (:mod:`filletfold.layout.convex`) decide the pairs that are
+clearly apart or clearly overlapping, with margins far above round-off; shapely decides the
+few others, as it decided every pair one at a time before. The same tabs, to the bit.
 """
 
 from __future__ import annotations
@@ -23,6 +24,27 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
 from ..surface.pattern import Annotations, CreasePattern, Label, face_arrays
+from .convex import (
+    BoxGrid,
+    abs_max,
+    boxes,
+    clip_area,
+    convex_overlap,
+    cross,
+    fold,
+    inward_lines,
+    is_convex,
+    next_corners,
+    pad_columns,
+    polygon_area,
+    row_max,
+    sat_gap,
+    shrink_convex,
+    side_normals,
+    surely_valid,
+    take_rows,
+    turns,
+)
 
 #: The candidate tabs of a border, in the order they are tried: (share of the full height,
 #: which half of the border or None for all of it); each on side A, then on side B.
@@ -75,7 +97,7 @@ def _seam_pairs(p: CreasePattern, decimals: int = 9) -> np.ndarray:
     cut = np.flatnonzero(p.edge_assignment == "B")
     vertex, end = np.unique(p.edges[cut], return_inverse=True)
     at = np.round(p.vertices_3d[vertex], decimals) + 0.0  # no -0.0
-    nan = _fold(np.logical_or, np.isnan(at))  # NaN is equal to nothing: never paired
+    nan = fold(np.logical_or, np.isnan(at))  # NaN is equal to nothing: never paired
     keep = ~nan[end.reshape(-1, 2)].any(axis=1)
     cut, end = cut[keep], end.reshape(-1, 2)[keep]
     if len(cut) == 0:
@@ -187,7 +209,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         The unit normal pointing away from the face of the run's first edge.
     """
     n = len(start) - 1
-    pts = _rows(p.vertices_2d, _rows(p.edges, edges).ravel())  # two per edge
+    pts = take_rows(p.vertices_2d, take_rows(p.edges, edges).ravel())  # two per edge
     at = 2 * start[:-1]
     d = np.maximum.reduceat(pts, at, axis=0) - np.minimum.reduceat(pts, at, axis=0)
     norm = _rownorm(d)
@@ -201,7 +223,7 @@ def _segments(p: CreasePattern, edges: np.ndarray, start: np.ndarray):
         # the bits of `points @ axis` (a BLAS gemv), and np.argmin's first of the smallest
         t = np.matmul(pts[at_k], axis[runs][:, :, None])[..., 0]
         lo[runs], hi[runs] = at_k[:, 0] + t.argmin(axis=1), at_k[:, 0] + t.argmax(axis=1)
-    ends = np.stack([_rows(pts, lo), _rows(pts, hi)], axis=1)
+    ends = np.stack([take_rows(pts, lo), take_rows(pts, hi)], axis=1)
     flat, fstart = face_arrays(p.faces)
     face = p.edge_faces[edges[start[:-1]]].max(axis=1)
     size = fstart[face + 1] - fstart[face]
@@ -266,242 +288,6 @@ def _closed_polygons(rings: np.ndarray) -> np.ndarray:
     return shapely.polygons(shapely.linearrings(np.concatenate([rings, rings[:, :1]], axis=1)))
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """z of the cross products of 2D vectors (..., 2)."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-def _side_normals(poly: np.ndarray) -> np.ndarray:
-    """Unit normals (n, k, 2) of the sides of polygons (n, k, 2), to the left of each side
-    (NaN for a side of no length)."""
-    edge = _next(poly) - poly
-    u = np.empty_like(edge)
-    u[..., 0], u[..., 1] = -edge[..., 1], edge[..., 0]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        u /= np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)[..., None]
-    return u
-
-
-def _next(poly: np.ndarray) -> np.ndarray:
-    """``np.roll(poly, -1, axis=1)``, faster: the corner after each corner of polygons."""
-    out = np.empty_like(poly)
-    out[:, :-1], out[:, -1] = poly[:, 1:], poly[:, 0]
-    return out
-
-
-def inward_lines(quads: np.ndarray):
-    """The sides of convex polygons as half-planes.
-
-    Parameters
-    ----------
-    quads : (n, k, 2) float
-        Convex polygons, either orientation.
-
-    Returns
-    -------
-    normal : (n, k, 2) float
-        Unit inward normals of the sides.
-    offset : (n, k) float
-        A point ``x`` is inside side ``j`` of polygon ``i`` where
-        ``normal[i, j] @ x >= offset[i, j]``.
-    """
-    area2 = _cross(quads, _next(quads)).sum(axis=1)
-    normal = _side_normals(quads)
-    normal[~(area2 >= 0)] *= -1
-    return normal, normal[..., 0] * quads[..., 0] + normal[..., 1] * quads[..., 1]
-
-
-def shrink_convex(quads: np.ndarray, by, normal: np.ndarray | None = None) -> np.ndarray:
-    """Convex polygons (n, k, 2) with every side moved inwards by ``by`` (corners mitred);
-    ``normal``: their unit inward normals, if known (:func:`inward_lines`)."""
-    if normal is None:
-        normal, _ = inward_lines(quads)
-    prev = np.roll(normal, 1, axis=1)  # the side before each corner
-    dot = prev[..., 0] * normal[..., 0] + prev[..., 1] * normal[..., 1]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mitre = (prev + normal) / (1 + dot)[..., None]
-    return quads + np.asarray(by, dtype=np.float64).reshape(-1, 1, 1) * mitre
-
-
-def _project(axes: np.ndarray, poly: np.ndarray):
-    """Smallest and largest projections (n, a) of polygons (n, k, 2) on axes (n, a, 2)."""
-    t = [
-        axes[..., 0] * poly[:, i, None, 0] + axes[..., 1] * poly[:, i, None, 1]
-        for i in range(poly.shape[1])
-    ]
-    return np.minimum.reduce(t), np.maximum.reduce(t)
-
-
-def sat_gap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Signed gap between convex polygons, by separating axes.
-
-    Parameters
-    ----------
-    a, b : (n, ka, 2), (n, kb, 2) float
-        Convex polygons, either orientation (repeated corners allowed).
-
-    Returns
-    -------
-    (n,) float
-        The widest gap between the projections of ``a[i]`` and ``b[i]`` on the unit normals of
-        their sides: > 0, the polygons are that far apart; < 0, they overlap by at least that
-        much along every side normal, so they intersect. Sides of no length are skipped.
-    """
-    axes = np.concatenate([_side_normals(a), _side_normals(b)], axis=1)
-    lo_a, hi_a = _project(axes, a)
-    lo_b, hi_b = _project(axes, b)
-    gap = np.maximum(lo_b - hi_a, lo_a - hi_b)
-    return _fold(np.maximum, np.where(np.isnan(gap), -np.inf, gap))
-
-
-def convex_overlap(a: np.ndarray, b: np.ndarray):
-    """Area of the overlap of convex polygons, by Green's theorem on their clipped sides.
-
-    Parameters
-    ----------
-    a, b : (n, ka, 2), (n, kb, 2) float
-        Convex polygons, either orientation (repeated corners allowed).
-
-    Returns
-    -------
-    area : (n,) float
-        Area of ``a[i]`` and ``b[i]`` overlapping.
-    empty : (n,) bool
-        Whether no side of either has a piece inside the other (they are apart).
-    doubt : (n,) bool
-        Where a corner lies exactly on the line of a side of the other: sides may overlap
-        there, and count twice; ask :func:`clip_area`.
-    """
-    sign_a, sign_b = np.sign(_signed_area2(a)), np.sign(_signed_area2(b))
-    s1, in1, doubt1 = _sides_inside(a, b, sign_b)
-    s2, in2, doubt2 = _sides_inside(b, a, sign_a)
-    return np.abs(sign_a * s1 + sign_b * s2) / 2, ~in1 & ~in2, doubt1 | doubt2
-
-
-def _signed_area2(poly: np.ndarray) -> np.ndarray:
-    """Twice the signed areas (n,) of polygons (n, k, 2), about their first corners."""
-    local = poly - poly[:, :1]
-    return _cross(local, _next(local)).sum(axis=1)
-
-
-def _sides_inside(p: np.ndarray, q: np.ndarray, sign_q: np.ndarray):
-    """The sides of polygons ``p`` clipped to the convex polygons ``q`` (their orientations
-    ``sign_q``): the sums (n,) of ``cross(start, end)`` of the pieces inside, whether any
-    piece is, and whether a corner of ``p`` lies on the line of a side of ``q``."""
-    a = p
-    b = _next(p)
-    lo = np.zeros(a.shape[:2])
-    hi = np.ones(a.shape[:2])
-    out = np.zeros(a.shape[:2], dtype=bool)
-    doubt = np.zeros(a.shape[:2], dtype=bool)
-    q_next = _next(q)
-    for j in range(q.shape[1]):
-        ex, ey = q_next[:, j, 0] - q[:, j, 0], q_next[:, j, 1] - q[:, j, 1]
-        nx, ny = (-ey * sign_q)[:, None], (ex * sign_q)[:, None]  # inward
-        qx, qy = q[:, j, 0, None], q[:, j, 1, None]
-        da = nx * (a[..., 0] - qx) + ny * (a[..., 1] - qy)
-        db = nx * (b[..., 0] - qx) + ny * (b[..., 1] - qy)
-        side = ((ex != 0) | (ey != 0))[:, None]
-        doubt |= side & ((da == 0) | (db == 0))
-        out |= (da < 0) & (db < 0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = da / (da - db)
-        enter, leave = (da < 0) & (db >= 0), (db < 0) & (da >= 0)
-        np.maximum(lo, t, out=lo, where=enter)
-        np.minimum(hi, t, out=hi, where=leave)
-    keep = ~out & (lo < hi)
-    d = b - a
-    start, end = a + lo[..., None] * d, a + hi[..., None] * d
-    return np.where(keep, _cross(start, end), 0.0).sum(axis=1), keep.any(axis=1), doubt.any(1)
-
-
-def clip_area(poly: np.ndarray, normal: np.ndarray, offset: np.ndarray):
-    """Area of polygons clipped by half-planes (Sutherland-Hodgman), in batches.
-
-    Parameters
-    ----------
-    poly : (n, k, 2) float
-        Simple polygons (either orientation, convex or not), padded by repeating a corner.
-    normal, offset : (n, h, 2), (n, h) float
-        The half-planes ``normal[i, j] @ x >= offset[i, j]`` clipping ``poly[i]`` (together a
-        convex region).
-
-    Returns
-    -------
-    area : (n,) float
-        Area of each clipped polygon (0 where empty).
-    empty : (n,) bool
-        Whether no corner is left at all.
-    """
-    n = len(poly)
-    rows = np.arange(n)[:, None]
-    cnt = np.full(n, poly.shape[1])
-    for j in range(normal.shape[1]):
-        k = poly.shape[1]
-        if k == 0:
-            break
-        dist = (
-            poly[..., 0] * normal[:, j, None, 0]
-            + poly[..., 1] * normal[:, j, None, 1]
-            - offset[:, j, None]
-        )
-        slot = np.arange(k)
-        live = slot < cnt[:, None]
-        prev_i = np.where(slot == 0, cnt[:, None] - 1, slot - 1) * live
-        prev, dprev = poly[rows, prev_i], dist[rows, prev_i]
-        inside, inside_prev = dist >= 0, dprev >= 0
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = dprev / (dprev - dist)  # where used, the two ends are on either side
-            cross = prev + t[..., None] * (poly - prev)
-        out = np.stack([cross, poly], axis=2).reshape(n, 2 * k, 2)
-        keep = np.stack([live & (inside != inside_prev), live & inside], axis=2).reshape(n, -1)
-        cnt = keep.sum(axis=1)
-        dest = np.cumsum(keep, axis=1) - 1
-        new = np.zeros((n, int(cnt.max(initial=0)), 2))
-        r, c = np.nonzero(keep)
-        new[r, dest[r, c]] = out[r, c]
-        poly = new
-    k = poly.shape[1]
-    slot = np.arange(k)
-    live = slot < cnt[:, None]
-    nxt = poly[rows, np.where(slot + 1 >= cnt[:, None], 0, slot + 1)]
-    area = np.abs(np.sum(np.where(live, _cross(poly, nxt), 0.0), axis=1)) / 2
-    return area, cnt == 0
-
-
-def _fold(op, a: np.ndarray, axis: int = 1) -> np.ndarray:
-    """``op.reduce(a, axis)`` over a short axis, a slice at a time (numpy is slow at reducing
-    many short rows; ``op`` is ``np.maximum``, ``np.minimum``, ``np.logical_and``, ...)."""
-    parts = np.moveaxis(a, axis, 0)
-    out = parts[0].copy()
-    for x in parts[1:]:
-        op(out, x, out=out)
-    return out
-
-
-def _colmax(a: np.ndarray) -> np.ndarray:
-    """Row maxima of a narrow (n, k) array."""
-    return _fold(np.maximum, a)
-
-
-def _absmax(a: np.ndarray) -> np.ndarray:
-    """(n,) float: the largest absolute value of every ``a[i]`` (n, k, 2)."""
-    return _fold(np.maximum, np.abs(a).reshape(len(a), -1))
-
-
-def _rows(a: np.ndarray, index: np.ndarray) -> np.ndarray:
-    """``a[index]`` for an int array ``index``, much faster for an ``a`` of several
-    dimensions (``np.take`` along the first axis)."""
-    return np.take(a, index, axis=0)
-
-
-def _pad(a: np.ndarray, width: int) -> np.ndarray:
-    """An (n, k) array widened to (n, width) by repeating its last column."""
-    if a.shape[1] == width:
-        return a
-    return np.concatenate([a, np.repeat(a[:, -1:], width - a.shape[1], axis=1)], axis=1)
-
-
 def _bucket(size: np.ndarray) -> np.ndarray:
     """Corner counts up to 8, larger ones rounded up to a power of two: faces padded together."""
     up = (2 ** np.ceil(np.log2(np.maximum(size, 1)))).astype(np.int64)
@@ -514,138 +300,6 @@ def _padded(coords: np.ndarray, flat: np.ndarray, start: np.ndarray, faces: np.n
     slot = np.minimum(np.arange(k), size[:, None] - 1)
     at = np.take(flat, (start[faces][:, None] + slot).ravel())
     return np.take(coords, at, axis=0).reshape(len(faces), k, coords.shape[1])
-
-
-def _turns(corners: np.ndarray) -> np.ndarray:
-    """(n, k) float: the sines of the turns at the corners of polygons (n, k, 2) (NaN at a
-    side of no length)."""
-    edge = _next(corners) - corners
-    length = np.sqrt(edge[..., 0] ** 2 + edge[..., 1] ** 2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return _cross(edge, _next(edge)) / (length * _next(length))
-
-
-def _convex(corners: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
-    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12);
-    ``turn``: their :func:`_turns`, if known."""
-    turn = _turns(corners) if turn is None else turn
-    turn = np.where(np.isnan(turn), 0.0, turn)  # repeated corners turn by nothing
-    return _fold(np.logical_and, turn >= -1e-12) | _fold(np.logical_and, turn <= 1e-12)
-
-
-def _surely_valid(quads: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
-    """(n,) bool: polygons that are strictly convex by a margin far above round-off (so
-    valid polygons); False means "ask shapely". ``turn``: their :func:`_turns`, if known."""
-    turn = _turns(quads) if turn is None else turn
-    with np.errstate(invalid="ignore"):
-        return _fold(np.logical_and, turn > 1e-6) | _fold(np.logical_and, turn < -1e-6)
-
-
-def _area(quads: np.ndarray) -> np.ndarray:
-    """Areas (n,) of polygons (n, k, 2), about their first corners."""
-    local = quads - quads[:, :1]
-    return np.abs(np.sum(_cross(local, _next(local)), axis=1)) / 2
-
-
-class _Grid:
-    """Boxes filed in the cells of a uniform grid, to find the boxes another box overlaps.
-
-    Parameters
-    ----------
-    lo, hi : (n, 2) float
-        Lower and upper corners of the boxes (a box with a corner not finite is left out).
-    """
-
-    def __init__(self, lo: np.ndarray, hi: np.ndarray):
-        self.box = np.concatenate([lo, hi], axis=1)  # (n, 4): x0, y0, x1, y1
-        self.cols = [np.ascontiguousarray(x) for x in self.box.T]
-        kept = np.flatnonzero(np.isfinite(self.box).all(axis=1))
-        self.origin, self.cell, self.shape = np.zeros(2), 1.0, np.ones(2, dtype=np.int64)
-        self.items = np.zeros(0, dtype=np.int64)
-        self.first = np.zeros(0, dtype=np.uint8)  # 1: a box's first column, 2: first row
-        self.start = np.zeros(2, dtype=np.int64)
-        if not len(kept):
-            return
-        lo, hi = lo[kept], hi[kept]
-        self.origin = lo.min(axis=0)
-        span = max(float(np.max(hi.max(axis=0) - self.origin)), 1e-300)
-        # about a box per cell; larger cells while the boxes would fill too many of them
-        cell = max(float(np.median(np.max(hi - lo, axis=1))), span / 4096, 1e-300)
-        while True:
-            self.cell = cell
-            self.shape = np.floor((hi.max(axis=0) - self.origin) / cell).astype(np.int64) + 1
-            c0, c1 = self._cells(lo, hi)
-            if np.prod(c1 - c0 + 1, axis=1).sum() <= 8 * len(kept) + 1024:
-                break
-            cell *= 2
-        keys, items, first = self._entries(c0, c1, kept)
-        order = _argsort_small(keys, int(np.prod(self.shape)))
-        self.items, self.first = items[order], first[order]
-        # the entries of cell k: items[start[k]:start[k + 1]]
-        self.start = np.zeros(int(np.prod(self.shape)) + 1, dtype=np.int64)
-        np.cumsum(np.bincount(keys, minlength=len(self.start) - 1), out=self.start[1:])
-
-    def _cells(self, lo, hi):
-        """The first and last cells (n, 2) that boxes cover, clipped to the grid."""
-        c0 = np.floor((lo - self.origin) / self.cell)
-        c1 = np.floor((hi - self.origin) / self.cell)
-        top = self.shape - 1
-        return np.clip(c0, 0, top).astype(np.int64), np.clip(c1, -1, top).astype(np.int64)
-
-    def _entries(self, c0, c1, items):
-        """(cell key, item, whether the cell is in the box's first column (1) and row (2))
-        of every cell of every box."""
-        w = np.maximum(c1 - c0 + 1, 0)
-        count = w[:, 0] * w[:, 1]
-        item = np.repeat(np.arange(len(c0)), count)
-        k = np.arange(len(item)) - np.repeat(np.cumsum(count) - count, count)
-        wy = np.maximum(w[item, 1], 1)
-        dx, dy = k // wy, k % wy
-        first = (dx == 0).astype(np.uint8) | ((dy == 0).astype(np.uint8) << 1)
-        return (c0[item, 0] + dx) * self.shape[1] + c0[item, 1] + dy, items[item], first
-
-    def query(self, lo: np.ndarray, hi: np.ndarray):
-        """The pairs of a box (``lo``, ``hi``: (m, 2)) and a filed box that overlap (closed).
-
-        Returns
-        -------
-        (k,) int, (k,) int
-            The boxes asked and the filed ones.
-        """
-        if not len(lo) or not len(self.items):
-            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-        box = np.concatenate([lo, hi], axis=1)
-        finite = np.isfinite(box).all(axis=1)
-        c0, c1 = self._cells(np.where(finite[:, None], lo, 0), np.where(finite[:, None], hi, -1))
-        c1[~finite] = -1
-        keys, asked, low = self._entries(c0, c1, np.arange(len(lo)))
-        first = self.start[keys]
-        count = self.start[keys + 1] - first
-        which = np.repeat(np.arange(len(keys)), count)
-        at = np.arange(len(which)) + np.repeat(first - np.cumsum(count) + count, count)
-        # each pair once: in the cell of the low corner of the two boxes' overlap, which is
-        # in the first column of one of them and in the first row of one of them
-        keep = np.flatnonzero((np.take(low, which) | np.take(self.first, at)) == 3)
-        a, b = np.take(asked, np.take(which, keep)), np.take(self.items, np.take(at, keep))
-        qa, fb = [np.take(x, a) for x in box.T], [np.take(x, b) for x in self.cols]
-        keep = (qa[0] <= fb[2]) & (fb[0] <= qa[2]) & (qa[1] <= fb[3]) & (fb[1] <= qa[3])
-        return a[keep], b[keep]
-
-
-def _argsort_small(keys: np.ndarray, bound: int) -> np.ndarray:
-    """Stable ``np.argsort`` of integers in ``[0, bound)``: radix passes on 16 bits."""
-    if bound <= 1 << 16:
-        return np.argsort(keys.astype(np.uint16), kind="stable")
-    if bound <= 1 << 32:
-        low = np.argsort((keys & 0xFFFF).astype(np.uint16), kind="stable")
-        return low[np.argsort((keys[low] >> 16).astype(np.uint16), kind="stable")]
-    return np.argsort(keys, kind="stable")
-
-
-def _boxes(quads: np.ndarray):
-    """Lower and upper corners (n, 2) of the boxes of polygons (n, k, 2)."""
-    with np.errstate(invalid="ignore"):
-        return _fold(np.minimum, quads), _fold(np.maximum, quads)
 
 
 class _Faces:
@@ -683,12 +337,12 @@ class _Faces:
             self.row[faces] = np.arange(len(faces))
             corners = _padded(self.coords, self.flat, self.start, faces, k)
             finite[faces] = np.isfinite(corners).all(axis=(1, 2))
-            lo[faces], hi[faces] = _boxes(corners)
-            turn = _turns(corners)
+            lo[faces], hi[faces] = boxes(corners)
+            turn = turns(corners)
             if k <= 8:  # not padded: strictly convex is valid, no need to ask shapely
-                valid[faces] = _surely_valid(corners, turn)
-            self.convex[faces] = _convex(corners, turn)
-            u = _side_normals(corners)
+                valid[faces] = surely_valid(corners, turn)
+            self.convex[faces] = is_convex(corners, turn)
+            u = side_normals(corners)
             t = [
                 u[..., 0] * corners[:, i, None, 0] + u[..., 1] * corners[:, i, None, 1]
                 for i in range(k)
@@ -705,7 +359,7 @@ class _Faces:
             self.polys.update(zip(doubt[~ok].tolist(), fixed, strict=True))
         self.fast = valid & finite  # the faces that the array tests may decide
         self.extent = np.max(hi - lo, axis=1)
-        self.grid = _Grid(lo, hi)
+        self.grid = BoxGrid(lo, hi)
 
     def polygons(self, faces: np.ndarray) -> np.ndarray:
         """Shapely geometries of faces (made once; an invalid face as its valid part)."""
@@ -728,13 +382,13 @@ class _Faces:
         for k, (fx, fy, *_) in self.sets.items():
             faces = np.flatnonzero(self.bucket == k)
             x, y = fx - fx[:, :1], fy - fy[:, :1]
-            area[faces] = np.abs(np.sum(x * _next(y) - y * _next(x), axis=1)) / 2
+            area[faces] = np.abs(np.sum(x * next_corners(y) - y * next_corners(x), axis=1)) / 2
         fixed = [f for f in self.polys if not self.fast[f]]
         if fixed:
             area[fixed] = shapely.area(self.polygons(np.asarray(fixed, dtype=np.int64)))
         return area
 
-    def clear(self, quads, area, hint=None) -> np.ndarray:
+    def clear(self, quads, area, hint=None) -> tuple[np.ndarray, np.ndarray]:
         """Tabs that overlap no face: shapely's verdict on each, had it been asked.
 
         Parameters
@@ -762,7 +416,7 @@ class _Faces:
         s = self.s
         local = quads - quads[:, :1]
         normal, offset = inward_lines(local)
-        perimeter = np.sum(np.linalg.norm(local - _next(local), axis=-1), axis=1)
+        perimeter = np.sum(np.linalg.norm(local - next_corners(local), axis=-1), axis=1)
         # the region s / 2 inside the tab: apart from it by s / 4, a face is apart from the
         # shrunk tab whatever round-off shapely and these figures make (checked by `sure`)
         frame = {
@@ -776,14 +430,14 @@ class _Faces:
             "off": np.ascontiguousarray(offset.T + s / 2),
             "inner": shrink_convex(local, s / 2, normal),  # about the origin
             "least": 1e-9 * area + 2 * s * perimeter,
-            "reach": _absmax(quads) + _absmax(local) + self.h,
+            "reach": abs_max(quads) + abs_max(local) + self.h,
             "wide": np.zeros(n, dtype=bool),
         }
         if hint is not None:
             t = np.flatnonzero(hint >= 0)
             self._pairs(frame, t, hint[t], blocker, None)
         rest = np.flatnonzero(blocker < 0)
-        i, faces = self.grid.query(*_boxes(_rows(quads, rest)))
+        i, faces = self.grid.query(*boxes(take_rows(quads, rest)))
         tabs = np.take(rest, i)
         slow = []
         self._pairs(frame, tabs, faces, blocker, slow)
@@ -817,30 +471,30 @@ class _Faces:
             fx, fy, ux, uy, lo, hi = self.sets[k]
             t, f = np.take(tabs, pair), np.take(faces, pair)
             row = np.take(self.row, f)
-            x = _rows(fx, row) - np.take(frame["ox"], t)[:, None]
-            y = _rows(fy, row) - np.take(frame["oy"], t)[:, None]
+            x = take_rows(fx, row) - np.take(frame["ox"], t)[:, None]
+            y = take_rows(fy, row) - np.take(frame["oy"], t)[:, None]
             live = np.arange(len(pair))
             if slow is not None:
                 # apart along a side of the tab (its hinge first: its own piece's faces)
                 for j in range(4):
                     tl = np.take(t, live)
-                    xl, yl = _rows(x, live), _rows(y, live)
-                    d = _colmax(xl * np.take(nx[j], tl)[:, None] + yl * np.take(ny[j], tl)[:, None])
+                    xl, yl = take_rows(x, live), take_rows(y, live)
+                    d = row_max(xl * np.take(nx[j], tl)[:, None] + yl * np.take(ny[j], tl)[:, None])
                     live = live[~(d - np.take(off[j], tl) < -s / 4)]
                 # apart along a side of a convex face
                 conv = live[np.take(self.convex, np.take(f, live))]
                 if len(conv):
                     r, tc = np.take(row, conv), np.take(t, conv)
-                    inner = _rows(frame["inner"], tc) + _rows(frame["origin"], tc)[:, None]
-                    ur, vr = _rows(ux, r), _rows(uy, r)
+                    inner = take_rows(frame["inner"], tc) + take_rows(frame["origin"], tc)[:, None]
+                    ur, vr = take_rows(ux, r), take_rows(uy, r)
                     proj = [ur * inner[:, i, 0, None] + vr * inner[:, i, 1, None] for i in range(4)]
                     low, high = np.minimum.reduce(proj), np.maximum.reduce(proj)
-                    gap = np.maximum(low - _rows(hi, r), _rows(lo, r) - high)
-                    apart = _fold(np.logical_or, gap > s / 4)  # NaN (no length): not apart
+                    gap = np.maximum(low - take_rows(hi, r), take_rows(lo, r) - high)
+                    apart = fold(np.logical_or, gap > s / 4)  # NaN (no length): not apart
                     drop = np.zeros(len(pair), dtype=bool)
                     drop[conv[apart]] = True
                     live = live[~drop[live]]
-            kept.append((np.take(pair, live), _rows(x, live), _rows(y, live)))
+            kept.append((np.take(pair, live), take_rows(x, live), take_rows(y, live)))
         if not kept:
             return
         # a tab is blocked by its first overlapping face: clip the first pair of every tab,
@@ -848,7 +502,7 @@ class _Faces:
         width = max(x.shape[1] for _, x, _ in kept)
         pair = np.concatenate([p for p, _, _ in kept])
         poly = np.concatenate(
-            [np.stack([_pad(x, width), _pad(y, width)], axis=-1) for _, x, y in kept]
+            [np.stack([pad_columns(x, width), pad_columns(y, width)], axis=-1) for _, x, y in kept]
         )
         t = np.take(tabs, pair)
         first = np.zeros(len(pair), dtype=bool)
@@ -858,14 +512,14 @@ class _Faces:
             if not len(part):
                 continue
             tp, fp = np.take(t, part), np.take(faces, np.take(pair, part))
-            pp = _rows(poly, part)
-            got, empty, doubt = convex_overlap(pp, _rows(frame["inner"], tp))
+            pp = take_rows(poly, part)
+            got, empty, doubt = convex_overlap(pp, take_rows(frame["inner"], tp))
             doubt |= ~np.take(self.convex, fp)
             if doubt.any():  # Sutherland-Hodgman: faces not convex, touching sides
                 d = np.flatnonzero(doubt)
                 td = np.take(tp, d)
                 got[d], empty[d] = clip_area(
-                    _rows(pp, d), _rows(frame["normal"], td), _rows(frame["offset"], td)
+                    take_rows(pp, d), take_rows(frame["normal"], td), take_rows(frame["offset"], td)
                 )
             big = ~empty & (got > np.take(frame["least"], tp))
             blocker[tp[big]] = fp[big]
@@ -915,11 +569,11 @@ def conflicts(
         return np.zeros(0, dtype=bool)
     origin = later[:, :1]
     a, b = earlier - origin, shrink_convex(later - origin, shrink)
-    (alo, ahi), (blo, bhi) = _boxes(a), _boxes(b)
-    gap = _fold(np.maximum, np.maximum(blo - ahi, alo - bhi))  # apart along x or y
+    (alo, ahi), (blo, bhi) = boxes(a), boxes(b)
+    gap = fold(np.maximum, np.maximum(blo - ahi, alo - bhi))  # apart along x or y
     sat = np.flatnonzero(~(gap > shrink / 4))
-    gap[sat] = sat_gap(_rows(a, sat), _rows(b, sat))
-    scale, reach = _absmax(later), _absmax(a)
+    gap[sat] = sat_gap(take_rows(a, sat), take_rows(b, sat))
+    scale, reach = abs_max(later), abs_max(a)
     sure = 16 * EPS * (reach + scale + shrink / SHRINK) < shrink / 4
     hit = ~(sure & (gap > shrink / 4))
     slow = np.flatnonzero(~sure | ~((gap > shrink / 4) | (gap < -shrink / 4)))
@@ -1034,7 +688,7 @@ def _no_gc():
 
 def _piece_of(p: CreasePattern, edges: np.ndarray) -> np.ndarray:
     """The piece of the face of each (border) edge."""
-    return np.take(p.face_piece, _fold(np.maximum, _rows(p.edge_faces, edges)))
+    return np.take(p.face_piece, fold(np.maximum, take_rows(p.edge_faces, edges)))
 
 
 def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list:
@@ -1084,10 +738,12 @@ def _candidates(ends, normal, tab_height, cand):
             at = np.flatnonzero(k == 2 * level + side)
             if not len(at):
                 continue
-            sub = _rows(ends, border[at])[:, side]
+            sub = take_rows(ends, border[at])[:, side]
             sub = sub if part is None else _halves(sub, part)
             height[at] = scale * tab_height
-            quads[at], ok[at] = tab_outlines(sub, _rows(normal, border[at])[:, side], height[at])
+            quads[at], ok[at] = tab_outlines(
+                sub, take_rows(normal, border[at])[:, side], height[at]
+            )
             hinges[at] = sub
     return quads, hinges, ok, height
 
@@ -1139,7 +795,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
     # the border (per side 2 * border + A or B)
     up = tab_height * normal[..., None, :]
     envelope = np.concatenate([ends, ends[:, :, ::-1] + up], axis=2).reshape(2 * n, 4, 2)
-    sides = _Grid(*_boxes(envelope))
+    sides = BoxGrid(*boxes(envelope))
     good = np.zeros((n, n_cand), dtype=bool)
     state = _Greedy(n, n_cand)
     blocker_of = np.full((n, 2), -1, dtype=np.int64)  # a face that blocked a side's last tab
@@ -1149,14 +805,14 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
         quads[row(c)] = q
         c, q, height = c[ok], np.compress(ok, q, axis=0), height[ok]
-        area, least = _area(q), 1e-3 * height**2
-        valid = _surely_valid(q)
+        area, least = polygon_area(q), 1e-3 * height**2
+        valid = surely_valid(q)
         doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > 1e-6 * least))
         if len(doubt):
             shapes = _closed_polygons(q[doubt])
             valid[doubt], area[doubt] = shapely.is_valid(shapes), shapely.area(shapes)
         keep = np.flatnonzero(valid & (area > least))
-        c, q, area = c[keep], _rows(q, keep), area[keep]
+        c, q, area = c[keep], take_rows(q, keep), area[keep]
         blocked = np.zeros(len(c), dtype=bool)
         level = c % n_cand // 2
         held = np.zeros(n * n_cand, dtype=bool)  # held by a tab found wide of its blocker
@@ -1166,7 +822,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
             blocked[at[sure]] = True  # their blockers stay those of their held tabs
             at = at[~sure]
             found, wide = faces.clear(
-                _rows(q, at), area[at], blocker_of[c[at] // n_cand, c[at] % 2]
+                take_rows(q, at), area[at], blocker_of[c[at] // n_cand, c[at] % 2]
             )
             hit = at[found >= 0]
             blocked[hit] = True
@@ -1177,7 +833,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
         # the sides of other borders near the new candidates
-        i, j = sides.query(*_boxes(_rows(quads, row(c))))
+        i, j = sides.query(*boxes(take_rows(quads, row(c))))
         pc, ps = c[i], j
         other = ps // 2 != pc // n_cand
         pc, ps = pc[other], ps[other]
@@ -1186,13 +842,15 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         # border's tab the quarter-height one)
         lo = np.flatnonzero(ps // 2 < pc // n_cand)
         lo = lo[state.undecided[ps[lo] // 2]]
-        lo = lo[conflicts(_rows(envelope, ps[lo]), _rows(quads, row(pc[lo])), s, exact=False)]
+        lo = lo[
+            conflicts(take_rows(envelope, ps[lo]), take_rows(quads, row(pc[lo])), s, exact=False)
+        ]
         a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
         holder = np.asarray(COVER)[b % n_cand]
         cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
         key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
         held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
-        maybe = conflicts(held, _rows(quads, row(key // (n * n_cand))), s, exact=False) | ~fits
+        maybe = conflicts(held, take_rows(quads, row(key // (n * n_cand))), s, exact=False) | ~fits
         state.might_meet(a[maybe[inv]], b[maybe[inv]])
         # the tested candidates of those sides: which tabs intersect which
         rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
@@ -1201,14 +859,14 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
         later = np.where(a // n_cand > b // n_cand, a, b)
         earlier = a + b - later
-        hit = conflicts(_rows(quads, row(earlier)), _rows(quads, row(later)), s)
+        hit = conflicts(take_rows(quads, row(earlier)), take_rows(quads, row(later)), s)
         state.meets(later[hit], earlier[hit])
         undecided = state.run(undecided, good, tested=ks[-1] + 1)
         if not len(undecided):
             break
     picked = state.picked()
     out = quads[row(picked)]
-    ccw = np.sum(_cross(out - out[:, :1], np.roll(out - out[:, :1], -1, axis=1)), axis=1) > 0
+    ccw = np.sum(cross(out - out[:, :1], np.roll(out - out[:, :1], -1, axis=1)), axis=1) > 0
     out[~ccw] = out[~ccw, ::-1]  # far above round-off: shapely's orientation, had it been asked
     local = picked % n_cand
     return picked // n_cand, local // 2, local % 2, out, hinge[row(picked)]
