@@ -135,6 +135,7 @@ def _sides_inside(p: np.ndarray, q: np.ndarray, sign_q: np.ndarray):
     piece is, and whether a corner of ``p`` lies on the line of a side of ``q``."""
     a = p
     b = next_corners(p)
+    px, py = np.ascontiguousarray(p[..., 0]), np.ascontiguousarray(p[..., 1])
     lo = np.zeros(a.shape[:2])
     hi = np.ones(a.shape[:2])
     out = np.zeros(a.shape[:2], dtype=bool)
@@ -143,17 +144,15 @@ def _sides_inside(p: np.ndarray, q: np.ndarray, sign_q: np.ndarray):
     for j in range(q.shape[1]):
         ex, ey = q_next[:, j, 0] - q[:, j, 0], q_next[:, j, 1] - q[:, j, 1]
         nx, ny = (-ey * sign_q)[:, None], (ex * sign_q)[:, None]  # inward
-        qx, qy = q[:, j, 0, None], q[:, j, 1, None]
-        da = nx * (a[..., 0] - qx) + ny * (a[..., 1] - qy)
-        db = nx * (b[..., 0] - qx) + ny * (b[..., 1] - qy)
-        side = ((ex != 0) | (ey != 0))[:, None]
-        doubt |= side & ((da == 0) | (db == 0))
-        out |= (da < 0) & (db < 0)
+        da = nx * (px - q[:, j, 0, None]) + ny * (py - q[:, j, 1, None])  # at each corner
+        db = next_corners(da)  # at the end of each side
+        doubt |= ((ex != 0) | (ey != 0))[:, None] & (da == 0)
+        below_a, below_b = da < 0, db < 0
+        out |= below_a & below_b
         with np.errstate(invalid="ignore", divide="ignore"):
             t = da / (da - db)
-        enter, leave = (da < 0) & (db >= 0), (db < 0) & (da >= 0)
-        np.maximum(lo, t, out=lo, where=enter)
-        np.minimum(hi, t, out=hi, where=leave)
+        np.maximum(lo, t, out=lo, where=below_a & (db >= 0))  # entering
+        np.minimum(hi, t, out=hi, where=below_b & (da >= 0))  # leaving
     keep = ~out & (lo < hi)
     d = b - a
     start, end = a + lo[..., None] * d, a + hi[..., None] * d

@@ -416,7 +416,8 @@ class _Faces:
         s = self.s
         local = quads - quads[:, :1]
         normal, offset = inward_lines(local)
-        perimeter = np.sum(np.linalg.norm(local - next_corners(local), axis=-1), axis=1)
+        side = next_corners(local) - local
+        perimeter = fold(np.add, np.sqrt(side[..., 0] ** 2 + side[..., 1] ** 2))
         # the region s / 2 inside the tab: apart from it by s / 4, a face is apart from the
         # shrunk tab whatever round-off shapely and these figures make (checked by `sure`)
         frame = {
