@@ -444,3 +444,92 @@ def test_gluing_maps_are_rigid_on_a_sliver_far_from_the_origin():
     assert off < 1e-14  # was 2e-11
     rho = frame.rho[:2, :2]
     assert np.abs(rho.T @ rho - np.eye(2)).max() < 1e-14
+
+
+# ---- conical sides (a sharp neighbour): docs/method.md, "Sharp vertices and conical fillets"
+
+
+def _sharp_case(name, seed):
+    m = load_mesh(name)[0]
+    rd = round_edges(m, 0.08 * m.mean_edge_length)
+    rng = np.random.default_rng(seed)
+    sharp = rng.random(m.n_vertices) < 0.3
+    return m, rd, sharp
+
+
+@pytest.mark.parametrize("name", ["cube", "icosahedron", "random-convex", "dimpled-cube"])
+def test_conical_sides_chain_their_fillets_gluing_maps(name):
+    """With sharp neighbours, rho is the chain of the fillets' and cylinders' gluing maps
+    (the chain of tests/rounding/test_tapered.py), T lies on both faces' lines, and the
+    frames of vertices with no sharp neighbour are unchanged."""
+    from ..rounding.test_tapered import Chart, chain
+
+    m, rd, sharp = _sharp_case(name, 3)
+    verts = list(range(m.n_vertices))
+    plain = vertex_frames(m, rd, verts)
+    frames = vertex_frames(m, rd, verts, sharp=sharp)
+    n_conical = 0
+    for f0, f in zip(plain, frames, strict=True):
+        cone = f.arrays.conical
+        n_conical += int(cone.sum())
+        if sharp[f.vertex]:
+            assert not cone.any()  # a sharp vertex's own sides stay as they are
+        want = sharp[f.ring.neighbors] & (f.arrays.radius > 0) & ~sharp[f.vertex]
+        np.testing.assert_array_equal(cone, want)
+        if not cone.any():
+            np.testing.assert_array_equal(f.rho, f0.rho)
+            continue
+        _, rho = chain(f0, [Chart(s, bool(c)) for s, c in zip(f0.sides, cone, strict=True)])
+        np.testing.assert_allclose(f.rho, rho, atol=1e-13)
+        for i in range(len(f.ring.faces)):
+            j = (i + 1) % len(f.sides)
+            C, R, _, _ = f.arrays.chart(np.array([i, j]), np.array([f.arrays.arc[i], 0.0]))
+            # T_end of side i on its end ruling, T_start of side j on its start ruling
+            for T, c, r, z in ((f.T_end[i], C[0], R[0], f.lmax_end[i]),
+                               (f.T_start[j], C[1], R[1], f.lmax_start[j])):  # fmt: skip
+                np.testing.assert_allclose(T, c + z * r, atol=1e-12)
+            np.testing.assert_allclose(f.T_end[i], f.T_start[j], atol=1e-10)
+    assert n_conical > 0
+
+
+def test_row_maps_read_eq1_on_a_fillet_as_on_a_cylinder():
+    """crease_numerator / crease_denominator through the per-row charts are the ruled eq. (1)
+    of rounding.tapered, on cylinders and fillets alike."""
+    from filletfold.rounding.tapered import crease_height_ruled
+    from filletfold.vertex.crease import chart_apex, crease_denominator, crease_numerator
+
+    m, rd, sharp = _sharp_case("icosahedron", 5)
+    frames = vertex_frames(m, rd, list(range(m.n_vertices)), sharp=sharp)
+    rng = np.random.default_rng(0)
+    checked = 0
+    for f in frames:
+        sa = f.arrays
+        side = np.repeat(np.arange(len(sa.arc)), 5)
+        s = sa.arc[side] * rng.random(len(side))
+        V = f.U + 0.3 * rng.standard_normal(3)
+        v = 0.1 * rng.standard_normal(2)
+        C, R, c, r = sa.chart(side, s)
+        vi = chart_apex(sa.Q[side], sa.t[side], v)
+        _, num_w, dn_w = crease_height_ruled(V, vi, C, R, c, r)
+        Q, t, R_row, M_row = sa.row_maps(side, s)
+        v_row = chart_apex(Q, t, v)
+        num = crease_numerator(V, v_row, s, C)
+        dn = crease_denominator(V, v_row, M_row, R_row)
+        np.testing.assert_allclose(num, num_w, atol=1e-12)
+        np.testing.assert_allclose(dn, dn_w, atol=1e-12)
+        checked += int(sa.conical.any())
+    assert checked > 0
+
+
+def test_a_fillets_surface_normal_is_the_faces_at_its_ends():
+    m, rd, sharp = _sharp_case("cube", 1)
+    for f in vertex_frames(m, rd, list(range(m.n_vertices)), sharp=sharp):
+        sa = f.arrays
+        k = np.flatnonzero(sa.conical)
+        if not len(k):
+            continue
+        n0 = sa.surface_normal(k, np.zeros(len(k)))
+        n1 = sa.surface_normal(k, sa.arc[k])
+        faces = np.asarray(f.ring.faces)
+        np.testing.assert_allclose(n0, m.face_normal[faces[(k - 1) % len(faces)]], atol=1e-12)
+        np.testing.assert_allclose(n1, m.face_normal[faces[k]], atol=1e-12)

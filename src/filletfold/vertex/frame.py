@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
 from ..rounding.edges import EdgeRounding
+from ..rounding.tapered import fillet_chart, perpendiculars, ruled_gluing_maps
 from ..tolerances import tol
 
 
@@ -53,6 +54,10 @@ class Side:
         Axis point in the midpoint cross-section.
     N0, B : (3,) float
         ``N(s) = cos(s / r) N0 + sin(s / r) B``; ``N0`` is the normal of face ``f_{i-1}``.
+    S : (3,) float or None
+        On a *conical* side (the edge's other end is a sharp vertex): that end, the apex of
+        the conical fillet that rounds the edge instead of a cylinder
+        (:mod:`filletfold.rounding.tapered`). None on a cylinder.
     """
 
     edge: int
@@ -67,6 +72,12 @@ class Side:
     O: np.ndarray | None = None
     N0: np.ndarray | None = None
     B: np.ndarray | None = None
+    S: np.ndarray | None = None
+
+    @property
+    def conical(self) -> bool:
+        """True for a conical fillet (:attr:`S` set)."""
+        return self.S is not None
 
     @property
     def flat(self) -> bool:
@@ -169,6 +180,10 @@ class SideArrays:
         Its translation.
     face_normal : (n_faces, 3) float
         Front normal of each ring face.
+    S : (k, 3) float
+        Apex of each conical side's fillet (:attr:`Side.S`), NaN on the other sides (None:
+        no side is conical). On a conical side the chart is the fillet's (:meth:`chart`),
+        not ``(s, z) -> C(s) + z R``.
     """
 
     edge: np.ndarray
@@ -184,6 +199,77 @@ class SideArrays:
     Q: np.ndarray
     t: np.ndarray
     face_normal: np.ndarray
+    S: np.ndarray | None = None
+
+    @property
+    def conical(self) -> np.ndarray:
+        """(k,) bool: the conical sides."""
+        if self.S is None:
+            return np.zeros(len(self.edge), dtype=bool)
+        return ~np.isnan(self.S[:, 0])
+
+    def chart(self, i: np.ndarray, s: np.ndarray):
+        """Base-curve points, rulings and their images in the sides' charts at arc parameters
+        ``s`` (m,) of sides ``i`` (m,): ``C``, ``R`` (m, 3), ``c``, ``r`` (m, 2).
+
+        A cylinder's chart is ``c = (s, 0)``, ``r = (0, 1)`` with ``R`` the edge direction; a
+        conical side's is its fillet's (:func:`~filletfold.rounding.tapered.fillet_chart`).
+        """
+        i, s = np.asarray(i, dtype=np.int64), np.asarray(s, dtype=float)
+        C = self.base(i, s)
+        R = self.R[i].copy()
+        c = np.stack([s, np.zeros_like(s)], axis=1)
+        r = np.repeat([[0.0, 1.0]], len(s), axis=0)
+        cone = self.conical[i]
+        if cone.any():
+            k = i[cone]
+            _, R[cone], c[cone], r[cone], _ = fillet_chart(
+                self.O[k], self.N0[k], self.B[k], self.kappa[k], self.radius[k], self.S[k], s[cone]
+            )
+        return C, R, c, r
+
+    def row_maps(self, i: np.ndarray, s: np.ndarray):
+        """Per-row charts in which every side reads as a cylinder, for eq. (1) as written.
+
+        On a conical side the chart at ``s`` is turned and moved so that ``c(s)`` lands on
+        ``(s, 0)`` and ``r(s)`` on ``(0, 1)``; with ``R`` the ruling at ``s`` and ``M = C(s)``,
+        :func:`~filletfold.vertex.crease.crease_numerator` and
+        :func:`~filletfold.vertex.crease.crease_denominator` then give the ruled form of
+        eq. (1) (:func:`~filletfold.rounding.tapered.crease_height_ruled`), and their
+        gradients hold unchanged. On a cylinder these are ``Q``, ``t``, ``R`` and ``M``.
+
+        Returns
+        -------
+        Q : (m, 2, 2) float
+        t : (m, 2) float
+            The map from the common frame into each row's chart.
+        R, M : (m, 3) float
+        """
+        i, s = np.asarray(i, dtype=np.int64), np.asarray(s, dtype=float)
+        Q, t, R, M = self.Q[i].copy(), self.t[i].copy(), self.R[i].copy(), self.M[i].copy()
+        cone = self.conical[i]
+        if cone.any():
+            C, Rc, c, r = self.chart(i[cone], s[cone])
+            # the turn taking r = (sin th, cos th) to (0, 1)
+            rot = np.stack([np.stack([r[:, 1], -r[:, 0]], -1), np.stack([r[:, 0], r[:, 1]], -1)], 1)
+            Q[cone] = rot @ Q[cone]
+            shift = np.stack([s[cone], np.zeros(len(C))], axis=1) - np.einsum("kij,kj->ki", rot, c)
+            t[cone] = np.einsum("kij,kj->ki", rot, t[cone]) + shift
+            R[cone], M[cone] = Rc, C
+        return Q, t, R, M
+
+    def surface_normal(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """(m, 3) front normals of the sides' surfaces along their base curves: ``N(s)`` on a
+        cylinder, ``unit(C'(s) x R(s))`` on a conical fillet (the faces' normals at the
+        ends)."""
+        N = self.normal(i, s)
+        cone = self.conical[np.asarray(i, dtype=np.int64)]
+        if cone.any():
+            k = np.asarray(i, dtype=np.int64)[cone]
+            _, Rc, _, _ = self.chart(k, np.asarray(s, dtype=float)[cone])
+            n = np.cross(self.tangent(k, np.asarray(s, dtype=float)[cone]), Rc)
+            N[cone] = n / np.linalg.norm(n, axis=1)[:, None]
+        return N
 
     def _angle(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
         """(m, 1) turning angles ``s / r`` of sides ``i`` (0 on a side of radius 0)."""
@@ -254,6 +340,7 @@ def stack_sides(sides: list, Q=None, t=None, face_normal=None) -> SideArrays:
         Q=Q,
         t=t,
         face_normal=face_normal,
+        S=np.array([np.full(3, np.nan) if x.S is None else x.S for x in sides]).reshape(-1, 3),
     )
 
 
@@ -281,6 +368,7 @@ class _SideStore:
             sa.O[p],
             sa.N0[p],
             sa.B[p],
+            None if sa.S is None or np.isnan(sa.S[p, 0]) else sa.S[p],
         )
 
 
@@ -587,7 +675,7 @@ def _ring_walks(mesh: PolyMesh, verts: np.ndarray):
 
 
 def vertex_frames(
-    mesh: PolyMesh, rounding: EdgeRounding, vertices, start_edges=None
+    mesh: PolyMesh, rounding: EdgeRounding, vertices, start_edges=None, sharp=None
 ) -> list[VertexFrame]:
     """Build the sides, T points and development of many vertices at once.
 
@@ -604,6 +692,11 @@ def vertex_frames(
         Per vertex, for a closed ring: the incident edge to list first. The development is cut
         along the start of its cylinder, so this chooses where the module's angle-defect cut
         runs. None (or an edge not in the ring) keeps the ring's own order.
+    sharp : (n_vertices,) bool, optional
+        The sharp vertices (no cone, the corner kept). A rounded side of a vertex that is not
+        sharp, whose other end is, is *conical*: its edge is rounded by the conical fillet
+        from that end (:mod:`filletfold.rounding.tapered`), so its T points lie on the
+        fillet's end rulings and its gluing maps are the fillet's. None: no sharp vertex.
 
     Returns
     -------
@@ -678,6 +771,11 @@ def vertex_frames(
     gamma = np.where(curved, rounding.half_angle[edge], 0.0)
     arc = np.where(curved, rounding.arc_length[edge], 0.0)
     kappa = np.where(curved, rounding.kappa[edge], 0).astype(np.int64)
+    S = np.full((len(sv), 3), np.nan)
+    if sharp is not None:
+        sharp = np.asarray(sharp, dtype=bool)
+        cone = curved & sharp[nbr] & ~sharp[verts][sv]
+        S[cone] = other[cone]
     # boundary sides get O = M and zero N0, B here, so that their base curve is the point M
     sa = SideArrays(
         edge=edge.astype(np.int64),
@@ -693,7 +791,9 @@ def vertex_frames(
         Q=None,
         t=None,
         face_normal=None,
+        S=S,
     )
+    cone = sa.conical
     frames = np.concatenate([U[fv][:, None], _face_axes(mesh, face)], axis=1)  # (F, 3, 3)
 
     # ---- T points: the tangent lines on face f_i of sides i (its end) and i + 1 (its start)
@@ -701,12 +801,17 @@ def vertex_frames(
     sj = so[fv] + (fp + 1) % ne[fv]
     p1 = sa.base(si, arc[si])
     p2 = sa.base(sj, np.zeros(len(sj)))
-    z1, z2 = _line_crossings(p1, R[si], p2, R[sj])
+    d1, d2 = R[si], R[sj]  # a conical side's line on the face is its end ruling from S
+    if cone.any():
+        d1, d2 = d1.copy(), d2.copy()
+        d1[cone[si]] = sa.chart(si[cone[si]], arc[si[cone[si]]])[1]
+        d2[cone[sj]] = sa.chart(sj[cone[sj]], np.zeros(int(cone[sj].sum())))[1]
+    z1, z2 = _line_crossings(p1, d1, p2, d2)
     lmax_start, lmax_end = np.full(len(sv), np.nan), np.full(len(sv), np.nan)
     T_start, T_end = np.full((len(sv), 3), np.nan), np.full((len(sv), 3), np.nan)
     lmax_end[si], lmax_start[sj] = z1, z2
-    T_end[si] = p1 + z1[:, None] * R[si]
-    T_start[sj] = p2 + z2[:, None] * R[sj]
+    T_end[si] = p1 + z1[:, None] * d1
+    T_start[sj] = p2 + z2[:, None] * d2
 
     # ---- development: chain tau -> cylinder 0 -> f_0 -> ... (closed) or f_0 -> ... (open)
     rs = np.nonzero(rounded)[0]
@@ -720,6 +825,16 @@ def vertex_frames(
     g_end_inv[rs] = invert(
         gluing_maps(t_end, R[rs], frames[f_next[rs]], sa.base(rs, arc[rs]), arc[rs])
     )
+    if cone.any():  # a conical side touches its faces along its end rulings
+        k = np.flatnonzero(cone)
+        for ends, face_of, store in ((np.zeros(len(k)), f_prev, "start"), (arc[k], f_next, "end")):
+            C, Rc, c, r = sa.chart(k, ends)
+            E, e = perpendiculars(C, sa.tangent(k, ends), Rc, c, r)
+            g = ruled_gluing_maps(frames[face_of[k]], C, Rc, E, c, r, e)
+            if store == "start":
+                g_start[k] = g
+            else:
+                g_end_inv[k] = invert(g)
     current = np.repeat(np.eye(3)[None], n, axis=0)  # tau = f_{n-1}; f_0 for an open ring
     cyl_map = np.full((len(sv), 3, 3), np.nan)
     face_map = np.empty((len(fv), 3, 3))
