@@ -225,6 +225,7 @@ def build_constraints_many(
     k = np.array([len(a.arc) for a in arrays])  # sides (= ring faces) per vertex
     so, sv = np.cumsum(k) - k, np.repeat(np.arange(n), k)  # first side, vertex of each side
     side, first, last, s, C, N = sa.samples(np.repeat(np.asarray(n_samples).reshape(n), k))
+    cone = sa.conical
     extras = [] if extras is None else [(j, x) for j, x in enumerate(extras) if x is not None]
     if any(len(x) for _, x in extras):  # each vertex's extra samples after its own
         x_vert = np.concatenate([np.full(len(x), j) for j, x in extras])
@@ -237,6 +238,8 @@ def build_constraints_many(
         n_x = np.bincount(x_vert, minlength=n)
         shift = (np.cumsum(n_x) - n_x)[sv]  # extra samples of the vertices before
         first, last = first + shift, last + shift
+    if cone.any():  # a fillet's surface normal is the cone's, not the cylinder's
+        N = sa.surface_normal(side, s)
     m = np.bincount(sv[side], minlength=n)  # samples per vertex
     mo, mv = np.cumsum(m) - m, np.repeat(np.arange(n), m)  # first sample, vertex of each
     margin = np.asarray(margins, dtype=float).reshape(n)
@@ -291,7 +294,10 @@ def build_constraints_many(
     c = np.bincount(sv[chord], minlength=n)
     l_count = m + c + 4 * k
     l_start = np.cumsum(l_count) - l_count
-    ne = np.cross(C[last[chord]] - C[first[chord]], sa.R[chord])
+    along = sa.R[chord]
+    if cone.any():  # the chord plane of a fillet passes through its apex
+        along = np.where(cone[chord, None], C[first[chord]] - sa.S[chord], along)
+    ne = np.cross(C[last[chord]] - C[first[chord]], along)
     ne /= np.linalg.norm(ne, axis=1)[:, None]
     T_start = np.concatenate([f.T_start for f in frames])
     T_end = np.concatenate([f.T_end[: len(f.ring.faces)] for f in frames])
@@ -303,7 +309,11 @@ def build_constraints_many(
     ring_faces = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
     face_row = sides - so[sv] + l_start[sv] + m[sv] + c[sv]
     nxt = so[sv] + (sides - so[sv] + 1) % k[sv]
-    tilted = fold_planes(sa.face_normal, sa.R, sa.R[nxt], sigma[sv])
+    R_end, R_start = sa.R, sa.R[nxt]  # the sides' lines on each face, at its T
+    if cone.any():
+        R_end = sa.chart(sides, sa.arc)[1]
+        R_start = sa.chart(nxt, np.zeros(len(nxt)))[1]
+    tilted = fold_planes(sa.face_normal, R_end, R_start, sigma[sv])
     for idx, vert, normal, point, kind, element in (
         (np.arange(len(s)) - mo[mv] + l_start[mv], mv, N, C, "nonint", sa.edge[side]),
         (chord_rank + l_start[sv[chord]] + m[sv[chord]], sv[chord], ne, T_start[chord], "chord",
@@ -317,7 +327,10 @@ def build_constraints_many(
         lin_b[idx] = -np.einsum("ij,ij->i", a_, point) - margin[vert]
         l_kind[idx], l_element[idx] = kind, element
     quad_c, quad_s = C[q_sample], s[q_sample]
-    quad_R, quad_M, quad_Q, quad_t = sa.R[q_side], sa.M[q_side], sa.Q[q_side], sa.t[q_side]
+    if cone.any():  # per-row charts in which a fillet reads as a cylinder
+        quad_Q, quad_t, quad_R, quad_M = sa.row_maps(q_side, quad_s)
+    else:
+        quad_R, quad_M, quad_Q, quad_t = sa.R[q_side], sa.M[q_side], sa.Q[q_side], sa.t[q_side]
     q_element = sa.edge[q_side]
     q_end, l_end = q_start + m + 3 * k, l_start + l_count
     out = []
@@ -484,17 +497,24 @@ def crease_length(
     -------
     l : (k,) float
     dn : float or (k,) float
-        The denominator ``(v - c) . r - (V - C) . R`` (constant along an arc; > 0 when valid),
-        per side given: a float for one side, else one per arc parameter.
+        The denominator ``(v - c) . r - (V - C) . R`` (constant along a cylinder's arc, not
+        along a conical fillet's; > 0 when valid), per side given: a float for one side (the
+        smallest on a fillet), else one per arc parameter.
     """
     sa = frame.arrays
     s = np.asarray(s, dtype=float)
     one = np.ndim(i) == 0
     side = np.full(len(s), i) if one else np.asarray(i)
-    vi = chart_apex(sa.Q, sa.t, v)  # per side of the ring
-    dn = crease_denominator(V, vi, sa.M, sa.R)
     if C is None:
         C = sa.base(side, s)
+    if sa.conical[side].any():  # a fillet's chart turns with s: dn varies along its arc
+        Q, t, R, M = sa.row_maps(side, s)
+        vi = chart_apex(Q, t, v)
+        dn = crease_denominator(V, vi, M, R)
+        l = crease_height(crease_numerator(V, vi, s, C), dn)
+        return l, float(dn.min()) if one else dn
+    vi = chart_apex(sa.Q, sa.t, v)  # per side of the ring
+    dn = crease_denominator(V, vi, sa.M, sa.R)
     l = crease_height(crease_numerator(V, vi[side], s, C), dn[side])
     return l, float(dn[i]) if one else dn[side]
 
@@ -594,10 +614,19 @@ def validate_apices(
     side, first, last, s, C, N = sa.samples(n_samples)
     vi = chart_apex(sa.Q, sa.t, v)  # developed apex in each cylinder's chart
     d = V[side] - C
-    num = crease_numerator(V[side], vi[side], s, C)
-    dn = crease_denominator(V, vi, sa.M, sa.R)
+    if sa.conical.any():  # a fillet's chart turns with s: eq. (1) row by row, dn varies
+        Q_s, t_s, R_s, M_s = sa.row_maps(side, s)
+        vi_s = chart_apex(Q_s, t_s, v[side])
+        num = crease_numerator(V[side], vi_s, s, C)
+        dn_s = crease_denominator(V[side], vi_s, M_s, R_s)
+        dn = np.minimum.reduceat(dn_s, first)
+        N = sa.surface_normal(side, s)
+    else:
+        num = crease_numerator(V[side], vi[side], s, C)
+        dn = crease_denominator(V, vi, sa.M, sa.R)
+        dn_s, R_s = dn[side], sa.R[side]
     valid = dn > 0
-    l = crease_height(num, np.where(valid, dn, 1.0)[side])
+    l = crease_height(num, np.where(valid[side], dn_s, 1.0))
     nonint = sigma[vert][side] * np.einsum("ij,ij->i", d, N)
     # the minima between samples: Newton from the smallest sample on the closed forms
     l_min, l_at = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
@@ -622,8 +651,8 @@ def validate_apices(
     nrm = sa.face_normal
     face_val = sigma[fvert] * np.einsum("ij,ij->i", V[fside] - T_face, nrm)
     # the straight crease on each face, from side i's end to side i + 1's start
-    p0 = C[last[fside]] + l[last[fside], None] * sa.R[fside]
-    p1 = C[first[nxt]] + l[first[nxt], None] * sa.R[nxt]
+    p0 = C[last[fside]] + l[last[fside], None] * R_s[last[fside]]
+    p1 = C[first[nxt]] + l[first[nxt], None] * R_s[first[nxt]]
     dvec = p1 - p0
     length = np.linalg.norm(dvec, axis=1)
     e_face = eps[fvert]
@@ -681,12 +710,13 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
     ``l(s) = num(s) / (2 dn)`` of eq. (1) (``num(s) = (v_x - s)^2 + v_y^2 - |V - C(s)|^2``);
     without, ``sigma (V - C(s)) . N(s)``. With ``C(s) = O + kappa r N(s)`` both are
     trigonometric in ``s / r``. ``V`` ((3,) or (k, 3) float) and ``sigma`` (int or (k,)) may be
-    given per side, so that the sides of many vertices are refined at once.
+    given per side, so that the sides of many vertices are refined at once. A conical side
+    keeps its smallest sample (its rows' charts turn with ``s``).
     """
     ends = np.append(first[1:], len(values))
     best = np.minimum.reduceat(values, first)
     r, arc = sa.radius, sa.arc
-    ok = r > 0
+    ok = (r > 0) & ~sa.conical  # a conical fillet's closed form is not this one: samples only
     # the first sample of each side that attains its smallest value (the side's first sample
     # where none does: a NaN)
     side = np.repeat(np.arange(len(first)), ends - first)
