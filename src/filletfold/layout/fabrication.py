@@ -90,7 +90,10 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
         recut = {}  # the frames cut along the tree's edges, built at once
         if cut is not None:
             cut_at = [u for u, (f, _, _) in enumerate(solved) if f.ring.closed and cut[u] >= 0]
-            new_frames = vertex_frames(mesh, rounding, cut_at, [int(cut[u]) for u in cut_at])
+            sharp = np.array([f.sharp for f, _, _ in solved], dtype=bool)
+            new_frames = vertex_frames(
+                mesh, rounding, cut_at, [int(cut[u]) for u in cut_at], sharp=sharp
+            )
             recut = dict(zip(cut_at, new_frames, strict=True))
         batch = []  # (frame, apex, developed apex) of every vertex, its ring re-cut
         for u, (frame, apex, v) in enumerate(solved if cut is not None else []):

@@ -38,6 +38,7 @@ import numpy as np
 
 from ..mesh.polymesh import PolyMesh
 from ..parallel import thread_map
+from ..rounding.tapered import perpendiculars, ruled_gluing_maps
 from ..tolerances import tol
 from ..vertex.apex import _stack
 from ..vertex.crease import chart_apex, crease_denominator, crease_height, crease_numerator
@@ -45,6 +46,7 @@ from ..vertex.frame import SideArrays, VertexFrame, dot_rows, gluing_maps, stack
 from .faces import FaceLists, polygon_area2
 from .overlap import faces_interior_disjoint, faces_interior_disjoint_many, run_overlaps
 from .piece import Piece
+from .sharp import sharp_modules
 
 
 def _arc_parameters(arc: np.ndarray, n: np.ndarray):
@@ -180,7 +182,9 @@ def build_modules(
     n_samples : int or (n_edges,) int
         Points per arc, for all arcs or per edge.
     apices : sequence of ((3,) float or None)
-        Spatial apex of each frame's vertex (None: a hole border).
+        Spatial apex of each frame's vertex (None: a hole border; a sharp vertex's frame,
+        :attr:`~filletfold.vertex.frame.VertexFrame.sharp`, gets the fan of
+        :func:`~filletfold.surface.sharp.sharp_modules` instead).
     developed : sequence of ((2,) float or None)
         Its developed apex.
     progress : callable, optional
@@ -199,13 +203,21 @@ def build_modules(
     if np.size(n_samples) == 0 or np.min(n_samples) < 1:
         raise ValueError(f"every arc needs at least one sample, got {n_samples!r}")
     for frame, apex, v in zip(frames, apices, developed, strict=True):
+        if frame.sharp and apex is not None:
+            raise ValueError(f"vertex {frame.vertex}: a sharp vertex has no apex")
         if apex is not None and (v is None or not frame.ring.closed):
             why = "no developed apex" if v is None else "an open ring"
             raise ValueError(
                 f"vertex {frame.vertex}: a cone needs a closed ring and both apices ({why})"
             )
     modules: list = [None] * len(frames)
-    chunks = [list(range(c, min(c + CHUNK, len(frames)))) for c in range(0, len(frames), CHUNK)]
+    corners = [j for j, f in enumerate(frames) if f.sharp]  # sharp vertices: their fans
+    if corners:
+        fans = sharp_modules([frames[j] for j in corners], centres, None, n_samples)
+        for j, module in zip(corners, fans, strict=True):
+            modules[j] = module
+    rest = [j for j, f in enumerate(frames) if not f.sharp]
+    chunks = [rest[c : c + CHUNK] for c in range(0, len(rest), CHUNK)]
 
     def chunk_modules(which: list) -> list:
         chunk = _Chunk.of(
@@ -390,7 +402,10 @@ class _Chunk:
                 np.minimum.reduceat(sa.length, side_first[:-1]),
                 np.abs(np.array([f.U for f in frames])).max(axis=1),
             ),
-            patch=[f"cylinder {e}" for e in sa.edge.tolist()]
+            patch=[
+                f"{'fillet' if cone_side else 'cylinder'} {e}"
+                for e, cone_side in zip(sa.edge.tolist(), sa.conical.tolist(), strict=True)
+            ]
             + [f"cone {f.vertex}" for f in frames]
             + [f"face {f}" for f in ring_face.tolist()],
             tee=np.concatenate(
@@ -405,16 +420,41 @@ class _Chunk:
     def curves(self, side: np.ndarray, s: np.ndarray):
         """Base points ``C`` (m, 3), heights ``z`` (m,) and top points ``F`` (m, 3) at arc
         parameters ``s`` (m,) of ``side`` (m,): the crease (eq. (1)) on a cone's sides, the hole
-        border elsewhere."""
+        border elsewhere. On a conical side ``z`` runs along the fillet's ruling at ``s`` and
+        eq. (1) is evaluated in that row's chart (:meth:`SideArrays.row_maps`)."""
         sa = self.sides
         C = sa.base(side, s)
         z = self.height[side]
-        on = np.flatnonzero(self.cone[self.side_vertex[side]])
-        if len(on):
-            i = side[on]
-            num = crease_numerator(self.apex[self.side_vertex[i]], self.vi[i], s[on], C[on])
-            z[on] = crease_height(num, self.dn[i])
-        return C, z, C + z[:, None] * sa.R[side]
+        R = sa.R[side]
+        on = self.cone[self.side_vertex[side]]
+        conic = sa.conical[side]
+        plain = np.flatnonzero(on & ~conic)
+        if len(plain):
+            i = side[plain]
+            num = crease_numerator(self.apex[self.side_vertex[i]], self.vi[i], s[plain], C[plain])
+            z[plain] = crease_height(num, self.dn[i])
+        k = np.flatnonzero(conic)
+        if len(k):
+            Q, t, R[k], M = sa.row_maps(side[k], s[k])
+            c = np.flatnonzero(on[k])
+            if len(c):
+                kc = k[c]
+                V = self.apex[self.side_vertex[side[kc]]]
+                vi = chart_apex(Q[c], t[c], self.dev[self.side_vertex[side[kc]]])
+                num = crease_numerator(V, vi, s[kc], C[kc])
+                z[kc] = crease_height(num, crease_denominator(V, vi, M[c], R[kc]))
+        return C, z, C + z[:, None] * R
+
+    def in_side_chart(self, side: np.ndarray, s: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """(m, 2) common-frame images of the points at arc parameters ``s`` and heights ``z``
+        (m,) of sides ``side`` (m,): ``(s, z)`` in a cylinder's chart, ``c(s) + z r(s)`` in a
+        fillet's."""
+        p = np.stack([s, z], axis=1)
+        k = np.flatnonzero(self.sides.conical[side])
+        if len(k):
+            _, _, c, r = self.sides.chart(side[k], s[k])
+            p[k] = c + z[k, None] * r
+        return apply_rows(self.cyl[side], p)
 
     def in_face_chart(self, p: np.ndarray, face: np.ndarray) -> np.ndarray:
         """(m, 2) common-frame images of points ``p`` (m, 3) on ring faces ``face`` (m,)
@@ -639,9 +679,8 @@ def _run_points(chunk: _Chunk, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
     # the half-cylinders: base curves and creases (module._side_curves, module._strips)
     side = lay.side[lay.sample_share]
     C, z, F = chunk.curves(side, lay.s)
-    maps = chunk.cyl[side]
-    P2[lay.base] = apply_rows(maps, np.stack([lay.s, np.zeros(len(side))], axis=1))
-    P2[lay.top] = apply_rows(maps, np.stack([lay.s, z], axis=1))
+    P2[lay.base] = chunk.in_side_chart(side, lay.s, np.zeros(len(side)))
+    P2[lay.top] = chunk.in_side_chart(side, lay.s, z)
     P3[lay.base], P3[lay.top] = C, F
     # an unrounded first side: its line on the first face, up to half its lmax_end
     q = np.flatnonzero(lay.head & (lay.n == 0))
@@ -680,6 +719,12 @@ def _end_copy(chunk: _Chunk, P2, P3, at: np.ndarray, side: np.ndarray, face: np.
     s0 = np.zeros(len(side))
     C, z, F = chunk.curves(side, s0)
     glue = gluing_maps(sa.tangent(side, s0), sa.R[side], chunk.face_frame[face], C, s0)
+    k = np.flatnonzero(sa.conical[side])
+    if len(k):  # a fillet touches the face along its ruling from S (its chart at s = 0 is a
+        # cylinder's: the points below are the same, the map is the fillet's)
+        Ck, Rk, c, r = sa.chart(side[k], s0[k])
+        E, e = perpendiculars(Ck, sa.tangent(side[k], s0[k]), Rk, c, r)
+        glue[k] = ruled_gluing_maps(chunk.face_frame[face[k]], Ck, Rk, E, c, r, e)
     m = chunk.face_map[face] @ glue
     P2[at] = apply_rows(m, np.stack([s0, s0], axis=1))
     P2[at + 1] = apply_rows(m, np.stack([s0, z], axis=1))

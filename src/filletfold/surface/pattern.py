@@ -255,7 +255,8 @@ class CreasePattern:
         """Edges from faces; assignment and fold angle from the folded geometry.
 
         An edge with one face is a border or cut (B). An edge between two faces of one patch,
-        between a cylinder and a face piece (tangent continuous by construction), or between
+        between a cylinder or conical fillet and a face piece (tangent continuous by
+        construction), or between
         two face pieces meeting within ``tol.coplanar_deg`` (across a flat, unrounded edge) is F
         with fold angle 0. Any other edge is a crease: M where the surface is convex seen from the
         front, V otherwise, with the fold angle between the two faces' 3D normals.
@@ -291,7 +292,8 @@ class CreasePattern:
             map(ids.__getitem__, self.face_patch), dtype=np.int64, count=len(self.face_patch)
         )
         kind = np.array([p.split(" ")[0] for p in ids] or [""])
-        cyl, face = (kind == "cylinder")[patch], (kind == "face")[patch]
+        cyl = ((kind == "cylinder") | (kind == "fillet"))[patch]  # tangent to the faces
+        face = (kind == "face")[patch]
         tangent = (cyl[fa] & face[fb]) | (face[fa] & cyl[fb])
         coplanar = face[fa] & face[fb] & (np.abs(theta) < tol.coplanar_deg)
         smooth = (patch[fa] == patch[fb]) | tangent | coplanar

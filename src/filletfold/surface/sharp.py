@@ -37,14 +37,15 @@ from .piece import Piece
 SEAM_MARGIN = 0.05
 
 
-def _side_points(frame: VertexFrame, i: int, conical: bool, n_samples: int):
+def _side_points(frame: VertexFrame, i: int, conical, n_samples):
     """The half of side ``i`` seen from the sharp vertex: 3D points, their distances to ``S``
     and their developed angles from the side's start (one point, ``M``, when not conical)."""
     side = frame.sides[i]
     U = frame.U
-    if not (conical and side.radius > 0):
+    if not ((side.radius > 0) if conical is None else (conical[side.edge] and side.radius > 0)):
         return side.M[None], np.array([0.5 * side.length]), np.zeros(1)
-    s = np.linspace(0.0, side.arc, max(int(n_samples), 2))
+    n = int(n_samples) if np.ndim(n_samples) == 0 else int(n_samples[side.edge])
+    s = np.linspace(0.0, side.arc, max(n, 2))
     m = len(s)
     rows = (
         np.repeat(side.O[None], m, 0),
@@ -58,12 +59,12 @@ def _side_points(frame: VertexFrame, i: int, conical: bool, n_samples: int):
     return C, cone_rulings(C, S)[1], developed_angles(*rows, S, s)
 
 
-def _fan(frame: VertexFrame, centres: np.ndarray, conical: np.ndarray, n_samples: int):
+def _fan(frame: VertexFrame, centres: np.ndarray, conical, n_samples):
     """Every side's half (:func:`_side_points`), every face's wedge at ``S`` and its three
     corners ``P``, centre, ``P'`` in the face's chart with the chart angle of ``P``."""
     ring = frame.ring
     n_e, n_f = len(ring.edges), len(ring.faces)
-    sides = [_side_points(frame, i, bool(conical[e]), n_samples) for i, e in enumerate(ring.edges)]
+    sides = [_side_points(frame, i, conical, n_samples) for i in range(len(ring.edges))]
     chart_points = []
     wedge = np.zeros(n_f)
     for f in range(n_f):
@@ -81,9 +82,7 @@ def _polar(angle: np.ndarray, radius: np.ndarray) -> np.ndarray:
     return np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=-1)
 
 
-def sharp_module(
-    frame: VertexFrame, centres: np.ndarray, conical: np.ndarray, n_samples: int
-) -> list[Piece]:
+def sharp_module(frame: VertexFrame, centres: np.ndarray, conical, n_samples) -> list[Piece]:
     """The flat piece(s) of one sharp vertex (:func:`sharp_modules` of a batch of one).
 
     Parameters
@@ -91,9 +90,10 @@ def sharp_module(
     frame : VertexFrame
     centres : (n_faces, 3) float
         Face piece centres, by mesh face.
-    conical : (n_edges,) bool
-        Which edges are conical fillets (rounded, the other end takes a cone).
-    n_samples : int
+    conical : (n_edges,) bool or None
+        Which edges are conical fillets (the other end takes a cone); None: every rounded
+        side (radius > 0: an edge between two sharp vertices has radius 0).
+    n_samples : int or (n_edges,) int
         Points per fillet arc.
 
     Returns
@@ -151,17 +151,15 @@ def sharp_module(
     return [p.compact() for p in pieces]
 
 
-def sharp_modules(
-    frames: list, centres: np.ndarray, conical: np.ndarray, n_samples: int
-) -> list[list[Piece]]:
+def sharp_modules(frames: list, centres: np.ndarray, conical, n_samples) -> list[list[Piece]]:
     """The modules of many sharp vertices: :func:`sharp_module` of each frame.
 
     Parameters
     ----------
     frames : sequence of VertexFrame
     centres : (n_faces, 3) float
-    conical : (n_edges,) bool
-    n_samples : int
+    conical : (n_edges,) bool or None
+    n_samples : int or (n_edges,) int
 
     Returns
     -------
@@ -171,7 +169,7 @@ def sharp_modules(
     return [sharp_module(f, centres, conical, n_samples) for f in frames]
 
 
-def fan_angle(frame: VertexFrame, centres: np.ndarray, conical: np.ndarray) -> float:
+def fan_angle(frame: VertexFrame, centres: np.ndarray, conical=None) -> float:
     """The angle the sharp vertex's fan sweeps in the development (radians): the faces'
     wedges at ``S`` (each corner angle less ``psi`` beside each conical side) plus the
     fillets' sectors ``theta(a)``."""

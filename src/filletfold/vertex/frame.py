@@ -434,6 +434,9 @@ class VertexFrame:
         Those crossing points.
     corner_angle : (n_faces,) float
         Face angle of each ring face at the vertex (radians; above pi at a reflex corner).
+    sharp : bool
+        The vertex is sharp: it keeps its corner, and its module is the fan of
+        :mod:`filletfold.surface.sharp` (``vertex_frames(..., sharp=)``).
     """
 
     vertex: int
@@ -449,6 +452,7 @@ class VertexFrame:
     T_start: np.ndarray
     T_end: np.ndarray
     corner_angle: np.ndarray
+    sharp: bool = False
 
     @property
     def n_sides(self) -> int:
@@ -878,6 +882,7 @@ def vertex_frames(
             T_start=T_start[s:s2],
             T_end=T_end[s:s2],
             corner_angle=corner[f:f2],
+            sharp=bool(sharp is not None and sharp[u]),
         )
         if ring.closed:
             frame.__dict__["arrays"] = SideArrays(
