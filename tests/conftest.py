@@ -28,11 +28,16 @@ CLOSED_CONVEX = [n for n, e in EXAMPLES.items() if "convex" in e.kinds and e.clo
 
 @functools.cache
 def design_of(
-    name: str, radius="10%", depth="30%", samples: int = 24, arc_step: float = 1.5
+    name: str,
+    radius="10%",
+    depth="30%",
+    samples: int = 24,
+    arc_step: float = 1.5,
+    sharp: str = "auto",
 ) -> filletfold.Design:
     """Round a built-in example (cached: designs are read-only in the tests)."""
     return filletfold.round_mesh(
-        name, radius=radius, depth=depth, samples=samples, arc_step=arc_step
+        name, radius=radius, depth=depth, samples=samples, arc_step=arc_step, sharp=sharp
     )
 
 

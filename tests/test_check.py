@@ -35,6 +35,7 @@ CHECKS = [
     "contraction",
     "on planes",
     "on cylinders",
+    "on fillets",
     "M/V",
     "fold-angle match",
     "fold-angle range",
@@ -43,6 +44,7 @@ CHECKS = [
     "face orientation",
     "smallest edge",
     "smallest face angle",
+    "holes",
 ]
 
 
@@ -124,7 +126,8 @@ def test_written_designs_pass(name, tmp_root, capsys):
     assert len(lines) == len(CHECKS) + 1 and lines[-1].startswith("valid")
     for line, name_ in zip(lines, CHECKS, strict=False):
         assert line.startswith(name_)
-        assert (" info " if name_ == "smallest face angle" else " ok ") in line
+        info = name_ in ("smallest face angle", "holes")
+        assert (" info " if info else " ok ") in line
     contraction = lines[CHECKS.index("contraction")]
     assert "q =" in contraction and "12 digits" in contraction  # the file's rounding is said
 
@@ -134,8 +137,11 @@ def test_certificate_as_json(tmp_root, capsys):
     data = cert.as_dict()
     assert list(data) == ["ok", "checks"] and data["ok"] is True
     assert list(data["checks"]) == CHECKS
-    for entry in data["checks"].values():
+    for name, entry in data["checks"].items():
         assert list(entry) == ["ok", "value", "limit", "detail"]
+        if name == "on fillets":  # the cube has no conical fillet: nothing measured
+            assert entry["value"] is None and entry["ok"] is True
+            continue
         assert type(entry["value"]) is float and type(entry["ok"]) is bool
         assert entry["limit"] is None or type(entry["limit"]) is float
     assert json.loads(json.dumps(data, allow_nan=False)) == data
@@ -145,8 +151,9 @@ def test_certificate_as_json(tmp_root, capsys):
 
 
 def test_nothing_to_measure_is_not_a_failure():
-    """The Miura design has no cone and no M/V crease: those checks hold, with no figure."""
-    cert = certify_design(design_of("miura"))
+    """The Miura design with holes (``--sharp none``) has no cone and no M/V crease: those
+    checks hold, with no figure."""
+    cert = certify_design(design_of("miura", sharp="none"))
     for name in ("ruling isometry", "fold-angle range", "smallest fold angle"):
         assert cert[name].ok and math.isnan(cert[name].value)
     assert cert.as_dict()["checks"]["ruling isometry"]["value"] is None

@@ -1,13 +1,15 @@
 """The default command on real meshes (tests/data/corpus, see its SOURCES.md): what a user gets.
 
-Every mesh gives a design whose certificate holds, or a one-line error that names a defect no
-tool could repair; never a traceback. ``benchmarks/corpus.py`` prints the same corpus as a table
+Every mesh gives a design whose certificate holds and whose folded surface has no hole (every
+vertex a cone or kept sharp), or a one-line error that names a defect no tool could repair;
+never a traceback. ``benchmarks/corpus.py`` prints the same corpus as a table
 (repairs, radii fitted, vertices per status, time).
 """
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -45,3 +47,11 @@ def test_default_command_gives_a_valid_design_or_one_line(name, tmp_path, capsys
     assert main(["check", str(out)]) == 0  # from the files alone, too
     counts = report["status_counts"]
     assert counts["ok"] + counts["boundary"] + counts["sharp"] > 0
+    # no holes (issue 15): every vertex has a cone or keeps its corner, the folded surface has
+    # the mesh's boundary loops and its border runs along the mesh's boundary edges
+    treatments = {v["treatment"] for v in report["vertices"]}
+    assert treatments <= {"cone", "sharp"}, f"{name}: {treatments}"
+    holes = report["certificate"]["checks"]["holes"]
+    assert holes["value"] == 0 and " 0 notches" in holes["detail"], holes["detail"]
+    notch = re.search(r"deepest notch of the border / size ([0-9.e+-]+)", holes["detail"])
+    assert notch is None or float(notch.group(1)) <= 1e-9, holes["detail"]

@@ -110,8 +110,8 @@ PAIR_CHUNK = 1 << 18
 #: Faces whose neighbours are asked of the tree at once (bounds the pairs held).
 QUERY_CHUNK = 1 << 16
 
-_CONE, _CYLINDER, _FACE = 0, 1, 2
-_KINDS = {"cone": _CONE, "cylinder": _CYLINDER, "face": _FACE}
+_CONE, _CYLINDER, _FACE, _FILLET = 0, 1, 2, 3
+_KINDS = {"cone": _CONE, "cylinder": _CYLINDER, "face": _FACE, "fillet": _FILLET}
 
 
 @dataclass
@@ -321,6 +321,7 @@ class _Data:
         with np.errstate(invalid="ignore", divide="ignore"):
             normal /= np.linalg.norm(normal, axis=1)[:, None]
         self.face_centre, self.face_normal = centre, normal
+        self.mesh_flat, self.mesh_nxt = mflat, mnxt
         try:
             ev = np.asarray(edges["vertices"], dtype=np.int64).reshape(-1, 2)
             n_edges = len(ev)
@@ -337,6 +338,7 @@ class _Data:
         if n_edges and ef.max() >= self.n_mesh_faces:
             raise ParameterError("edges refer to a mesh face out of range", name="edges")
         self.n_mesh_edges = n_edges
+        self.edge_vertices = ev
         # cylinder axes: O = M - kappa (r / cos gamma) unit(N_a + N_b), along the edge
         rounded = (ef >= 0).all(axis=1) & (r > 0) & (kappa != 0) & np.isfinite(gamma)
         a, b = self.mv[ev[:, 0]], self.mv[ev[:, 1]]
@@ -362,8 +364,14 @@ class _Data:
             _CONE: len(self.mv),
             _CYLINDER: self.n_mesh_edges,
             _FACE: self.n_mesh_faces,
+            _FILLET: self.n_mesh_edges,
         }
-        what = {_CONE: "mesh vertex", _CYLINDER: "mesh edge", _FACE: "mesh face"}
+        what = {
+            _CONE: "mesh vertex",
+            _CYLINDER: "mesh edge",
+            _FACE: "mesh face",
+            _FILLET: "mesh edge",
+        }
         parsed = {}
         for name in names:
             parts = name.split()
@@ -372,7 +380,7 @@ class _Data:
                 face = self.patch.index(name)
                 raise ParameterError(
                     f"pattern face {face} has patch {name!r}, not 'cone <vertex>', "
-                    "'cylinder <edge>' or 'face <face>'",
+                    "'cylinder <edge>', 'fillet <edge>' or 'face <face>'",
                     name="face_patch",
                 )
             index = int(parts[1])
@@ -479,10 +487,12 @@ def certify(
         _contraction(data),
         _on_planes(data),
         _on_cylinders(data),
+        _on_fillets(data),
         *_fold_angles(data),
         *_overlap(data),
         _smallest_edge(data),
         _smallest_face_angle(data),
+        _holes(data),
     ]
     return Certificate(checks=checks, size=data.size, coord_quantum=data.q)
 
@@ -600,6 +610,135 @@ def _on_cylinders(g: _Data) -> Check:
     worst = {"pattern_vertex": v, "mesh_edge": me}
     ok = bool(err[k] <= CYLINDER_TOL)
     return Check(name, ok, float(err[k]), CYLINDER_TOL, detail, "<=", worst)
+
+
+def _on_fillets(g: _Data) -> Check:
+    """Every corner of a ``fillet e`` face on the cone from the edge's sharp end (the end
+    without an apex) over the edge's base circle: the ruling through it meets the midpoint
+    cross-section at the radius ``r`` from the axis."""
+    name = "on fillets"
+    c = np.flatnonzero(g.kind[g.face_of] == _FILLET)
+    if not len(c):
+        return Check(name, True, float("nan"), CYLINDER_TOL, "no conical fillet in the design")
+    e = g.index[g.face_of[c]]
+    ends = g.edge_vertices[e]
+    bare = np.isnan(g.apex[ends]).any(axis=2)  # (k, 2): the end without an apex
+    one = bare.sum(axis=1) == 1
+    S = g.mv[np.where(bare[:, 0], ends[:, 0], ends[:, 1])]
+    P = g.v3[g.flat[c]]
+    t = g.axis_dir[e]
+    M = 0.5 * (g.mv[ends[:, 0]] + g.mv[ends[:, 1]])
+    d = P - S
+    along = np.einsum("ij,ij->i", d, t)
+    at_apex = np.linalg.norm(d, axis=1) <= CYLINDER_TOL * g.size
+    with np.errstate(invalid="ignore", divide="ignore"):
+        X = S + (np.einsum("ij,ij->i", M - S, t) / along)[:, None] * d
+        w = X - g.axis_point[e]
+        radial = w - np.einsum("ij,ij->i", w, t)[:, None] * t
+        err = np.abs(np.linalg.norm(radial, axis=1) - g.radius[e]) / g.size
+    err = np.where(at_apex, 0.0, err)
+    err = np.where(g.rounded[e] & one & np.isfinite(err), err, np.inf)
+    k = int(np.argmax(err))
+    v, me = int(g.flat[c[k]]), int(e[k])
+    detail = (
+        f"{_distinct(g.flat[c])} points of {_distinct(e)} fillets; worst pattern vertex {v} "
+        f"(fillet {me}); |distance of its ruling's base point - r| / size {CYLINDER_TOL:g}"
+    )
+    if not one.all():
+        detail += f"; fillet {int(e[~one][0])} has not exactly one end without an apex"
+    worst = {"pattern_vertex": v, "mesh_edge": me}
+    ok = bool(err[k] <= CYLINDER_TOL)
+    return Check(name, ok, float(err[k]), CYLINDER_TOL, detail, "<=", worst)
+
+
+def _borders(points: np.ndarray, flat: np.ndarray, nxt: np.ndarray, eps: float):
+    """The border of a polygon surface whose corners are ``points[flat]`` (corners within
+    ``eps`` of each other are one vertex; ``eps < 0``: the points as given, so that a mesh's
+    vertices split apart at a non-manifold point stay apart): its edges used by one face, as
+    pairs of point indices, and the number of loops they form."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    n = len(points)
+    pairs = (
+        cKDTree(points).query_pairs(eps, output_type="ndarray")
+        if eps >= 0
+        else np.zeros((0, 2), dtype=np.int64)
+    )
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    n_root, root = connected_components(graph, directed=False)
+    root = root.astype(np.int64)  # int32 labels: lo * n below would overflow
+    first = np.zeros(n_root, dtype=np.int64)  # a point of each vertex: its first
+    first[root[::-1]] = np.arange(n)[::-1]
+    a, b = root[flat], root[flat[nxt]]
+    keep = a != b
+    lo, hi = np.minimum(a, b)[keep], np.maximum(a, b)[keep]
+    key, count = np.unique(lo * n + hi, return_counts=True)
+    border = key[count == 1]
+    if not len(border):
+        return np.zeros((0, 2), dtype=np.int64), 0
+    u, w = border // n, border % n
+    nodes, inv = np.unique(np.concatenate([u, w]), return_inverse=True)
+    m = len(nodes)
+    g = coo_matrix((np.ones(len(u)), (inv[: len(u)], inv[len(u) :])), shape=(m, m))
+    # loops: the cycle rank E - V + C of the border (two loops that touch at a point, as the
+    # boxes of a mesh split apart at a non-manifold vertex do, count as two)
+    loops = len(u) - m + int(connected_components(g, directed=False)[0])
+    return np.stack([first[u], first[w]], axis=1), loops
+
+
+def _distance_to_segments(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k,) distance of every point ``p`` (k, 3) to the nearest of the segments ``a b``."""
+    d = b - a
+    length2 = np.maximum(np.einsum("ij,ij->i", d, d), np.finfo(float).tiny)
+    best = np.full(len(p), np.inf)
+    for lo in range(0, len(a), 256):  # segments in blocks: (k, 256) at a time
+        aa, dd, ll = a[lo : lo + 256], d[lo : lo + 256], length2[lo : lo + 256]
+        t = np.clip(np.einsum("kij,ij->ki", p[:, None] - aa[None], dd) / ll, 0.0, 1.0)
+        q = aa[None] + t[..., None] * dd[None]
+        best = np.minimum(best, np.linalg.norm(p[:, None] - q, axis=2).min(axis=1))
+    return best
+
+
+def _holes(g: _Data) -> Check:
+    """Holes and notches of the folded surface (the pattern's faces glued where their 3D
+    corners coincide). Its border edges that do not run along a boundary edge of the mesh
+    form closed loops (holes: at vertices without a cone that were not kept sharp,
+    ``--sharp``) or arcs from the mesh's border back to it (notches: at boundary vertices not
+    kept sharp). Reported with the deepest notch / size, not limited."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    eps = 1e-9 * g.size
+    border, _ = _borders(g.v3, g.flat, g.nxt, eps)
+    mesh_border, _ = _borders(g.mv, g.mesh_flat, g.mesh_nxt, -1.0)
+    on = np.zeros(len(border), dtype=bool)
+    depth = 0.0
+    if len(mesh_border) and len(border):
+        a, b = g.mv[mesh_border[:, 0]], g.mv[mesh_border[:, 1]]
+        ends = np.unique(border)
+        far = _distance_to_segments(g.v3[ends], a, b)
+        mid = _distance_to_segments(0.5 * (g.v3[border[:, 0]] + g.v3[border[:, 1]]), a, b)
+        d0, d1 = far[np.searchsorted(ends, border[:, 0])], far[np.searchsorted(ends, border[:, 1])]
+        on = (d0 <= eps) & (d1 <= eps) & (mid <= eps)
+        depth = float(np.max(np.maximum(d0, d1), initial=0.0)) / g.size
+    off = border[~on]
+    holes = notches = 0
+    if len(off):
+        nodes, inv = np.unique(off, return_inverse=True)
+        inv = inv.reshape(-1, 2)
+        m = len(nodes)
+        graph = coo_matrix((np.ones(len(off)), (inv[:, 0], inv[:, 1])), shape=(m, m))
+        n_comp, comp = connected_components(graph, directed=False)
+        degree = np.bincount(inv.ravel(), minlength=m)
+        open_comp = np.zeros(n_comp, dtype=bool)
+        open_comp[comp[degree != 2]] = True
+        holes, notches = int((~open_comp).sum()), int(open_comp.sum())
+    detail = f"{holes} holes and {notches} notches in the folded surface's border"
+    if len(mesh_border):
+        detail += f"; deepest notch of the border / size {depth:.3g}"
+    return Check("holes", True, float(holes), None, detail, "", {})
 
 
 def _face_newell(g: _Data) -> tuple[np.ndarray, np.ndarray]:

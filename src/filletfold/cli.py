@@ -33,7 +33,13 @@ from rich.console import Console
 from rich.markup import escape
 
 from . import __version__
-from .defaults import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES
+from .defaults import (
+    DEFAULT_ARC_STEP,
+    DEFAULT_DEPTH,
+    DEFAULT_RADIUS,
+    DEFAULT_SAMPLES,
+    DEFAULT_SHARP,
+)
 from .errors import FilletfoldError, InternalError, one_line
 from .tolerances import tol
 
@@ -206,6 +212,17 @@ def round_cmd(
             show_default=False,
         ),
     ] = None,
+    sharp: Annotated[
+        str,
+        typer.Option(
+            "--sharp",
+            help="Which vertices without a cone keep their corner instead of a hole: none, "
+            "all, or a comma-separated list of saddle, infeasible, boundary. Their edges to "
+            "cones taper into them (conical fillets). Default: all, less boundary with "
+            "--material-loss (so the sheet stays one piece).",
+            show_default=False,
+        ),
+    ] = DEFAULT_SHARP,
     strict: Annotated[
         bool,
         typer.Option(
@@ -308,6 +325,7 @@ def round_cmd(
                 clamp=clamp,
                 fit_vertices=fit_vertices,
                 strict=strict,
+                sharp=sharp,
                 material_loss=material_loss,
                 max_loss=max_loss,
                 layout=layout,

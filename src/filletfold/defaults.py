@@ -6,3 +6,6 @@ DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
 DEFAULT_ARC_STEP = 1.5  # degrees: see round_mesh(arc_step=...)
+#: Which cone-less vertices keep their corner (see round_mesh(sharp=...)): "auto" is every
+#: kind (saddle, infeasible, boundary), less boundary with material loss.
+DEFAULT_SHARP = "auto"

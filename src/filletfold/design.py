@@ -15,7 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .defaults import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES
+from .defaults import (
+    DEFAULT_ARC_STEP,
+    DEFAULT_DEPTH,
+    DEFAULT_RADIUS,
+    DEFAULT_SAMPLES,
+    DEFAULT_SHARP,
+)
 from .errors import (
     FilletfoldError,
     InternalError,
@@ -40,6 +46,13 @@ from .surface.module import build_modules
 from .surface.pattern import CreasePattern
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
+from .vertex.sharpen import (
+    SHARP_KINDS,
+    parse_sharp,
+    set_treatments,
+    sharp_kind,
+    sharpen_vertices,
+)
 from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
 
 
@@ -114,6 +127,8 @@ class Parameters:
         Layout asked for.
     coplanar_deg : float
         Neighbouring faces closer than this angle are merged on input.
+    sharp : str
+        The kinds of cone-less vertices kept sharp, comma-separated (``"none"``: holes).
     """
 
     radius: object = DEFAULT_RADIUS
@@ -127,6 +142,7 @@ class Parameters:
     coplanar_deg: float = tol.coplanar_deg
     fit_vertices: bool = True
     strict: bool = False
+    sharp: str = "saddle,infeasible,boundary"
 
     def as_dict(self) -> dict:
         def plain(x):
@@ -144,6 +160,7 @@ class Parameters:
             "coplanar_deg": self.coplanar_deg,
             "fit_vertices": self.fit_vertices,
             "strict": self.strict,
+            "sharp": self.sharp,
         }
 
 
@@ -397,6 +414,7 @@ def round_mesh(
     strict: bool = False,
     fit_vertices: bool | None = None,
     certify: bool = True,
+    sharp: str | None = DEFAULT_SHARP,
 ) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
@@ -463,6 +481,14 @@ def round_mesh(
         keep them where that makes its cone feasible (:mod:`filletfold.vertex.rescue`); off,
         the radius that would work is only given in its reason. Default: on, off with
         ``strict``.
+    sharp : str or sequence of str
+        Which vertices without a cone keep their corner instead of a hole
+        (:mod:`filletfold.vertex.sharpen`): ``"none"``, ``"all"`` or a comma-separated list of
+        ``saddle``, ``infeasible`` (a developable vertex that does not close counts as
+        infeasible) and ``boundary``. Their edges to vertices with a cone become conical
+        fillets, those between two of them straight creases. ``"auto"`` (the default): all
+        three, except ``boundary`` with ``material_loss`` (a conical fillet would open the
+        neighbour's closed development, and the sheet would no longer be one piece).
     certify : bool
         Measure the design's invariants (:func:`filletfold.check.certify_design`) into
         ``design.certificate`` (about 5 % of the time; the browser app skips it).
@@ -495,6 +521,11 @@ def round_mesh(
     clamp = (not strict) if clamp is None else bool(clamp)
     fit_vertices = (not strict) if fit_vertices is None else bool(fit_vertices)
     floor = 0.0 if strict else tol.fillet_floor
+    if sharp == "auto":
+        kinds = set(SHARP_KINDS) - ({"boundary"} if material_loss else set())
+    else:
+        kinds = parse_sharp(sharp)
+    sharp_spec = ",".join(k for k in SHARP_KINDS if k in kinds) or "none"
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
     pm, clean_log = load_mesh(mesh, coplanar_deg=coplanar_deg, strict=strict)
     shift = far_offset(pm.vertices)
@@ -513,14 +544,21 @@ def round_mesh(
         coplanar_deg=coplanar_deg,
         fit_vertices=fit_vertices,
         strict=strict,
+        sharp=sharp_spec,
     )
     ref = pm.mean_edge_length
     size = mesh_size(pm)
     min_width = 0.0 if strict else tol.min_fillet * size
 
-    key = _stage_key(pm, radius, clamp, material_loss, max_loss, coplanar_deg)
+    key = _stage_key(pm, radius, clamp, material_loss, max_loss, coplanar_deg, sharp_spec)
     st = reuse.stages if reuse is not None and reuse.stages is not None else None
     if st is not None and st.key != key:
+        st = None
+    if (
+        st is not None
+        and any(f.sharp for f in st.frames)
+        and not np.array_equal(st.depths, _resolve_depth(depth, ref, pm.n_vertices))
+    ):  # a new depth may give a sharp vertex its cone: the sharp vertices are chosen again
         st = None
 
     t = time.perf_counter()
@@ -566,6 +604,7 @@ def round_mesh(
         coplanar_deg=coplanar_deg,
         floor=floor,
         min_width=min_width,
+        sharp_kinds=kinds,
     )
     timings["apices"] = time.perf_counter() - t
 
@@ -675,10 +714,13 @@ def _apices(
     coplanar_deg,
     floor,
     min_width,
+    sharp_kinds=frozenset(),
 ):
     """The apex stage of :func:`round_mesh`: every pending vertex's apex (those of a reused
     design's vertices whose depth did not change are kept), then the rescue of the infeasible
-    ones. Returns the frames, classification, rounding and face-piece centres afterwards (the
+    ones, then the cone-less vertices of ``sharp_kinds`` made sharp and their neighbours solved
+    again (:func:`~filletfold.vertex.sharpen.sharpen_vertices`).
+    Returns the frames, classification, rounding and face-piece centres afterwards (the
     rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
     kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
     pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
@@ -712,10 +754,33 @@ def _apices(
             vertices=pending,
         )
         kept -= rescue.resolved
+    if sharp_kinds and any(sharp_kind(s) in sharp_kinds for s in res.status):
+        frames = list(frames)
+        classified = copy.deepcopy(classified)
+        _stage("sharp vertices")
+        rounding, centres, sharpening = sharpen_vertices(
+            pm,
+            rounding,
+            frames,
+            res,
+            depths,
+            centres,
+            face_piece_centres,
+            apices,
+            sharp_kinds,
+            flat_deg=coplanar_deg,
+            floor=floor,
+            min_width=min_width,
+            size=size,
+            progress=progress,
+            classified=classified,
+        )
+        kept -= sharpening.resolved | set(np.flatnonzero(sharpening.sharp).tolist())
     solved = [
         st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
         for u, frame in enumerate(frames)
     ]
+    set_treatments(res, np.array([f.sharp for f in frames], dtype=bool))
     return frames, classified, rounding, centres, solved, kept, rescue
 
 

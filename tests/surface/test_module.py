@@ -33,7 +33,13 @@ def convex_design(seed: int, samples: int = 24, arc_step: float = 1.5) -> fillet
     m = filletfold.load_mesh(random_convex(seed))[0]
     radius = 0.5 * round_edges(m, 1e-3).uniform_limit
     return filletfold.round_mesh(
-        m, radius=radius, samples=samples, arc_step=arc_step, tabs=False, layout="modules"
+        m,
+        radius=radius,
+        samples=samples,
+        arc_step=arc_step,
+        tabs=False,
+        layout="modules",
+        sharp="none",
     )
 
 
@@ -72,13 +78,15 @@ def test_every_example_gives_the_modules_of_the_oracle(name):
     """Cones split into runs (blob), saddle holes (torus, saddle-patch), developable holes
     (miura, resch), open boundary rings, reflex corners (l-prism), creases through a corner T
     whose points merge (yoshimura)."""
-    d = design_of(name)
+    d = design_of(name, sharp="none")
     compare(d, d.stages.samples)
 
 
 @pytest.mark.parametrize(("samples", "arc_step"), [(24, 1.5), (24, 0.0), (3, 1.5), (3, 0.0)])
 def test_geodesic_sphere_and_random_convex(samples, arc_step):
-    designs = [design_of("geodesic-sphere:level=2", samples=samples, arc_step=arc_step)]
+    designs = [
+        design_of("geodesic-sphere:level=2", samples=samples, arc_step=arc_step, sharp="none")
+    ]
     designs += [convex_design(seed, samples, arc_step) for seed in range(4)]
     for d in designs:
         compare(d, d.stages.samples)
@@ -87,7 +95,7 @@ def test_geodesic_sphere_and_random_convex(samples, arc_step):
 @pytest.mark.parametrize("name", ["geodesic-sphere:level=2", "torus", "resch", "saddle-patch"])
 def test_uniform_sample_counts(name):
     """An int for all arcs, down to 2 points per arc (and 1: a single point on every arc)."""
-    d = design_of(name)
+    d = design_of(name, sharp="none")
     for n in (1, 2, 7):
         compare(d, n)
 
@@ -97,7 +105,7 @@ def test_uniform_sample_counts(name):
 def test_holes_open_rings_and_runs_at_other_radii(name, radius, depth):
     """Saddle and developable holes, open boundary rings, modules split into runs and the
     reflex corners of l-prism at other radii and depths."""
-    d = design_of(name, radius=radius, depth=depth)
+    d = design_of(name, radius=radius, depth=depth, sharp="none")
     compare(d, d.stages.samples)
 
 
@@ -107,12 +115,13 @@ def test_real_meshes_give_the_modules_of_the_oracle(name):
     points merge, fitted radii: what the examples do not have."""
     from pathlib import Path
 
-    d = filletfold.round_mesh(Path(__file__).parent.parent / "data" / "corpus" / name, tabs=False)
+    corpus = Path(__file__).parent.parent / "data" / "corpus"
+    d = filletfold.round_mesh(corpus / name, tabs=False, sharp="none")
     compare(d, d.stages.samples)
 
 
 def test_any_vertices_in_any_order():
-    d = design_of("house")
+    d = design_of("house", sharp="none")
     st = d.stages
     order = [7, 2, 9, 0, 2]
     frames = [st.solved[u][0] for u in order]
@@ -139,7 +148,7 @@ def test_any_vertices_in_any_order():
 def test_one_vertex_built_alone_is_the_same_as_in_the_batch():
     """build_module (a batch of one) gives a vertex the pieces it gets among all the others: a
     module does not depend on the vertices built beside it."""
-    d = design_of("blob")
+    d = design_of("blob", sharp="none")
     st = d.stages
     frames, apices, developed = (list(c) for c in zip(*st.solved, strict=True))
     together = build_modules(d.mesh, frames, st.centres, st.samples, apices, developed)
@@ -154,7 +163,7 @@ def test_one_vertex_built_alone_is_the_same_as_in_the_batch():
 def test_chunks(name, monkeypatch):
     """Vertices built in several chunks give the same modules."""
     monkeypatch.setattr(module, "CHUNK", 7)
-    d = design_of(name)
+    d = design_of(name, sharp="none")
     compare(d, d.stages.samples)
 
 
@@ -166,7 +175,7 @@ def test_overlapping_rings_are_split_without_the_union(monkeypatch):
         raise AssertionError("not expected here")
 
     for name in ("torus", "resch"):
-        d = design_of(name)
+        d = design_of(name, sharp="none")
         st = d.stages
         assert max(len(m) for m in st.modules) == 2
         want = [build_module(d.mesh, f, st.centres, st.samples, a, v) for f, a, v in st.solved]
@@ -213,7 +222,7 @@ def _square_pieces():
 def _module_pieces():
     """Pieces of real modules, and whole modules that overlap themselves."""
     for name in ("torus", "l-prism", "blob", "yoshimura"):
-        d = design_of(name)
+        d = design_of(name, sharp="none")
         for piece in d.pieces[:40]:
             yield piece.arrays()[0], piece.faces
         st = d.stages

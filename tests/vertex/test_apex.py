@@ -127,8 +127,9 @@ def _reference_refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1
 
 
 def _cases(name):
-    """Frames, centres and the solved (V, v, sigma) of every vertex with a cone."""
-    d = design_of(name)
+    """Frames, centres and the solved (V, v, sigma) of every vertex with a cone (with holes:
+    the reference has no conical fillets)."""
+    d = design_of(name, sharp="none")
     res = d.vertices
     us = [u for u in range(d.mesh.n_vertices) if res.status[u] == "ok"]
     frames = [d.stages.frames[u] for u in us]
@@ -231,7 +232,7 @@ def test_cuts_are_the_worst_points_and_a_retry_with_them_holds_there():
     from filletfold.vertex.batch import solve_apex_batch
     from filletfold.vertex.solve import ATTEMPTS, apex_problems
 
-    d = design_of("blob")
+    d = design_of("blob", sharp="none")
     probs = apex_problems(d.mesh, d.rounding, d.stages.depths)
     cons = [p.constraints(*ATTEMPTS[0]) for p in probs]
     sols = solve_apex_batch(cons, [p.target for p in probs], [p.starts for p in probs])

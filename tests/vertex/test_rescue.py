@@ -16,12 +16,12 @@ CONE = Path(__file__).resolve().parents[1] / "data" / "corpus" / "compas-cone.st
 
 @pytest.fixture(scope="module")
 def fitted():
-    return filletfold.round_mesh(CONE, tabs=False)
+    return filletfold.round_mesh(CONE, tabs=False, sharp="none")
 
 
 @pytest.fixture(scope="module")
 def hinted():
-    return filletfold.round_mesh(CONE, tabs=False, fit_vertices=False)
+    return filletfold.round_mesh(CONE, tabs=False, fit_vertices=False, sharp="none")
 
 
 def test_rescued_vertices_are_ok_with_their_edges_scaled_by_the_factor(fitted):

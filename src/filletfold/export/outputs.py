@@ -80,7 +80,9 @@ def report_records(design) -> dict:
         "uniform_radius_limit": _num(rd.uniform_limit),
         "status_counts": design.status_counts(),
         "mesh": {"vertices": mesh.vertices, "faces": list(mesh.faces)},
-        "edges": _edge_records(mesh, rd, design.fitting.get("radius_requested")),
+        "edges": _edge_records(
+            mesh, rd, design.fitting.get("radius_requested"), design.vertices.treatment
+        ),
         "vertices": _vertex_records(design.vertices),
         "pattern": {
             "pieces": int(pat.n_pieces),
@@ -148,8 +150,13 @@ def _not_finite(x: np.ndarray) -> np.ndarray:
     return bad.any(axis=1) if bad.ndim == 2 else bad
 
 
-def _edge_records(mesh, rd, design_requested=None) -> Records:
-    """The ``edges`` of the report: one record per mesh edge."""
+def _edge_records(mesh, rd, design_requested=None, treatment=None) -> Records:
+    """The ``edges`` of the report: one record per mesh edge (``treatment`` from the
+    vertices' treatments, :func:`~filletfold.vertex.sharpen.edge_treatments`)."""
+    from ..vertex.sharpen import edge_treatments
+
+    if treatment is None:
+        treatment = [""] * mesh.n_vertices
     boundary = (mesh.edge_faces < 0).any(axis=1)
     bent = rd.half_angle > 0
     loss_limit = np.full(mesh.n_edges, np.nan)  # None where not bent
@@ -169,6 +176,7 @@ def _edge_records(mesh, rd, design_requested=None) -> Records:
             ).tolist(),
             "half_angle": np.asarray(rd.half_angle, dtype=float),
             "assignment": np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist(),
+            "treatment": edge_treatments(mesh, rd, treatment),
             "arc_length": np.asarray(rd.arc_length, dtype=float),
             "strip_width": np.asarray(rd.strip_width, dtype=float),
             "material_loss": np.asarray(rd.loss, dtype=float),
@@ -194,6 +202,7 @@ def _vertex_records(res) -> Records:
     columns = {
         "kind": list(res.kind),
         "status": list(res.status),
+        "treatment": list(res.treatment),
         "reason": list(res.reason),
         "angle_sum": floats(res.angle_sum),
         "angle_defect": floats(res.defect),

@@ -59,6 +59,11 @@ class VertexResult:
         Apex position in the crease pattern layout.
     margin : (n,) float
         Smallest slack of the dense validation (length units).
+    treatment : list of str
+        What the surface does at the vertex: ``"cone"`` (status ``ok``), ``"sharp"`` (the
+        corner kept: made sharp by :mod:`filletfold.vertex.sharpen`, or every edge unrounded)
+        or ``"hole"`` (no cone and not kept sharp: a hole border, or a notch at a boundary
+        vertex); ``""`` until the apex stage has run.
     """
 
     kind: list
@@ -76,6 +81,11 @@ class VertexResult:
     apex_developed: np.ndarray
     apex_2d: np.ndarray
     margin: np.ndarray
+    treatment: list = None
+
+    def __post_init__(self):
+        if self.treatment is None:
+            self.treatment = [""] * len(self.kind)
 
     def take(self, other: VertexResult, vertices) -> None:
         """Copy every per-vertex field of ``other`` at ``vertices`` into this result."""
@@ -111,7 +121,12 @@ class VertexResult:
 
 
 def classify_vertices(
-    mesh: PolyMesh, rounding: EdgeRounding, res: VertexResult, vertices=None, start_edge=None
+    mesh: PolyMesh,
+    rounding: EdgeRounding,
+    res: VertexResult,
+    vertices=None,
+    start_edge=None,
+    sharp=None,
 ) -> list[VertexFrame]:
     """Build the vertices' frames, classify them and find their normals (sec. 2.5, 3.1).
 
@@ -130,6 +145,9 @@ def classify_vertices(
     start_edge : sequence of (int or None), optional
         Per listed vertex, the incident edge along which its module is cut (see
         :func:`~filletfold.vertex.frame.vertex_frames`).
+    sharp : (n_vertices,) bool, optional
+        Sharp vertices: their neighbours' sides toward them are conical fillets
+        (:func:`~filletfold.vertex.frame.vertex_frames`).
 
     Returns
     -------
@@ -141,7 +159,7 @@ def classify_vertices(
     vertices = [int(u) for u in vertices]
     if start_edge is None:
         start_edge = [None] * len(vertices)
-    frames = vertex_frames(mesh, rounding, vertices, start_edge)
+    frames = vertex_frames(mesh, rounding, vertices, start_edge, sharp=sharp)
     closed = [k for k, f in enumerate(frames) if f.ring.closed]
     verts = np.array(vertices, dtype=np.int64)
     res.angle_sum[verts] = mesh.vertex_angle_sum[verts]

@@ -1,0 +1,237 @@
+"""Sharp vertices: the vertices that take no cone keep their corner instead of a hole.
+
+After the apices (and the rescue), every vertex without a cone whose kind is asked for
+(:data:`SHARP_KINDS`: ``saddle``, ``infeasible`` (``developable`` counts as infeasible),
+``boundary``) becomes *sharp* (``docs/method.md``, "Sharp vertices and conical fillets"):
+
+- an edge between two sharp vertices is left unrounded (radius 0: a straight crease folded by
+  the dihedral angle);
+- the other rounded edges of a sharp vertex become conical fillets with their apex at it, so
+  every neighbour that has a cone is solved again with those sides conical
+  (:func:`~filletfold.vertex.frame.vertex_frames` with ``sharp``);
+- a neighbour that then finds no apex is infeasible: when ``infeasible`` is asked for it
+  becomes sharp in the next round, and so on until no vertex changes.
+
+:func:`sharpen_vertices` runs these rounds on the vertex stage's state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..mesh.polymesh import PolyMesh
+from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
+from .solve import VertexResult, classify_vertices, solve_apices
+
+#: The kinds of cone-less vertices that ``--sharp`` can make sharp, in the order they are
+#: named.
+SHARP_KINDS = ("saddle", "infeasible", "boundary")
+
+#: Rounds of :func:`sharpen_vertices` at most (each makes the newly infeasible neighbours of
+#: the last round's sharp vertices sharp).
+MAX_ROUNDS = 8
+
+
+def parse_sharp(spec) -> frozenset:
+    """The kinds named by ``spec``: ``"none"``, ``"all"``, or a comma-separated subset of
+    :data:`SHARP_KINDS` (a sequence of names works too).
+
+    Raises
+    ------
+    ParameterError
+        For a name that is not a kind.
+    """
+    if spec is None:
+        return frozenset(SHARP_KINDS)
+    names = spec.split(",") if isinstance(spec, str) else list(spec)
+    names = [str(n).strip().lower() for n in names if str(n).strip()]
+    if names in (["none"], []):
+        return frozenset()
+    if names == ["all"]:
+        return frozenset(SHARP_KINDS)
+    bad = [n for n in names if n not in SHARP_KINDS]
+    if bad:
+        raise ParameterError(
+            f"--sharp: unknown kind {bad[0]!r}; use none, all or a comma-separated list of "
+            + ", ".join(SHARP_KINDS)
+        )
+    return frozenset(names)
+
+
+def set_treatments(res: VertexResult, sharp: np.ndarray | None) -> None:
+    """Fill ``res.treatment``: ``cone`` where ``ok``, ``sharp`` at the ``sharp`` vertices and
+    at those whose edges are all unrounded (status ``sharp``), ``hole`` elsewhere."""
+    for u, st in enumerate(res.status):
+        if st == "ok":
+            res.treatment[u] = "cone"
+        elif st == "sharp" or (sharp is not None and sharp[u]):
+            res.treatment[u] = "sharp"
+        else:
+            res.treatment[u] = "hole"
+
+
+def edge_treatments(mesh: PolyMesh, rounding: EdgeRounding, treatment) -> list:
+    """Per mesh edge: ``cylinder`` (rounded, no sharp end), ``cone`` (rounded, a conical
+    fillet from its sharp end), ``sharp`` (bent but unrounded: a straight crease), ``flat``
+    (between coplanar faces) or ``boundary``."""
+    sharp = np.array([t == "sharp" for t in treatment], dtype=bool)
+    ends = mesh.edges
+    tapered = sharp[ends[:, 0]] | sharp[ends[:, 1]]
+    boundary = (mesh.edge_faces < 0).any(axis=1)
+    rounded = rounding.radius > 0
+    bent = rounding.half_angle > 0
+    out = np.where(
+        boundary,
+        "boundary",
+        np.where(rounded, np.where(tapered, "cone", "cylinder"), np.where(bent, "sharp", "flat")),
+    )
+    return out.tolist()
+
+
+def sharp_kind(status: str) -> str | None:
+    """The :data:`SHARP_KINDS` entry of a vertex without a cone, from its status (None for a
+    vertex with a cone, ``ok``, or one whose edges are all unrounded, ``sharp``: its faces
+    meet at the vertex already)."""
+    if status in ("saddle", "boundary", "infeasible"):
+        return status
+    if status == "developable":
+        return "infeasible"
+    return None
+
+
+@dataclass
+class Sharpening:
+    """What :func:`sharpen_vertices` did.
+
+    Attributes
+    ----------
+    sharp : (n_vertices,) bool
+        The sharp vertices.
+    resolved : set of int
+        The vertices solved again (the neighbours of sharp vertices).
+    rounds : int
+    """
+
+    sharp: np.ndarray
+    resolved: set = field(default_factory=set)
+    rounds: int = 0
+
+
+def sharpen_vertices(
+    mesh: PolyMesh,
+    rounding: EdgeRounding,
+    frames: list,
+    res: VertexResult,
+    depths: np.ndarray,
+    centres: np.ndarray,
+    face_centres,
+    apices: dict,
+    kinds,
+    *,
+    flat_deg: float,
+    floor: float,
+    min_width: float,
+    size: float | None = None,
+    progress=None,
+    classified: VertexResult | None = None,
+) -> tuple[EdgeRounding, np.ndarray, Sharpening]:
+    """Make the cone-less vertices of ``kinds`` sharp and solve their neighbours again.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+    frames : list of VertexFrame
+        By vertex; the frames of the sharp vertices and of the vertices solved again are
+        replaced in place.
+    res : VertexResult
+        Updated in place (statuses and apices of the vertices solved again).
+    depths : (n_vertices,) float
+    centres : (n_faces, 3) float
+        Face piece centres.
+    face_centres : callable
+        ``face_centres(mesh, rounding)``: the centres again for a new rounding.
+    apices : dict
+        ``vertex -> (apex, developed apex)``, updated in place.
+    kinds : iterable of str
+        Of :data:`SHARP_KINDS`.
+    flat_deg, floor, min_width : float
+        Passed to :func:`~filletfold.rounding.edges.round_edges`.
+    size : float, optional
+        Passed to :func:`~filletfold.vertex.solve.solve_apices`.
+    progress : callable, optional
+    classified : VertexResult, optional
+        The classification before the apices (for a later ``reuse``): updated alike.
+
+    Returns
+    -------
+    rounding : EdgeRounding
+    centres : (n_faces, 3) float
+    Sharpening
+    """
+    kinds = frozenset(kinds)
+    n = mesh.n_vertices
+    sharp = np.zeros(n, dtype=bool)
+    out = Sharpening(sharp)
+    if not kinds:
+        return rounding, centres, out
+    ends = mesh.edges
+    for _ in range(MAX_ROUNDS):
+        new = np.array(
+            [u for u in range(n) if not sharp[u] and sharp_kind(res.status[u]) in kinds],
+            dtype=np.int64,
+        )
+        if not len(new):
+            break
+        out.rounds += 1
+        sharp[new] = True
+        changed = np.zeros(mesh.n_edges, dtype=bool)
+        both = sharp[ends[:, 0]] & sharp[ends[:, 1]] & (rounding.radius > 0)
+        if both.any():  # a straight crease between two sharp vertices
+            radius = rounding.radius.copy()
+            radius[both] = 0.0
+            radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
+            rounding = round_edges(
+                mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width
+            )
+            centres = face_centres(mesh, rounding)
+            changed = both
+        # the vertices whose sides changed: neighbours of the new sharp vertices, and every
+        # vertex of a face whose piece (and centre) changed with an unrounded edge
+        near = np.zeros(n, dtype=bool)
+        at_new = np.isin(ends, new).any(axis=1)
+        near[ends[at_new].ravel()] = True
+        if changed.any():
+            faces = np.unique(mesh.edge_faces[changed])
+            faces = faces[faces >= 0]
+            if len(faces):
+                near[np.concatenate([mesh.faces[f] for f in faces.tolist()])] = True
+        again = np.flatnonzero(near & ~sharp)
+        rebuilt = np.flatnonzero(near | sharp)
+        fresh = VertexResult.empty(n)
+        res.take(fresh, again)
+        status = {
+            int(u): (res.status[u], res.kind[u], res.reason[u]) for u in np.flatnonzero(sharp)
+        }
+        new_frames = classify_vertices(mesh, rounding, res, rebuilt, sharp=sharp)
+        for u, (st, kind, reason) in status.items():  # a sharp vertex keeps why it is sharp
+            res.status[u], res.kind[u], res.reason[u] = st, kind, reason
+        if classified is not None:
+            classified.take(res, rebuilt)
+        for u, f in zip(rebuilt.tolist(), new_frames, strict=True):
+            frames[u] = f
+        todo = [int(u) for u in again if res.status[u] == ""]
+        for u in np.flatnonzero(sharp).tolist():
+            apices.pop(u, None)
+        if todo:
+            solved = solve_apices(
+                {u: frames[u] for u in todo}, depths, res, centres, progress, todo, size=size
+            )
+            apices.update(solved)
+        out.resolved.update(int(u) for u in again)
+    for u in np.flatnonzero(sharp).tolist():
+        res.reason[u] = (res.reason[u] or "no cone") + "; kept sharp (its corner, no hole)"
+    return rounding, centres, out
