@@ -247,6 +247,16 @@ def test_triangulate_faces_is_triangulate_polygon_face_by_face(as_arrays):
     assert np.array_equal(owner, np.repeat(np.arange(len(faces)), np.maximum(sizes - 2, 0)))
 
 
+def test_triangulate_faces_reads_a_patterns_flat_faces_as_their_list():
+    """A pattern's faces (flat arrays, read without an array per face) give the triangles and
+    owners of the same faces as a list."""
+    pattern = design_of("resch").pattern
+    tris, owner = triangulate_faces(pattern.vertices_2d, pattern.faces)
+    want_tris, want_owner = triangulate_faces(pattern.vertices_2d, list(pattern.faces))
+    assert np.array_equal(tris, want_tris) and np.array_equal(owner, want_owner)
+    assert tris.dtype == np.int64 and len(owner) == len(tris)
+
+
 def test_scene_meshes_number_their_points_in_order():
     """Each patch kind's mesh holds the points its triangles use, in increasing order
     (numpy.unique's numbering)."""
