@@ -8,6 +8,7 @@ import pytest
 
 import filletfold
 import filletfold.design as design_module
+from filletfold.mesh import example_mesh
 
 
 @pytest.fixture
@@ -94,3 +95,45 @@ def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
     gc.collect()
     assert refs[0]() is not None  # held by kept.stages
     assert refs[1]() is None
+
+
+@pytest.fixture
+def cleanings(monkeypatch):
+    """Count the calls of ``load_mesh`` (which cleans the mesh) made by ``round_mesh``."""
+    calls = []
+    original = design_module.load_mesh
+
+    def spy(*args, **kwargs):
+        calls.append(args[0])
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(design_module, "load_mesh", spy)
+    return calls
+
+
+@pytest.mark.parametrize("shift", [0.0, 1e6])  # 1e6: computed about the centre (far_offset)
+def test_the_same_polymesh_is_cleaned_once(cleanings, shift):
+    """A new radius on the same PolyMesh (what the app does) takes the cleaned mesh over and
+    gives the design a fresh call gives, array for array; a different mesh or coplanar
+    tolerance is cleaned again."""
+    vertices, faces = example_mesh("house")
+    mesh = filletfold.PolyMesh(np.asarray(vertices) + shift, faces)
+    first = filletfold.round_mesh(mesh, radius="10%", tabs=False)
+    again = filletfold.round_mesh(mesh, radius="12%", tabs=False, reuse=first)
+    assert len(cleanings) == 1
+    assert again.stages.cleaned[1] is first.stages.cleaned[1]
+    fresh = filletfold.round_mesh(mesh, radius="12%", tabs=False)
+    assert len(cleanings) == 2
+    same_design(again, fresh)
+    np.testing.assert_array_equal(again.mesh.vertices, fresh.mesh.vertices)
+    assert again.repairs == fresh.repairs
+    copy = filletfold.PolyMesh(mesh.vertices.copy(), mesh.faces)  # equal arrays: taken over
+    filletfold.round_mesh(copy, radius="10%", tabs=False, reuse=again)
+    assert len(cleanings) == 2
+    moved = filletfold.PolyMesh(mesh.vertices * 1.01, mesh.faces)
+    same_design(
+        filletfold.round_mesh(moved, tabs=False, reuse=first),
+        filletfold.round_mesh(moved, tabs=False),
+    )
+    filletfold.round_mesh(mesh, tabs=False, coplanar_deg=2.0, reuse=first)
+    assert len(cleanings) == 5

@@ -197,6 +197,10 @@ class Stages:
         Points on each edge's arc (:meth:`~filletfold.rounding.edges.EdgeRounding.arc_points`).
     modules : list of list of Piece
         Each vertex's module pieces, before the layout.
+    cleaned : tuple or None
+        ``(input key, cleaned mesh, clean log, shift)`` of a :class:`PolyMesh` input (see
+        :func:`_input_key`): a later call on the same input takes the cleaned mesh over instead
+        of cleaning it again (None for other inputs: a file may change between calls).
     """
 
     key: tuple
@@ -212,6 +216,16 @@ class Stages:
     solved: list
     samples: np.ndarray
     modules: list
+    cleaned: tuple | None = None
+
+
+def _input_key(mesh, coplanar_deg, strict) -> tuple | None:
+    """Hashable identity of a :func:`round_mesh` input and the options its cleaning depends
+    on, for a :class:`PolyMesh` (its vertices and faces by their bytes); None otherwise."""
+    if not isinstance(mesh, PolyMesh):
+        return None
+    faces = (mesh.face_start.astype(np.int64), mesh.halfedge_from.astype(np.int64))
+    return (mesh.vertices.tobytes(), *(f.tobytes() for f in faces), repr(coplanar_deg), strict)
 
 
 def _stage_key(pm: PolyMesh, *params) -> tuple:
@@ -471,7 +485,9 @@ def round_mesh(
     reuse : Design, optional
         An earlier design of the same mesh: when the rounding parameters are the same, its
         rounding, frames and normals are taken over and only the vertices whose depth changed
-        are re-solved and rebuilt (see :class:`Stages`); the result is the same as without.
+        are re-solved and rebuilt (see :class:`Stages`); when ``mesh`` is a :class:`PolyMesh`
+        equal to the earlier one (same coplanar tolerance and ``strict``), its cleaned mesh is
+        taken over whatever the other parameters. The result is the same as without.
     strict : bool
         Refuse instead of repairing: a defect of the mesh raises the :class:`MeshError` that
         names it (see :func:`~filletfold.mesh.clean.clean_mesh`), and ``clamp`` and
@@ -527,10 +543,15 @@ def round_mesh(
         kinds = parse_sharp(sharp)
     sharp_spec = ",".join(k for k in SHARP_KINDS if k in kinds) or "none"
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
-    pm, clean_log = load_mesh(mesh, coplanar_deg=coplanar_deg, strict=strict)
-    shift = far_offset(pm.vertices)
-    if shift is not None:  # far from the origin: compute about the centre, shift back at the end
-        pm = PolyMesh(pm.vertices - shift, pm.faces)
+    input_key = _input_key(mesh, coplanar_deg, strict)
+    cleaned = reuse.stages.cleaned if reuse is not None and reuse.stages is not None else None
+    if input_key is not None and cleaned is not None and cleaned[0] == input_key:
+        _, pm, clean_log, shift = cleaned  # the same input, cleaned the same way: take it over
+    else:
+        pm, clean_log = load_mesh(mesh, coplanar_deg=coplanar_deg, strict=strict)
+        shift = far_offset(pm.vertices)
+        if shift is not None:  # far from the origin: compute about the centre, shift back later
+            pm = PolyMesh(pm.vertices - shift, pm.faces)
     timings["read"] = time.perf_counter() - t0
     params = Parameters(
         radius=radius,
@@ -636,6 +657,7 @@ def round_mesh(
             solved=solved,
             samples=points,
             modules=modules,
+            cleaned=None if input_key is None else (input_key, pm, clean_log, shift),
         )
     )
     pieces = [piece for module in modules for piece in module]

@@ -247,6 +247,16 @@ def test_triangulate_faces_is_triangulate_polygon_face_by_face(as_arrays):
     assert np.array_equal(owner, np.repeat(np.arange(len(faces)), np.maximum(sizes - 2, 0)))
 
 
+def test_triangulate_faces_reads_a_patterns_flat_faces_as_their_list():
+    """A pattern's faces (flat arrays, read without an array per face) give the triangles and
+    owners of the same faces as a list."""
+    pattern = design_of("resch").pattern
+    tris, owner = triangulate_faces(pattern.vertices_2d, pattern.faces)
+    want_tris, want_owner = triangulate_faces(pattern.vertices_2d, list(pattern.faces))
+    assert np.array_equal(tris, want_tris) and np.array_equal(owner, want_owner)
+    assert tris.dtype == np.int64 and len(owner) == len(tris)
+
+
 def test_scene_meshes_number_their_points_in_order():
     """Each patch kind's mesh holds the points its triangles use, in increasing order
     (numpy.unique's numbering)."""
@@ -446,6 +456,49 @@ def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(mo
         assert set(app.timings) == {"compute", "draw"}
     finally:
         release.set()
+        app.stop()
+
+
+def test_a_redraw_updates_the_scene_nodes_it_made_first():
+    """The first draw makes the scene nodes; a new design only gives them new arrays (the
+    same handles), those of the new design's scene arrays; kinds a design lacks are hidden,
+    and the pattern's nodes follow the "show pattern" box."""
+    pytest.importorskip("viser")
+    from filletfold.app import run_app
+
+    app = run_app("cube", host="127.0.0.1", port=_free_port())
+    try:
+        assert app.wait_drawn(1)
+        nodes = dict(app._nodes)
+        app._radius.value = 15.0
+        assert app.wait_idle(60) and app.session.design.params.radius == "15.0%"
+        assert app._nodes == nodes and all(app._nodes[k] is v for k, v in nodes.items())
+        arrays = scene_arrays(app.session.design)
+        for root, parts in (("/folded", arrays.folded), ("/pattern", arrays.flat)):
+            for kind, (v, f) in parts.items():
+                node = app._nodes[f"{root}/{kind}"]
+                assert np.array_equal(node.vertices, v.astype(np.float32))
+                assert np.array_equal(node.faces, f) and node.visible
+        for a, points in arrays.flat_creases.items():  # the cube has no valley creases
+            node = app._nodes[f"/pattern/crease_{a}"]
+            assert node.visible == (len(points) > 0)
+            if len(points):
+                assert np.array_equal(node.points, points.astype(np.float32))
+        assert np.array_equal(app._nodes["/folded/vertices"].colors, arrays.vertex_colors)
+        assert "radius 15.0%" in app.status
+
+        app.request_load("saddle-patch")  # no cones, no mountain or valley creases
+        assert app.wait_idle(60) and app.session.name == "saddle-patch"
+        assert app._nodes == nodes
+        arrays = scene_arrays(app.session.design)
+        visible = {name for name, node in app._nodes.items() if node.visible}
+        want = {f"{root}/{kind}" for root in ("/folded", "/pattern") for kind in arrays.folded}
+        want |= {f"/pattern/crease_{a}" for a, p in arrays.flat_creases.items() if len(p)}
+        want |= {f"/folded/crease_{a}" for a, p in arrays.folded_creases.items() if len(p)}
+        assert visible == want | {"/folded/vertices"} and "/folded/cone" not in visible
+        app._show_pattern.value = False
+        assert not any(app._nodes[name].visible for name in want if name.startswith("/pattern"))
+    finally:
         app.stop()
 
 

@@ -94,6 +94,9 @@ class AppServer:
         self.drawn_id = 0
         self._drawn = threading.Condition()
         self.timings: dict[str, float] = {}
+        self._nodes: dict = {}  # scene nodes by name, made by the first draw
+        self._clickable: set = set()  # folded nodes that select a vertex on a click
+        self._vertex_points = None  # the drawn vertex markers, for clicks
         self._build_gui()
         self._worker = threading.Thread(target=self._work, name="filletfold-app", daemon=True)
         self._worker.start()
@@ -357,73 +360,116 @@ class AppServer:
         percent = float(override[:-1]) if isinstance(override, str) and override[-1:] == "%" else 0
         self._vertex_depth.value = percent
 
+    def _node(self, name: str, add, *args, update: dict, **kwargs):
+        """The scene node ``name``: ``add(name, *args, **kwargs)`` the first time, later only
+        given the props ``update`` (viser sends the ones that changed). Updating a node instead
+        of adding it again spares the page a new three.js object and material per node."""
+        node = self._nodes.get(name)
+        if node is None:
+            node = self._nodes[name] = add(name, *args, **kwargs)
+        else:
+            for prop, value in update.items():
+                setattr(node, prop, value)
+        return node
+
+    def _clicked(self, event) -> None:
+        """A click on the folded surface selects the vertex nearest to the ray."""
+        points = self._vertex_points
+        if points is None:
+            return
+        u = nearest_vertex_to_ray(points, event.ray_origin, event.ray_direction)
+        if u >= 0:
+            self._vertex.value = u
+            self._select(u)
+
+    def _update_scene(self, arrays) -> None:
+        """Give the scene nodes the arrays of a design (:func:`~.view.scene_arrays`)."""
+        self._vertex_points = arrays.vertex_points
+        scene = self.server.scene
+        show_pattern = bool(self._show_pattern.value)
+        flat_nodes = []
+        for kind, rgb in PATCH_RGB.items():
+            for root, parts in (("/folded", arrays.folded), ("/pattern", arrays.flat)):
+                name = f"{root}/{kind}"
+                folded = root == "/folded"
+                if kind in parts:
+                    vertices, faces = parts[kind]
+                    update = {"vertices": vertices, "faces": faces}
+                else:  # hidden: its old arrays need not be sent
+                    (vertices, faces), update = _empty_mesh(), {}
+                node = self._node(
+                    name,
+                    scene.add_mesh_simple,
+                    vertices,
+                    faces,
+                    update=update,
+                    color=rgb,
+                    side="double",
+                    flat_shading=False,
+                )
+                if folded and name not in self._clickable:
+                    # point clouds take no clicks in viser; the surface does
+                    node.on_click(self._clicked)
+                    self._clickable.add(name)
+                node.visible = kind in parts and (folded or show_pattern)
+                if kind in parts and not folded:
+                    flat_nodes.append(node)
+        for root, segs in (
+            ("/folded", arrays.folded_creases),
+            ("/pattern", arrays.flat_creases),
+        ):
+            for a, points in segs.items():
+                name = f"{root}/crease_{a}"
+                shown = len(points) > 0
+                node = self._node(
+                    name,
+                    scene.add_line_segments,
+                    points if shown else _empty_segments(),
+                    CREASE_RGB[a],
+                    update={"points": points} if shown else {},
+                    thickness=2.0 if a != "B" else 1.0,
+                    thickness_units="screen",
+                )
+                node.visible = shown and (root == "/folded" or show_pattern)
+                if shown and root == "/pattern":
+                    flat_nodes.append(node)
+        self._node(
+            "/folded/vertices",
+            scene.add_point_cloud,
+            arrays.vertex_points,
+            arrays.vertex_colors,
+            update={
+                "points": arrays.vertex_points,
+                "colors": arrays.vertex_colors,
+                "point_size": arrays.point_size,
+            },
+            point_size=arrays.point_size,
+            point_shape="circle",
+            point_shading="flat",
+        )
+        self._flat_nodes = flat_nodes
+
     def _draw(self) -> None:
         t = time.perf_counter()
         design, design_id = self.session.design, self.session.design_id
         if design is None:
             return
         arrays = scene_arrays(design)
-        scene = self.server.scene
-        flat_nodes, folded_nodes = [], []
+        # one window of messages: the page applies the scene and the status line together
         with self.server.atomic():
-            for kind, rgb in PATCH_RGB.items():
-                for root, parts in (("/folded", arrays.folded), ("/pattern", arrays.flat)):
-                    name = f"{root}/{kind}"
-                    if kind not in parts:
-                        scene.add_mesh_simple(name, *_empty_mesh(), visible=False)
-                        continue
-                    vertices, faces = parts[kind]
-                    node = scene.add_mesh_simple(
-                        name, vertices, faces, color=rgb, side="double", flat_shading=False
-                    )
-                    (flat_nodes if root == "/pattern" else folded_nodes).append(node)
-            for root, segs in (
-                ("/folded", arrays.folded_creases),
-                ("/pattern", arrays.flat_creases),
-            ):
-                for a, points in segs.items():
-                    name = f"{root}/crease_{a}"
-                    node = scene.add_line_segments(
-                        name,
-                        points if len(points) else _empty_segments(),
-                        CREASE_RGB[a],
-                        thickness=2.0 if a != "B" else 1.0,
-                        thickness_units="screen",
-                        visible=len(points) > 0,
-                    )
-                    if root == "/pattern":
-                        flat_nodes.append(node)
-            scene.add_point_cloud(
-                "/folded/vertices",
-                arrays.vertex_points,
-                arrays.vertex_colors,
-                point_size=arrays.point_size,
-                point_shape="circle",
-                point_shading="flat",
+            self._update_scene(arrays)
+            counts = ", ".join(f"{n} {s}" for s, n in design.status_counts().items() if n)
+            shown = (
+                f", pattern drawn at {arrays.pattern_scale:.0%}" if arrays.pattern_scale < 1 else ""
             )
-        for node in flat_nodes:
-            node.visible = self._show_pattern.value
-        self._flat_nodes = flat_nodes
-
-        def clicked(event) -> None:
-            u = nearest_vertex_to_ray(arrays.vertex_points, event.ray_origin, event.ray_direction)
-            if u >= 0:
-                self._vertex.value = u
-                self._select(u)
-
-        for node in folded_nodes:  # point clouds take no clicks in viser; the surface does
-            node.on_click(clicked)
-
-        counts = ", ".join(f"{n} {s}" for s, n in design.status_counts().items() if n)
-        shown = f", pattern drawn at {arrays.pattern_scale:.0%}" if arrays.pattern_scale < 1 else ""
-        self._set_status(
-            f"**{design.source}**: {len(design.mesh.vertices)} vertices ({counts}), "
-            f"{len(design.pattern.faces)} pattern faces{shown}  \n{params_text(design.params)}"
-        )
-        n = len(design.mesh.vertices)
-        self._vertex.max = max(n - 1, 0)
-        if self._selected < n:
-            self._select(self._selected)
+            self._set_status(
+                f"**{design.source}**: {len(design.mesh.vertices)} vertices ({counts}), "
+                f"{len(design.pattern.faces)} pattern faces{shown}  \n{params_text(design.params)}"
+            )
+            n = len(design.mesh.vertices)
+            self._vertex.max = max(n - 1, 0)
+            if self._selected < n:
+                self._select(self._selected)
         self.timings["draw"] = time.perf_counter() - t
         with self._drawn:
             self.drawn_id = max(self.drawn_id, design_id)

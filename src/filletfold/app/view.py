@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..design import Design
+from ..surface.pattern import face_arrays
 from ..tolerances import tol
 
 #: RGB (0..255) of each patch kind.
@@ -103,8 +104,10 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
     Parameters
     ----------
     points_2d : (n, 2) float
-    faces : sequence of (k,) int
-        Corner indices into ``points_2d``.
+    faces : FlatFaces or sequence of (k,) int
+        Corner indices into ``points_2d`` (a pattern's
+        :class:`~filletfold.surface.pattern.FlatFaces` is read through its flat arrays, with
+        no array per face).
 
     Returns
     -------
@@ -114,10 +117,11 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
         The face each triangle came from (non-decreasing).
     """
     p = np.asarray(points_2d, dtype=float)
-    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    flat = np.concatenate(faces).astype(np.int64, copy=False) if faces else np.zeros(0, np.int64)
+    flat, offsets = face_arrays(faces)
+    flat = flat.astype(np.int64, copy=False)
+    sizes, start = np.diff(offsets), offsets[:-1]
     count = np.maximum(sizes - 2, 0)
-    start, t_start = np.cumsum(sizes) - sizes, np.cumsum(count) - count
+    t_start = np.cumsum(count) - count
     triangles = np.zeros((int(count.sum()), 3), dtype=np.int64)
     for k in np.unique(sizes[sizes >= 3]).tolist():
         which = np.flatnonzero(sizes == k)
@@ -131,7 +135,7 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
         triangles[rows[convex]] = f[convex][:, fan]
         for row, at in zip(f[~convex], rows[~convex], strict=True):
             triangles[at] = row[triangulate_polygon(p[row])]
-    return triangles, np.repeat(np.arange(len(faces)), count)
+    return triangles, np.repeat(np.arange(len(sizes)), count)
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
