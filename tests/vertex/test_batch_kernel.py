@@ -240,7 +240,8 @@ def test_designs_with_and_without_the_kernel(name, kwargs, monkeypatch):
 
 
 def test_small_batches_stay_with_numpy(monkeypatch):
-    """Below KERNEL_MIN_PROBLEMS problems the numpy version runs (no compile wait)."""
+    """Below KERNEL_MIN_PROBLEMS problems the numpy version runs, at or above it the kernel
+    (the default threshold, 1, sends every batch to the kernel)."""
     called = []
     monkeypatch.setattr(batch, "USE_KERNEL", True)
     monkeypatch.setattr(batch, "_kernel_loaded", False)
@@ -250,11 +251,12 @@ def test_small_batches_stay_with_numpy(monkeypatch):
     )
     calls = recorded_calls(problems_of(CASES[0]))
     rows, q, c, y, kw = calls[0]
-    assert len(rows.a) < batch.KERNEL_MIN_PROBLEMS
+    monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", len(rows.a) + 1)
     batch.interior_point(rows, q, c, y, **kw)
     monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", len(rows.a))
     batch.interior_point(rows, q, c, y, **kw)
     assert called == ["numpy", "numba"]
+    assert batch.KERNEL_MIN_PROBLEMS >= 1
 
 
 def test_importing_filletfold_does_not_import_numba():
@@ -273,7 +275,7 @@ def test_a_warm_kernel_leaves_small_batches_to_numpy(monkeypatch):
     monkeypatch.setattr(batch, "interior_point_numpy", lambda *a, **k: called.append("numpy"))
     calls = recorded_calls(problems_of(CASES[0]))
     rows, q, c, y, kw = calls[0]
-    assert len(rows.a) < batch.KERNEL_MIN_PROBLEMS
+    monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", len(rows.a) + 1)
     batch.interior_point(rows, q, c, y, **kw)
     assert called == ["numpy"]
     monkeypatch.setattr(batch, "USE_KERNEL", False)

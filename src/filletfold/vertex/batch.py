@@ -65,16 +65,17 @@ from .settings import (
 
 #: Run the interior-point method through the numba kernel (:mod:`.batch_kernel`, 3-6x
 #: faster) when numba is installed; ``FILLETFOLD_NUMBA=0`` turns it off. Its first use ever
-#: compiles it (about 15 s, once: the result is cached on disk) and every process pays about
-#: 1 s to load it, so it solves batches of at least :data:`KERNEL_MIN_PROBLEMS` problems only:
-#: a small design (the demo, the app's examples) never waits for it. Which path solves a batch
-#: depends on the batch's size alone, never on what the process solved before, so a design
-#: gives the same bytes first or last in a long process (the two paths agree only to rounding).
-#: (numba itself is imported on that first use, not with filletfold.)
+#: compiles it (about 15 s, once: the result is cached on disk; ``make install`` does it) and
+#: every process pays about 0.5-1 s to load it. It solves every batch of at least
+#: :data:`KERNEL_MIN_PROBLEMS` problems (1: all of them, so the app's small examples get it
+#: too: blob's slider change 1.2 s -> 0.33 s of compute). Which path solves a batch depends on
+#: the batch's size alone, never on what the process solved before, so a design gives the same
+#: bytes first or last in a long process, in the CLI, the API and the app (the two paths agree
+#: only to rounding). (numba itself is imported on that first use, not with filletfold.)
 USE_KERNEL = (
     importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
 )
-KERNEL_MIN_PROBLEMS = 256
+KERNEL_MIN_PROBLEMS = 1
 
 
 @dataclass
