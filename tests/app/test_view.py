@@ -19,6 +19,7 @@ from filletfold.app.view import (
     CREASE_RGB,
     PATCH_RGB,
     SCENE_WIDTH,
+    SHARP_RGB,
     STATUS_RGB,
     legend_markdown,
     scene_arrays,
@@ -44,7 +45,8 @@ def test_the_legend_shows_every_colour_with_its_name():
         assert shown[name] == hexed(CREASE_RGB[a])
     for status, rgb in STATUS_RGB.items():
         assert shown[status] == hexed(rgb)
-    assert len(rows) == len(PATCH_RGB) + len(CREASE_RGB) + len(STATUS_RGB)
+    assert shown["kept sharp (its corner, no hole)"] == hexed(SHARP_RGB)
+    assert len(rows) == len(PATCH_RGB) + len(CREASE_RGB) + len(STATUS_RGB) + 1
     headings = [line for line in text.splitlines() if line.startswith("**")]
     assert headings == ["**Patches**  ", "**Creases**  ", "**Vertices**  "]
 
@@ -230,3 +232,16 @@ def test_creases_and_markers_match_the_design(cube):
     for rgb, status in zip(s.vertex_colors.tolist(), design.vertices.status, strict=True):
         assert tuple(rgb) == STATUS_RGB[status]
     assert s.point_size > 0
+
+
+def test_sharp_vertices_have_their_own_colour_and_fillets_their_patch():
+    from filletfold.app.view import scene_arrays
+
+    from ..conftest import design_of
+
+    d = design_of("l-prism")
+    arrays = scene_arrays(d)
+    sharp = [u for u, t in enumerate(d.vertices.treatment) if t == "sharp"]
+    assert sharp
+    assert (arrays.vertex_colors[sharp] == SHARP_RGB).all()
+    assert "fillet" in arrays.folded

@@ -14,7 +14,12 @@ from ..surface.pattern import face_arrays
 from ..tolerances import tol
 
 #: RGB (0..255) of each patch kind.
-PATCH_RGB = {"cone": (245, 158, 64), "cylinder": (89, 153, 230), "face": (115, 199, 115)}
+PATCH_RGB = {
+    "cone": (245, 158, 64),
+    "cylinder": (89, 153, 230),
+    "fillet": (60, 200, 200),
+    "face": (115, 199, 115),
+}
 #: RGB of each crease assignment drawn.
 CREASE_RGB = {"M": (220, 40, 40), "V": (40, 80, 220), "B": (40, 40, 40)}
 #: RGB of each vertex status.
@@ -25,6 +30,8 @@ STATUS_RGB = {
     "boundary": (150, 150, 150),
     "developable": (150, 70, 200),
 }
+#: RGB of a vertex kept sharp (its corner kept, whatever its status: ``--sharp``).
+SHARP_RGB = (20, 20, 20)
 
 
 def _hex(rgb) -> str:
@@ -38,7 +45,7 @@ def legend_markdown() -> str:
         return f'<span style="color:{_hex(rgb)}">&#9632;</span> {text}  '
 
     lines = ["**Patches**  "]
-    lines += [row(PATCH_RGB[k], k) for k in ("cone", "cylinder", "face")]
+    lines += [row(PATCH_RGB[k], k) for k in ("cone", "cylinder", "fillet", "face")]
     lines += ["", "**Creases**  "]
     lines += [
         row(CREASE_RGB["M"], "mountain"),
@@ -47,6 +54,7 @@ def legend_markdown() -> str:
     ]
     lines += ["", "**Vertices**  "]
     lines += [row(rgb, status) for status, rgb in STATUS_RGB.items()]
+    lines += [row(SHARP_RGB, "kept sharp (its corner, no hole)")]
     return "\n".join(lines)
 
 
@@ -180,7 +188,7 @@ class SceneArrays:
     Attributes
     ----------
     folded : dict of str to (vertices (n, 3), triangles (t, 3))
-        The folded surface, one mesh per patch kind (``cone``, ``cylinder``, ``face``).
+        The folded surface, one mesh per patch kind (``cone``, ``cylinder``, ``fillet``, ``face``).
     flat : dict of str to (vertices (n, 3), triangles (t, 3))
         The crease pattern laid flat beside the folded form (z constant).
     folded_creases, flat_creases : dict of str to (s, 2, 3) float
@@ -265,7 +273,11 @@ def scene_arrays(design: Design) -> SceneArrays:
     mesh = design.mesh
     out.vertex_points = out.to_scene(mesh.vertices)
     out.vertex_colors = np.array(
-        [STATUS_RGB.get(s, (0, 0, 0)) for s in design.vertices.status], dtype=np.uint8
+        [
+            SHARP_RGB if t == "sharp" else STATUS_RGB.get(s, (0, 0, 0))
+            for s, t in zip(design.vertices.status, design.vertices.treatment, strict=True)
+        ],
+        dtype=np.uint8,
     ).reshape(-1, 3)
     lengths = np.linalg.norm(
         mesh.vertices[mesh.edges[:, 1]] - mesh.vertices[mesh.edges[:, 0]], axis=1
