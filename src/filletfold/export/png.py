@@ -25,10 +25,11 @@ __all__ = ["LAYOUT_FILL", "PATCH_COLOR", "pattern_png", "preview_png"]
 PATCH_COLOR = {
     "cone": (0.96, 0.62, 0.25),
     "cylinder": (0.35, 0.6, 0.9),
+    "fillet": (0.24, 0.78, 0.78),
     "face": (0.45, 0.78, 0.45),
 }
 #: Light fill of each patch kind in the flat layout.
-LAYOUT_FILL = {"cone": "#ffd8a8", "cylinder": "#cfe2ff", "face": "#d3f9d8"}
+LAYOUT_FILL = {"cone": "#ffd8a8", "cylinder": "#cfe2ff", "fillet": "#c5f6f6", "face": "#d3f9d8"}
 _OTHER_FILL = "#eeeeee"
 _TAB_FILL = "#d9d9d9"
 #: Crease colours of both pictures: a shade darker than the cut files' (thin lines on tints).
