@@ -699,6 +699,10 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
         if len(todo_b) == 0:
             continue
         keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter))
+    # a quick solve gives up early: once more from the best point (fresh multipliers)
+    again = np.nonzero(need & (best_g <= 0) & ~thorough)[0]
+    if len(again):
+        keep_best(again, _phase1(rows.take(again), best[again], again, max_iter))
     # the give-up rule is only a hint here: the rest continue from their best point, longer
     rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
     if len(rest):
