@@ -580,8 +580,8 @@ def solve_apex_batch(
         of points).
     thorough : bool or sequence of bool
         Per problem (or for all): before calling a problem infeasible, try every start,
-        continue the feasibility phase from the best point without the give-up rule, then by
-        linear programmes (:func:`phase1_lp`), and last run the reference SLSQP solver
+        continue the feasibility phase from the best point by linear programmes
+        (:func:`phase1_lp`), then without the give-up rule, and last run the reference SLSQP solver
         (:func:`~filletfold.vertex.reference.solve_apex_slsqp`) from the best point, the
         target and the first two starts. Without it only the
         :data:`PARALLEL_STARTS` best starts are tried and a problem is given up once it looks
@@ -703,15 +703,15 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
     again = np.nonzero(need & (best_g <= 0) & ~thorough)[0]
     if len(again):
         keep_best(again, _phase1(rows.take(again), best[again], again, max_iter))
-    # the give-up rule is only a hint here: the rest continue from their best point, longer
-    rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
-    if len(rest):
-        keep_best(rest, _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False))
     # the interior-point phase 1 can stall short of a thin window: linear programmes next
     for b in np.nonzero(need & (best_g <= 0) & thorough)[0].tolist():
         y_lp, t_lp = phase1_lp(rows.take(np.array([b])), best[b])
         if t_lp > best_g[b]:
             best[b], best_g[b] = y_lp, t_lp
+    # the give-up rule is only a hint here: the rest continue from their best point, longer
+    rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
+    if len(rest):
+        keep_best(rest, _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False))
     feasible = need & (best_g > 0)
     solve = np.nonzero(feasible)[0]
     y = np.zeros((B, n))
