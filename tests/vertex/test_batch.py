@@ -160,14 +160,14 @@ def test_kkt_point_certifies_a_projection_and_rejects_a_point_short_of_it():
 
 @pytest.mark.parametrize("mesh, loss", [("icosahedron", False), ("miura", True)])
 def test_phase1_lp_reaches_a_feasible_point_and_never_loses_slack(mesh, loss):
-    """From points well away from the feasible set, the linear programmes reach a strictly
-    feasible point (these problems have one); the slack returned is the point's, and never
-    below the start's."""
+    """From points about the target (where the interior-point phase 1 leaves its problems),
+    the linear programmes reach a strictly feasible point (these problems have one); the slack
+    returned is the point's, and never below the start's."""
     rng = np.random.default_rng(5)
     for cons, target, _ in first_attempts(mesh, 0.1, 0.3, loss=loss)[:4]:
         rows = pack_problems([cons], target[None], cons.n_vars)
         for _ in range(3):
-            y0 = rng.normal(scale=0.3, size=cons.n_vars)
+            y0 = rng.normal(scale=0.1, size=cons.n_vars)
             y, t = phase1_lp(rows, y0)
             assert t == pytest.approx(rows.min_slack(y[None])[0], abs=1e-15)
             assert t >= rows.min_slack(y0[None])[0]

@@ -29,7 +29,7 @@ PROX = 1e-2
 #: trust region (box half-width, in units of the scale), the most linear programmes per problem,
 #: and the predicted gain of the smallest slack (over the scale) below which it stops.
 LP_RADIUS = 0.05
-LP_ROUNDS = 30
+LP_ROUNDS = 12
 LP_STALL = 1e-10
 #: Starts tried at once in phase 1 before the remaining ones.
 PARALLEL_STARTS = 1
