@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/apex_solvers.py [--quick] [--repeat N] [--max-problems N]
                                                 [--random K] [--methods a,b,...] [--seed S]
+                                                [--mesh PATH ...]
 
 Every case is turned into the per-vertex apex problems of the pipeline's first attempt
 (``minimise |x - P|^2 / L^2`` subject to the sampled constraints ``g(x) >= 0`` of
@@ -33,7 +34,8 @@ the batched solver's.
 Cases: the Platonic solids, ``geodesic-sphere:level=3``, ``examples/bunny-lowres.obj``
 (radii clamped), and random convex polyhedra (five hulls of 30-200 points on a perturbed sphere,
 radius 5-25 % of the mean edge length per polyhedron, clamped; depth 5-100 % per vertex;
-seeded by ``--seed``).
+seeded by ``--seed``); ``--mesh PATH`` adds a mesh file (an irregular mesh: a random hull, a
+corpus mesh), radius 10 % clamped.
 Radius 10 % and depth 30 % elsewhere. ``--quick``: one run, at most 40 problems per case
 and two small random polyhedra.
 """
@@ -349,6 +351,7 @@ def main(argv=None) -> int:
     ap.add_argument("--random", type=int, default=None, help="random polyhedra (default 5)")
     ap.add_argument("--seed", type=int, default=6)
     ap.add_argument("--methods", default=",".join(METHODS))
+    ap.add_argument("--mesh", action="append", default=[], help="add a mesh file (repeatable)")
     args = ap.parse_args(argv)
     repeat = args.repeat or (1 if args.quick else 3)
     cap = args.max_problems or (40 if args.quick else None)
@@ -393,6 +396,7 @@ def main(argv=None) -> int:
         ("geodesic-3", "geodesic-sphere:level=3", "10%", "30%", False),
         ("bunny (clamp)", BUNNY, "10%", "30%", True),
     ]
+    cases += [(os.path.basename(m), m, "10%", "30%", True) for m in args.mesh]
     totals = {m: {"n": 0, "t": 0.0, "ok": [], "feas": [], "gap": []} for m in methods}
     t_start = time.perf_counter()
     for case in [*cases, ("random", None, None, None, None)]:

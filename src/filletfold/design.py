@@ -752,9 +752,9 @@ def _apices(
         res.take(st.vertices, sorted(kept))
         pending = [u for u in pending if u not in kept]
     _stage("apices")
-    # with the rescue to come, the hard cases' fallbacks wait for its last, smallest radii
-    thorough = material_loss or not fit_vertices
-    apices = _solve_apices(frames, depths, res, centres, progress, pending, size, thorough)
+    # thorough even with the rescue to come: a quick solve calls vertices infeasible that are
+    # not, and the rescue would shrink their radii for nothing
+    apices = _solve_apices(frames, depths, res, centres, progress, pending, size)
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
         frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves

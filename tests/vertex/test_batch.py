@@ -18,7 +18,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from filletfold.vertex.batch import pack, pack_problems, rows_of, solve_apex, solve_apex_batch
+from filletfold.vertex.batch import (
+    pack,
+    pack_problems,
+    phase1_lp,
+    rows_of,
+    solve_apex,
+    solve_apex_batch,
+)
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
 from filletfold.vertex.solve import apex_problems
 
@@ -149,3 +156,36 @@ def test_kkt_point_certifies_a_projection_and_rejects_a_point_short_of_it():
         assert not kkt_point(cons, p.target, interior)  # no active row: not a projection
         checked += 1
     assert checked > 0
+
+
+@pytest.mark.parametrize("mesh, loss", [("icosahedron", False), ("miura", True)])
+def test_phase1_lp_reaches_a_feasible_point_and_never_loses_slack(mesh, loss):
+    """From points about the target (where the interior-point phase 1 leaves its problems),
+    the linear programmes reach a strictly feasible point (these problems have one); the slack
+    returned is the point's, and never below the start's."""
+    rng = np.random.default_rng(5)
+    for cons, target, _ in first_attempts(mesh, 0.1, 0.3, loss=loss)[:4]:
+        rows = pack_problems([cons], target[None], cons.n_vars)
+        for _ in range(3):
+            y0 = rng.normal(scale=0.1, size=cons.n_vars)
+            y, t = phase1_lp(rows, y0)
+            assert t == pytest.approx(rows.min_slack(y[None])[0], abs=1e-15)
+            assert t >= rows.min_slack(y0[None])[0]
+            assert t > 0
+
+
+def test_phase1_lp_stops_at_an_infeasible_problem():
+    """Two contradictory face rows: the slack stays negative and the start is not lost."""
+    cons, target, _ = first_attempts("icosahedron", 0.15, 0.3)[0]
+    k = int(np.flatnonzero(cons.lin_kind == "face")[0])
+    bad = dataclasses.replace(
+        cons,
+        lin_a=np.vstack([cons.lin_a, -cons.lin_a[k]]),
+        lin_b=np.append(cons.lin_b, -cons.lin_b[k] - 0.01 * cons.scale),
+        lin_kind=np.append(cons.lin_kind, "face"),
+        lin_element=np.append(cons.lin_element, cons.lin_element[k]),
+    )
+    rows = pack_problems([bad], target[None], 3)
+    y0 = np.zeros(3)
+    _, t = phase1_lp(rows, y0)
+    assert rows.min_slack(y0[None])[0] <= t < 0

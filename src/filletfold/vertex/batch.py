@@ -14,7 +14,8 @@ see :data:`USE_KERNEL`):
 
 * **phase 1** (only for targets that violate a row and starts that do too): maximise ``t``
   subject to ``g_j(x) >= t`` and ``t <= t_cap``, from the best start, until ``t > 0``; the
-  reverse-convex rows (``l <= l_max``) can stall it, so the remaining starts are tried next;
+  reverse-convex rows (``l <= l_max``) can stall it, so the remaining starts are tried next
+  (and, in a thorough solve, linear programmes on the linearised rows: :func:`phase1_lp`);
 * **phase 2**: from the strictly feasible point, the closest point to ``P``, to a mean
   complementarity of ``1e-12`` (relative to the squared length scale).
 
@@ -51,6 +52,9 @@ from .settings import (
     IPM_TOL,
     KKT_ACTIVE,
     KKT_TOL,
+    LP_RADIUS,
+    LP_ROUNDS,
+    LP_STALL,
     MERIT_ROUNDOFF,
     MULTIPLIER_FLOOR,
     MULTIPLIER_START_FLOOR,
@@ -490,6 +494,72 @@ def _phase1(
     return z[:, :n]
 
 
+def phase1_lp(rows: RowBlock, y: np.ndarray) -> tuple[np.ndarray, float]:
+    """A larger smallest slack of one problem by sequential linear programming from ``y``.
+
+    Each round maximises ``s`` subject to ``g_j(y) + grad g_j(y) . d >= s`` on the real rows
+    and ``|d|_inf <= delta`` (a linear programme, solved by HiGHS), takes the step when the
+    smallest slack grows and adjusts the trust region ``delta`` by how much of the predicted
+    gain was realised. It stops at a positive slack, after :data:`LP_ROUNDS` programmes, or
+    once a programme predicts less than :data:`LP_STALL` (a local maximum).
+
+    The interior-point phase 1 can stall short of a thin feasible window that one such step
+    reaches (the reverse-convex ``l <= l_max`` rows, many rows nearly active at once); this is
+    what the thorough solve tries before the SLSQP fallback.
+
+    Parameters
+    ----------
+    rows : RowBlock
+        One problem (``B = 1``).
+    y : (n,) float
+
+    Returns
+    -------
+    y : (n,) float
+        The best point found.
+    t : float
+        Its smallest slack.
+    """
+    from scipy.optimize import linprog  # 0.1-0.3 s to import: only when needed
+
+    keep = rows.mask[0]
+    a, A, alpha = rows.a[0, keep], rows.A[0, keep], rows.alpha[0, keep]
+    e = rows.e
+    n = len(y)
+    y = np.asarray(y, dtype=float).copy()
+    g = a + A @ y + alpha * (y @ (e * y))
+    t = float(g.min())
+    delta = LP_RADIUS
+    cost = np.zeros(n + 1)
+    cost[n] = -1.0
+    for _ in range(LP_ROUNDS):
+        if t > 0:
+            break
+        J = A + 2 * alpha[:, None] * (e * y)[None, :]
+        lp = linprog(
+            cost,
+            A_ub=np.hstack([-J, np.ones((len(g), 1))]),
+            b_ub=g,
+            bounds=[(-delta, delta)] * n + [(None, None)],
+            method="highs",
+        )
+        if lp.x is None:
+            break
+        d, gain = lp.x[:n], float(lp.x[n]) - t
+        if gain <= LP_STALL:
+            break
+        y_new = y + d
+        g_new = a + A @ y_new + alpha * (y_new @ (e * y_new))
+        t_new = float(g_new.min())
+        if t_new > t:
+            if t_new - t > 0.5 * gain:
+                delta *= 2
+            y, g, t = y_new, g_new, t_new
+        else:
+            delta *= 0.25
+    return y, t
+
+
 def solve_apex_batch(
     problems: Sequence[ApexConstraints],
     targets: Sequence[np.ndarray],
@@ -511,9 +581,10 @@ def solve_apex_batch(
         of points).
     thorough : bool or sequence of bool
         Per problem (or for all): before calling a problem infeasible, try every start,
-        continue the feasibility phase from the best point without the give-up rule, and last
-        run the reference SLSQP solver (:func:`~filletfold.vertex.reference.solve_apex_slsqp`)
-        from the best point, the target and the first two starts. Without it only the
+        continue the feasibility phase from the best point by linear programmes
+        (:func:`phase1_lp`), then without the give-up rule, and last run the reference SLSQP solver
+        (:func:`~filletfold.vertex.reference.solve_apex_slsqp`) from the best point, the
+        target and the first two starts. Without it only the
         :data:`PARALLEL_STARTS` best starts are tried and a problem is given up once it looks
         infeasible: for attempts that have a more permissive one after them.
     max_iter : int
@@ -629,6 +700,15 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter) -> list[ApexS
         if len(todo_b) == 0:
             continue
         keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter))
+    # a quick solve gives up early: once more from the best point (fresh multipliers)
+    again = np.nonzero(need & (best_g <= 0) & ~thorough)[0]
+    if len(again):
+        keep_best(again, _phase1(rows.take(again), best[again], again, max_iter))
+    # the interior-point phase 1 can stall short of a thin window: linear programmes next
+    for b in np.nonzero(need & (best_g <= 0) & thorough)[0].tolist():
+        y_lp, t_lp = phase1_lp(rows.take(np.array([b])), best[b])
+        if t_lp > best_g[b]:
+            best[b], best_g[b] = y_lp, t_lp
     # the give-up rule is only a hint here: the rest continue from their best point, longer
     rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
     if len(rest):

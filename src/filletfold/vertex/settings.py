@@ -25,6 +25,12 @@ PROJECTION_TOL = 1e-13
 #: Proximal weight of phase 1 (maximise t - PROX / 2 |y - y0|^2): keeps the search near its
 #: start, where the developed apex of a closed development would otherwise drift away.
 PROX = 1e-2
+#: The linearised feasibility phase (:func:`~filletfold.vertex.batch.phase1_lp`): its first
+#: trust region (box half-width, in units of the scale), the most linear programmes per problem,
+#: and the predicted gain of the smallest slack (over the scale) below which it stops.
+LP_RADIUS = 0.05
+LP_ROUNDS = 12
+LP_STALL = 1e-10
 #: Starts tried at once in phase 1 before the remaining ones.
 PARALLEL_STARTS = 1
 #: The start of a closed development's developed apex is where two consecutive central rulings
