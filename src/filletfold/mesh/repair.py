@@ -125,13 +125,16 @@ def split_face_loops(faces, origin, vorig, log: RepairLog):
     faces : list of (k,) int
     origin : (n_faces,) int
     """
+    bad = _faces_to_split(faces)
+    if not bad.any():
+        return list(faces), np.asarray(origin, dtype=np.int64)
     out, out_origin = [], []
-    for f, o in zip(faces, origin.tolist(), strict=True):
-        g = f[f != np.roll(f, 1)] if len(f) > 1 else f
-        if len(g) == len(f) and len(np.unique(f)) == len(f) and len(f) >= 3:
+    for f, o, b in zip(faces, origin.tolist(), bad.tolist(), strict=True):
+        if not b:
             out.append(f)
             out_origin.append(o)
             continue
+        g = f[f != np.roll(f, 1)] if len(f) > 1 else f
         distinct = len(np.unique(g))
         if distinct < 3:
             log.add(
@@ -160,6 +163,30 @@ def split_face_loops(faces, origin, vorig, log: RepairLog):
             out.append(np.asarray(loop, dtype=np.int64))
             out_origin.append(o)
     return out, np.asarray(out_origin, dtype=np.int64)
+
+
+def _faces_to_split(faces) -> np.ndarray:
+    """(n_faces,) bool: the faces with fewer than three corners or a vertex twice, all at once.
+
+    Parameters
+    ----------
+    faces : list of (k,) int
+
+    Returns
+    -------
+    (n_faces,) bool
+    """
+    sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    bad = sizes < 3
+    if not len(faces):
+        return bad
+    flat = np.concatenate(faces).astype(np.int64, copy=False)
+    face = np.repeat(np.arange(len(faces)), sizes)
+    order = np.lexsort((flat, face))
+    f, v = face[order], flat[order]
+    twice = (f[1:] == f[:-1]) & (v[1:] == v[:-1])
+    bad[f[1:][twice]] = True
+    return bad
 
 
 def _repeated(g: np.ndarray) -> int:
