@@ -142,3 +142,22 @@ def test_face_rows_read_as_the_list_of_face_arrays():
     got_flat, got_start = face_arrays(rows)
     assert got_flat is flat and got_start is start
     assert list(FaceRows(flat[:0], start[:1])) == []
+
+
+def test_lowest_linked_matches_the_connected_components():
+    """Label propagation gives every point its group's lowest index, as the sparse graph's
+    connected components do."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from filletfold.surface.piece import lowest_linked
+
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        n, m = int(rng.integers(1, 40)), int(rng.integers(0, 60))
+        pairs = rng.integers(0, n, size=(m, 2))
+        graph = coo_matrix((np.ones(m), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        _, group = connected_components(graph, directed=False)
+        low = np.full(group.max() + 1, n)
+        np.minimum.at(low, group, np.arange(n))
+        assert np.array_equal(lowest_linked(pairs, n), low[group])

@@ -6,8 +6,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..tolerances import tol
@@ -123,11 +121,7 @@ class Piece:
         pairs = pairs[np.linalg.norm(p3[pairs[:, 0]] - p3[pairs[:, 1]], axis=1) < eps]
         # each point goes to the lowest point of its group of coincident points
         n = len(p2)
-        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-        _, group = connected_components(graph, directed=False)
-        lowest = np.full(group.max(initial=0) + 1, n)
-        np.minimum.at(lowest, group, np.arange(n))
-        root = lowest[group]
+        root = lowest_linked(pairs, n)
         flat, size, kept = _merged_faces(p2, self.faces, root, min_area=eps * eps)
         used = np.unique(flat)
         new = np.full(n, -1)
@@ -155,6 +149,26 @@ class Piece:
         overlap is answered without computing the union.
         """
         return faces_overlap(self.arrays()[0], self.faces, rel)
+
+
+def lowest_linked(pairs: np.ndarray, n: int) -> np.ndarray:
+    """(n,) int: the lowest index of each point's group, points linked by ``pairs`` (m, 2).
+
+    The connected components by label propagation on the pairs (each round gives both ends
+    of every pair the lower of their labels, then follows labels to their own), so a few
+    tiny groups cost a few array operations, not a sparse graph.
+    """
+    root = np.arange(n)
+    a, b = pairs[:, 0], pairs[:, 1]
+    while True:
+        low = np.minimum(root[a], root[b])
+        new = root.copy()
+        np.minimum.at(new, a, low)
+        np.minimum.at(new, b, low)
+        new = new[new]  # labels are indices of points of the group: follow them
+        if np.array_equal(new, root):
+            return root
+        root = new
 
 
 def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: float):
