@@ -631,6 +631,13 @@ def validate_apices(
     # the minima between samples: Newton from the smallest sample on the closed forms
     l_min, l_at = _refined_min(sa, V, l, s, first, vi=vi, dn=dn)
     nonint_min, nonint_at = _refined_min(sa, V, nonint, s, first, sigma=sigma[vert])
+    if sa.conical.any():  # no closed form on a fillet: densely between the samples beside
+        # each side's smallest one
+        cone = np.flatnonzero(sa.conical)
+        for values, best, at, kind in ((l, l_min, l_at, "l"), (nonint, nonint_min, nonint_at, "n")):
+            b, t = _conical_dense_min(sa, V, v, sigma[vert], cone, values, s, first, last, kind)
+            lower = b < best[cone]
+            best[cone[lower]], at[cone[lower]] = b[lower], t[lower]
     floor = np.zeros(n) if floors is None else np.asarray(floors, dtype=float).reshape(n)
     checks = np.stack(
         [
@@ -700,6 +707,40 @@ def _stack(arrays: Sequence[SideArrays]) -> SideArrays:
     return SideArrays(
         **{x.name: np.concatenate([getattr(a, x.name) for a in arrays]) for x in fields(SideArrays)}
     )
+
+
+#: Points between the two samples beside a conical side's smallest one where the validation
+#: evaluates its conditions again (a fillet's crease has no closed form to refine on).
+CONICAL_DENSE = 33
+
+
+def _conical_dense_min(sa, V, v, sigma, sides, values, s, first, last, kind):
+    """(k,) smallest value and where, of ``l(s)`` (``kind`` "l") or ``sigma (V - C) . N``
+    ("n") on conical ``sides`` (k,), over :data:`CONICAL_DENSE` points between the samples
+    beside each side's smallest sample. ``V``, ``v``, ``sigma`` per side."""
+    lo = np.empty(len(sides))
+    hi = np.empty(len(sides))
+    for j, i in enumerate(sides.tolist()):
+        a, b = int(first[i]), int(last[i])
+        k = a + int(np.argmin(values[a : b + 1]))
+        lo[j], hi[j] = s[max(k - 1, a)], s[min(k + 1, b)]
+    t = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, CONICAL_DENSE)[None]
+    side = np.repeat(sides, CONICAL_DENSE)
+    t = t.ravel()
+    C = sa.base(side, t)
+    if kind == "l":
+        Q, tr, R, M = sa.row_maps(side, t)
+        vi = chart_apex(Q, tr, v[side])
+        dn = crease_denominator(V[side], vi, M, R)
+        val = crease_height(crease_numerator(V[side], vi, t, C), np.where(dn > 0, dn, 1.0))
+        val = np.where(dn > 0, val, -np.inf)
+    else:
+        N = sa.surface_normal(side, t)
+        val = sigma[side] * np.einsum("ij,ij->i", V[side] - C, N)
+    val = val.reshape(len(sides), CONICAL_DENSE)
+    arg = np.argmin(val, axis=1)
+    rows = np.arange(len(sides))
+    return val[rows, arg], t.reshape(len(sides), CONICAL_DENSE)[rows, arg]
 
 
 def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
