@@ -38,6 +38,18 @@ def test_every_example_is_closed_by_default_and_has_holes_without(name):
     assert kept >= 0.8 * len(cones)
 
 
+def fillet_edge_lengths(d):
+    """(k,) flat and (k,) folded length of every pattern edge of a fillet face."""
+    p = d.pattern
+    patch = np.array([x.split()[0] for x in p.face_patch])
+    ef = p.edge_faces
+    on = (patch[ef[:, 0]] == "fillet") | (patch[np.maximum(ef[:, 1], 0)] == "fillet")
+    e = p.edges[on]
+    l2 = np.linalg.norm(p.vertices_2d[e[:, 0]] - p.vertices_2d[e[:, 1]], axis=1)
+    l3 = np.linalg.norm(p.vertices_3d[e[:, 0]] - p.vertices_3d[e[:, 1]], axis=1)
+    return l2, l3
+
+
 def join_angles(d, kind):
     """(k,) folded dihedral (degrees) across every pattern edge between a ``kind`` patch
     (``fillet`` or ``cylinder``) and a face piece: 0 for exact tangency, the sampling's error
@@ -70,13 +82,7 @@ def test_conical_fillets_hold_the_invariants(name):
     assert d.certificate["on fillets"].ok and d.certificate["on fillets"].value < 1e-12
     angles = join_angles(d, "fillet")
     assert len(angles) and angles.max() <= 1.5 * 1.5
-    p = d.pattern
-    patch = np.array([x.split()[0] for x in p.face_patch])
-    ef = p.edge_faces
-    on = (patch[ef[:, 0]] == "fillet") | (patch[np.maximum(ef[:, 1], 0)] == "fillet")
-    e = p.edges[on]
-    l2 = np.linalg.norm(p.vertices_2d[e[:, 0]] - p.vertices_2d[e[:, 1]], axis=1)
-    l3 = np.linalg.norm(p.vertices_3d[e[:, 0]] - p.vertices_3d[e[:, 1]], axis=1)
+    l2, l3 = fillet_edge_lengths(d)
     assert (l3 <= l2 + 1e-12 * d.certificate.size).all()
 
 
@@ -97,13 +103,7 @@ def test_fillet_mismatch_converges_under_refinement():
     worst = []
     for n in (9, 17, 33):
         d = filletfold.round_mesh("l-prism", samples=n, arc_step=0, tabs=False)
-        p = d.pattern
-        patch = np.array([x.split()[0] for x in p.face_patch])
-        ef = p.edge_faces
-        on = (patch[ef[:, 0]] == "fillet") | (patch[np.maximum(ef[:, 1], 0)] == "fillet")
-        e = p.edges[on]
-        l2 = np.linalg.norm(p.vertices_2d[e[:, 0]] - p.vertices_2d[e[:, 1]], axis=1)
-        l3 = np.linalg.norm(p.vertices_3d[e[:, 0]] - p.vertices_3d[e[:, 1]], axis=1)
+        l2, l3 = fillet_edge_lengths(d)
         worst.append(float(np.max(l2 - l3)))
     ratio = np.array(worst[:-1]) / np.array(worst[1:])
     assert (ratio > 3.5).all(), worst
