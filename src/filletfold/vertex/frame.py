@@ -246,7 +246,7 @@ class SideArrays:
         R, M : (m, 3) float
         """
         i, s = np.asarray(i, dtype=np.int64), np.asarray(s, dtype=float)
-        Q, t, R, M = self.Q[i].copy(), self.t[i].copy(), self.R[i].copy(), self.M[i].copy()
+        Q, t, R, M = self.Q[i], self.t[i], self.R[i], self.M[i]  # copies (fancy indexing)
         cone = self.conical[i]
         if cone.any():
             C, Rc, c, r = self.chart(i[cone], s[cone])
