@@ -118,7 +118,6 @@ def rescue_vertices(
     factor = {u: 1.0 for u in bad}
     tries = {u: 0 for u in bad}  # each vertex is halved ROUNDS times, then left sharp (apply)
     trial = VertexResult.empty(mesh.n_vertices) if not apply else None
-    edge_face = mesh.edge_faces
     for _ in range(2 * ROUNDS + 2):  # vertices made infeasible by a change join later rounds
         if not apply:
             bad = [u for u in bad if tries[u] < ROUNDS]
@@ -135,15 +134,11 @@ def rescue_vertices(
         if not len(edges):
             break
         radius[edges] *= scale[edges]
-        radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
-        new_rounding = round_edges(
-            mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width
+        radius, new_rounding, new_centres = reround(
+            mesh, radius, rounding.half_angle, face_centres, flat_deg, floor, min_width
         )
-        new_centres = face_centres(mesh, new_rounding)
         if apply:
-            faces = np.unique(edge_face[edges])
-            faces = faces[faces >= 0]
-            affected = np.unique(np.concatenate([mesh.faces[f] for f in faces]))
+            affected = face_vertices(mesh, edges)
             target = res
         else:
             affected = np.array(sorted(bad), dtype=np.int64)
@@ -207,6 +202,53 @@ def rescue_vertices(
                 f"(at most {r.max() * f:.4g}): --fit-vertices does so"
             )
     return rounding, centres, out
+
+
+def reround(
+    mesh: PolyMesh,
+    radius: np.ndarray,
+    half_angle: np.ndarray,
+    face_centres,
+    flat_deg: float,
+    floor: float,
+    min_width: float,
+) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
+    """The rounding of new radii, and its face piece centres: what the rescue and the sharp
+    vertices (:func:`~filletfold.vertex.sharpen.sharpen_vertices`) do after changing radii.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    radius : (n_edges,) float
+        The new radii.
+    half_angle : (n_edges,) float
+        The edges' half angles (:attr:`EdgeRounding.half_angle`).
+    face_centres : callable
+        ``face_centres(mesh, rounding) -> (n_faces, 3)``.
+    flat_deg, floor, min_width : float
+        Passed to :func:`~filletfold.rounding.edges.round_edges`.
+
+    Returns
+    -------
+    radius : (n_edges,) float
+        ``radius`` with the radii that would break an obtuse corner shrunk
+        (:func:`~filletfold.rounding.edges.shrink_broken`).
+    rounding : EdgeRounding
+    centres : (n_faces, 3) float
+    """
+    radius = shrink_broken(mesh, radius, half_angle)
+    rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width)
+    return radius, rounding, face_centres(mesh, rounding)
+
+
+def face_vertices(mesh: PolyMesh, edges) -> np.ndarray:
+    """The vertices of every face on one of ``edges`` (sorted, distinct): the vertices whose
+    face pieces, and so their creases' limits, change with those edges' radii."""
+    faces = np.unique(mesh.edge_faces[np.asarray(edges)])
+    faces = faces[faces >= 0]
+    if not len(faces):
+        return np.zeros(0, dtype=np.int64)
+    return np.unique(np.concatenate([mesh.faces[f] for f in faces.tolist()]))
 
 
 def _infeasible(res: VertexResult) -> list:

@@ -23,7 +23,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..mesh.polymesh import PolyMesh
-from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
+from ..rounding.edges import EdgeRounding
+from .rescue import face_vertices, reround
 from .solve import VertexResult, classify_vertices, solve_apices
 
 #: The kinds of cone-less vertices that ``--sharp`` can make sharp, in the order they are
@@ -193,22 +194,16 @@ def sharpen_vertices(
         if both.any():  # a straight crease between two sharp vertices
             radius = rounding.radius.copy()
             radius[both] = 0.0
-            radius = shrink_broken(mesh, radius, rounding.half_angle)  # obtuse corners may break
-            rounding = round_edges(
-                mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width
+            _, rounding, centres = reround(
+                mesh, radius, rounding.half_angle, face_centres, flat_deg, floor, min_width
             )
-            centres = face_centres(mesh, rounding)
             changed = both
         # the vertices whose sides changed: neighbours of the new sharp vertices, and every
         # vertex of a face whose piece (and centre) changed with an unrounded edge
         near = np.zeros(n, dtype=bool)
         at_new = np.isin(ends, new).any(axis=1)
         near[ends[at_new].ravel()] = True
-        if changed.any():
-            faces = np.unique(mesh.edge_faces[changed])
-            faces = faces[faces >= 0]
-            if len(faces):
-                near[np.concatenate([mesh.faces[f] for f in faces.tolist()])] = True
+        near[face_vertices(mesh, np.flatnonzero(changed))] = True
         again = np.flatnonzero(near & ~sharp)
         rebuilt = np.flatnonzero(near | sharp)
         fresh = VertexResult.empty(n)
