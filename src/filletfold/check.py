@@ -84,6 +84,8 @@ PLANE_TOL = 1e-9
 CYLINDER_TOL = 1e-9
 #: A cone face's corner is the apex when it is this close to it (/ design size).
 APEX_TOL = 1e-9
+#: Corners of the folded surface this close (/ design size) are one point (``holes``).
+GLUE_TOL = 1e-9
 #: Largest difference between a written fold angle and the folded form's (degrees; plus the
 #: file's rounding). A recomputed angle this close to 0 has no sign to disagree with.
 ANGLE_TOL_DEG = 1e-6
@@ -592,11 +594,7 @@ def _on_cylinders(g: _Data) -> Check:
     if not len(c):
         return Check(name, True, float("nan"), CYLINDER_TOL, "no cylinder in the design")
     e = g.index[g.face_of[c]]
-    w = g.v3[g.flat[c]] - g.axis_point[e]
-    t = g.axis_dir[e]
-    with np.errstate(invalid="ignore"):
-        radial = w - np.einsum("ij,ij->i", w, t)[:, None] * t
-        err = np.abs(np.linalg.norm(radial, axis=1) - g.radius[e]) / g.size
+    err = _off_cylinder(g, g.v3[g.flat[c]], e)
     err = np.where(g.rounded[e] & np.isfinite(err), err, np.inf)
     k = int(np.argmax(err))
     v, me = int(g.flat[c[k]]), int(e[k])
@@ -610,6 +608,15 @@ def _on_cylinders(g: _Data) -> Check:
     worst = {"pattern_vertex": v, "mesh_edge": me}
     ok = bool(err[k] <= CYLINDER_TOL)
     return Check(name, ok, float(err[k]), CYLINDER_TOL, detail, "<=", worst)
+
+
+def _off_cylinder(g: _Data, points: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """``|distance of points[i] from edge e[i]'s axis - its radius| / size`` (NaN stays NaN)."""
+    w = points - g.axis_point[e]
+    t = g.axis_dir[e]
+    with np.errstate(invalid="ignore"):
+        radial = w - np.einsum("ij,ij->i", w, t)[:, None] * t
+        return np.abs(np.linalg.norm(radial, axis=1) - g.radius[e]) / g.size
 
 
 def _on_fillets(g: _Data) -> Check:
@@ -633,9 +640,7 @@ def _on_fillets(g: _Data) -> Check:
     at_apex = np.linalg.norm(d, axis=1) <= CYLINDER_TOL * g.size
     with np.errstate(invalid="ignore", divide="ignore"):
         X = S + (np.einsum("ij,ij->i", M - S, t) / along)[:, None] * d
-        w = X - g.axis_point[e]
-        radial = w - np.einsum("ij,ij->i", w, t)[:, None] * t
-        err = np.abs(np.linalg.norm(radial, axis=1) - g.radius[e]) / g.size
+    err = _off_cylinder(g, X, e)
     err = np.where(at_apex, 0.0, err)
     err = np.where(g.rounded[e] & one & np.isfinite(err), err, np.inf)
     k = int(np.argmax(err))
@@ -710,7 +715,7 @@ def _holes(g: _Data) -> Check:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    eps = 1e-9 * g.size
+    eps = GLUE_TOL * g.size
     border, _ = _borders(g.v3, g.flat, g.nxt, eps)
     mesh_border, _ = _borders(g.mv, g.mesh_flat, g.mesh_nxt, -1.0)
     on = np.zeros(len(border), dtype=bool)
