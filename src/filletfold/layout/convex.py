@@ -10,6 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
+#: Turns (sines of corner angles) this close to 0 count as straight in :func:`is_convex`.
+TURN_ROUNDOFF = 1e-12
+#: Turns beyond this are convex far above round-off (:func:`surely_valid`); nearer ones are
+#: left to shapely.
+SURE_TURN = 1e-6
+
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """z of the cross products of 2D vectors (..., 2)."""
@@ -256,11 +262,12 @@ def turns(corners: np.ndarray) -> np.ndarray:
 
 
 def is_convex(corners: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
-    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to 1e-12);
-    ``turn``: their :func:`turns`, if known."""
+    """(n,) bool: padded polygons (n, k, 2) that are convex (every turn one way, up to
+    :data:`TURN_ROUNDOFF`); ``turn``: their :func:`turns`, if known."""
     turn = turns(corners) if turn is None else turn
     turn = np.where(np.isnan(turn), 0.0, turn)  # repeated corners turn by nothing
-    return fold(np.logical_and, turn >= -1e-12) | fold(np.logical_and, turn <= 1e-12)
+    left = fold(np.logical_and, turn >= -TURN_ROUNDOFF)
+    return left | fold(np.logical_and, turn <= TURN_ROUNDOFF)
 
 
 def surely_valid(quads: np.ndarray, turn: np.ndarray | None = None) -> np.ndarray:
@@ -268,7 +275,7 @@ def surely_valid(quads: np.ndarray, turn: np.ndarray | None = None) -> np.ndarra
     valid polygons); False means "ask shapely". ``turn``: their :func:`turns`, if known."""
     turn = turns(quads) if turn is None else turn
     with np.errstate(invalid="ignore"):
-        return fold(np.logical_and, turn > 1e-6) | fold(np.logical_and, turn < -1e-6)
+        return fold(np.logical_and, turn > SURE_TURN) | fold(np.logical_and, turn < -SURE_TURN)
 
 
 def polygon_area(quads: np.ndarray) -> np.ndarray:

@@ -56,6 +56,17 @@ SHRINK = 1e-9
 #: Overlap area (a share of the tab's area) above which a tab overlaps a face.
 OVERLAP = 1e-12
 
+#: A border no longer than this share of the tab height gets no tab.
+MIN_BORDER = 1e-9
+
+#: Relative round-off allowance of tab geometry: edges shorter than this share of the tab
+#: height are slivers, areas this close (relatively) are equal.
+SLIVER = 1e-6
+
+#: Smallest area of a candidate tab, as a share of its height squared: smaller ones are
+#: degenerate.
+LEAST_TAB = 1e-3
+
 #: A candidate that holds each (the same or a larger tab on the same hinge): 1 in 0, 4 in 2,
 #: 5 in 3 (side A, then B).
 COVER = (0, 1, 0, 1, 4, 5, 6, 7, 4, 5, 6, 7)
@@ -257,12 +268,13 @@ def tab_outlines(ends: np.ndarray, normal: np.ndarray, height) -> tuple[np.ndarr
     quads : (n, 4, 2) float
         ``p0, p1``, then the far side, inset at both ends by ``min(height, 0.3 * length)``.
     ok : (n,) bool
-        False where the segment is too short for a tab (no more than ``1e-9 * height``).
+        False where the segment is too short for a tab (no more than :data:`MIN_BORDER`
+        times ``height``).
     """
     height = np.broadcast_to(np.asarray(height, dtype=np.float64), (len(ends),))
     p0, p1 = ends[:, 0], ends[:, 1]
     length = _rownorm(p1 - p0)
-    ok = ~(length <= 1e-9 * height)
+    ok = ~(length <= MIN_BORDER * height)
     with np.errstate(invalid="ignore", divide="ignore"):
         d = (p1 - p0) / length[:, None]
     inset = np.where(0.3 * length < height, 0.3 * length, height)[:, None]
@@ -430,7 +442,7 @@ class _Faces:
             "ny": np.ascontiguousarray(normal[..., 1].T),
             "off": np.ascontiguousarray(offset.T + s / 2),
             "inner": shrink_convex(local, s / 2, normal),  # about the origin
-            "least": 1e-9 * area + 2 * s * perimeter,
+            "least": SHRINK * area + 2 * s * perimeter,
             "reach": abs_max(quads) + abs_max(local) + self.h,
             "wide": np.zeros(n, dtype=bool),
         }
@@ -637,7 +649,7 @@ def _tabs_and_labels(p, tab_height, part_names):
     if len(start) > 1:
         ea, na = _segments(p, side_a, start)
         eb, nb = _segments(p, side_b, start)
-        long = _rownorm(ea[:, 1] - ea[:, 0]) > 1e-6 * tab_height  # shorter: round-off slivers
+        long = _rownorm(ea[:, 1] - ea[:, 0]) > SLIVER * tab_height  # shorter: round-off
         ends, normal = np.stack([ea, eb], axis=1)[long], np.stack([na, nb], axis=1)[long]
         first_a, first_b = side_a[start[:-1][long]], side_b[start[:-1][long]]
     n_runs = len(ends)
@@ -703,7 +715,7 @@ def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list
     area = faces.areas()
     best = np.full(p.n_pieces, -np.inf)
     np.maximum.at(best, piece[inside], area[inside])
-    close = inside[~(area[inside] < best[piece[inside]] * (1 - 1e-6))]  # NaN kept: ask
+    close = inside[~(area[inside] < best[piece[inside]] * (1 - SLIVER))]  # NaN kept: ask
     exact = np.full(n, -np.inf)
     exact[close] = area[close]
     tie = close[np.bincount(piece[close], minlength=p.n_pieces)[piece[close]] > 1]
@@ -806,9 +818,9 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
         quads[row(c)] = q
         c, q, height = c[ok], np.compress(ok, q, axis=0), height[ok]
-        area, least = polygon_area(q), 1e-3 * height**2
+        area, least = polygon_area(q), LEAST_TAB * height**2
         valid = surely_valid(q)
-        doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > 1e-6 * least))
+        doubt = np.flatnonzero(~valid | ~(np.abs(area - least) > SLIVER * least))
         if len(doubt):
             shapes = _closed_polygons(q[doubt])
             valid[doubt], area[doubt] = shapely.is_valid(shapes), shapely.area(shapes)

@@ -33,6 +33,10 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import MeshError
 
+#: Added to the diagonal of planarize's normal equations (``A A^T``), which are singular when
+#: polygons share their constraints: far below their entries, so the step is the least-norm one.
+REGULARISE = 1e-12
+
 
 @dataclass(frozen=True)
 class Repair:
@@ -757,6 +761,6 @@ def _plane_step(idx, face, n, d, q, diam, n_vertices: int) -> np.ndarray:
         axis=1,
     ).ravel()
     a = sp.csr_matrix((vals, (rows, cols)), shape=(m, base + 3 * n_faces))
-    normal = (a @ a.T + 1e-12 * sp.identity(m, format="csr")).tocsc()
+    normal = (a @ a.T + REGULARISE * sp.identity(m, format="csr")).tocsc()
     y = spsolve(normal, -d, permc_spec="MMD_AT_PLUS_A")
     return (a.T @ y)[:base].reshape(-1, 3)
