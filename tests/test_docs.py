@@ -1,4 +1,5 @@
-"""docs/method.md names functions that exist, and the code cites it, not outside notes."""
+"""docs/method.md names functions that exist, the code cites it, not outside notes, and the
+README tree and the package docstrings name every module."""
 
 from __future__ import annotations
 
@@ -68,3 +69,32 @@ def test_code_cites_the_docs_not_outside_notes():
         if any(word in text for word in OUTSIDE):
             hits.append(str(path.relative_to(ROOT)))
     assert not hits, hits
+
+
+STAGES = ("mesh", "rounding", "vertex", "surface", "layout")
+
+
+def _readme_tree() -> dict[str, str]:
+    """The README's package tree ("What it computes"): folder -> its text."""
+    text = (ROOT / "README.md").read_text()
+    block = text.split("```\nsrc/filletfold/\n", 1)[1].split("```", 1)[0]
+    tree, folder = {}, None
+    for line in block.splitlines():
+        m = re.match(r"  (\w+)/\s", line)
+        if m:
+            folder = m.group(1)
+            tree[folder] = ""
+        tree[folder] += " " + line
+    return tree
+
+
+def test_the_readme_tree_and_the_package_docstrings_name_every_module():
+    tree = _readme_tree()
+    assert set(STAGES) <= set(tree)
+    for stage in STAGES:
+        folder = ROOT / "src" / "filletfold" / stage
+        modules = sorted(p.stem for p in folder.glob("*.py") if p.stem != "__init__")
+        doc = importlib.import_module(f"filletfold.{stage}").__doc__
+        for name in modules:
+            assert re.search(rf"\b{name}\b", tree[stage]), f"README tree lacks {stage}/{name}"
+            assert f":mod:`.{name}`" in doc, f"filletfold.{stage}'s docstring lacks {name}"

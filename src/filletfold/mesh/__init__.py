@@ -1,4 +1,6 @@
-"""Meshes: reading, built-in examples, validation and half-edge connectivity.
+"""Stage 1, the mesh: reading (:mod:`.io`), built-in examples and tessellations
+(:mod:`.examples`, :mod:`.tessellations`), validation, cleaning and repair (:mod:`.clean`,
+:mod:`.repair`, :mod:`.intersect`) and half-edge connectivity (:mod:`.polymesh`).
 
 :func:`load_mesh` is the one entry point front ends call: it accepts a file, a built-in example
 name, a ``(vertices, faces)`` pair or a :class:`PolyMesh`, and returns a cleaned mesh.

@@ -1,5 +1,6 @@
-"""Steps 3 and 4, the surface: each vertex's module (cone, half-cylinders, face shares; the
+"""Stages 4 and 5, the surface: each vertex's module (cone, half-cylinders, face shares; the
 curved creases of eq. (1) and the straight creases on the faces) as flat pieces with their
-folded positions, built for all vertices at once (:mod:`.module`; :mod:`.piece`, :mod:`.faces`,
-:mod:`.overlap`, :mod:`.centres`), and the crease pattern they assemble into
-(:mod:`.assemble`, :mod:`.pattern`)."""
+folded positions, built for all vertices at once (:mod:`.module`; the fans of sharp vertices
+:mod:`.sharp`; :mod:`.piece`, :mod:`.faces`, :mod:`.overlap`, :mod:`.centres`), the crease
+pattern they assemble into (:mod:`.assemble`, :mod:`.pattern`) and its validation
+(:mod:`.validate`)."""
