@@ -171,7 +171,9 @@ def test_cli_round_every_sheet_every_cut_format(sheet, tmp_path):
     group = svg.split('<g id="sheets"', 1)[1].split("</g>", 1)[0]
     rects = re.findall(r'width="([\d.]+)" height="([\d.]+)"', group)
     assert len(rects) == n_sheets
-    sides = [sorted(float(v) for v in r) for r in rects]
+    view_w = float(re.search(r'viewBox="0 0 ([\d.]+)', svg).group(1))
+    user = view_w / float(re.search(r'width="([\d.]+)mm"', svg).group(1))  # user units per mm
+    sides = [sorted(float(v) / user for v in r) for r in rects]
     assert_allclose(sides, [sorted([width, height])] * n_sheets, atol=2e-3)
     # the DXF read back, in mm; the PNG a picture
     doc = ezdxf.read(io.StringIO((out / "pattern.dxf").read_text()))

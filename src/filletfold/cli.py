@@ -6,13 +6,14 @@ Commands
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
 ``[--coplanar-tol DEG]``
-``[--format LIST] [--units U] [--scale S] [--sheet PAGE]``
+``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
     pictures).
 ``filletfold app [MESH] [--port N] [--host ADDR]``
     Start the browser app (viser) on MESH and print its address.
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
+``[--preset NAME]``
     Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
     ``pattern.svg``) and pictures (``pattern.png``, ``preview.png``) into ``DIR``.
 ``filletfold check DIR [--json]``
@@ -112,6 +113,16 @@ ScaleOption = Annotated[
     typer.Option(
         "--scale",
         help="Drawing units per mesh length unit in the DXF, SVG and PDF (default 1).",
+    ),
+]
+PresetOption = Annotated[
+    str | None,
+    typer.Option(
+        "--preset",
+        help="Cutter preset of pattern.svg and pattern.dxf: origami-simulator (Origami "
+        "Simulator's colours and fold-angle opacities; DXF layers CUT/MOUNTAIN/VALLEY/TAB/LABEL), "
+        "laser (hairlines, cut red, scores blue/green), plotter (dashed score lines) or card "
+        "(perforated fold lines) [default: origami-simulator].",
     ),
 ]
 SheetOption = Annotated[
@@ -276,6 +287,7 @@ def round_cmd(
     units: UnitsOption = "",
     scale: ScaleOption = None,
     sheet: SheetOption = None,
+    preset: PresetOption = None,
     no_tabs: Annotated[
         bool, typer.Option("--no-tabs", help="No glue tabs, seam labels or part numbers.")
     ] = False,
@@ -297,7 +309,7 @@ def round_cmd(
     try:
         chosen = parse_formats(formats if formats is not None else DEFAULT_FORMATS)
         # check units, scale and page before the (slow) design
-        _check_export_options(units, scale, sheet)
+        _check_export_options(units, scale, sheet, preset)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
     try:
@@ -342,7 +354,13 @@ def round_cmd(
         if dry_run:
             return
         written = export_design(
-            design, target, formats=chosen, units=units, scale=scale, page=sheet or "A4"
+            design,
+            target,
+            formats=chosen,
+            units=units,
+            scale=scale,
+            page=sheet or "A4",
+            preset=preset,
         )
     except typer.Exit:
         raise
@@ -354,9 +372,11 @@ def round_cmd(
         raise _error(f"the design fails its certificate ({names}): see report.json")
 
 
-def _check_export_options(units: str, scale, sheet: str | None) -> None:
-    """Raise the ParameterError that writing would raise for ``units``, ``scale`` or ``sheet``."""
+def _check_export_options(units: str, scale, sheet: str | None, preset=None) -> None:
+    """Raise the ParameterError that writing would raise for ``units``, ``scale``, ``sheet`` or
+    ``preset``."""
     from .export.dxf import check_scale
+    from .export.presets import get_preset
     from .units import check_units, sheet_size_mm
 
     check_units(units, unitless=True)
@@ -364,6 +384,7 @@ def _check_export_options(units: str, scale, sheet: str | None) -> None:
         check_scale(scale)
     if sheet is not None:
         sheet_size_mm(sheet)
+    get_preset(preset)
 
 
 @app.command("export")
@@ -375,6 +396,7 @@ def export_cmd(
     units: UnitsOption = "",
     scale: ScaleOption = None,
     sheet: SheetOption = None,
+    preset: PresetOption = None,
 ):
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
@@ -395,14 +417,16 @@ def export_cmd(
                 f"format {bad[0]} cannot be written from design.fold (export writes "
                 f"{', '.join(EXPORT_FORMATS)}; use 'filletfold round' for fold and json)"
             )
-        _check_export_options(units, scale, sheet)
+        _check_export_options(units, scale, sheet, preset)
         if not folder.is_dir():
             raise _error(f"{folder}: no such folder (write a design with 'filletfold round')")
         source = folder / "design.fold"
         if not source.is_file():
             raise _error(f"{source}: no design.fold in {folder} (write it with 'filletfold round')")
         pattern = read_fold(source)
-        files = cut_files(pattern, chosen, units=units, scale=scale, page=sheet or "A4")
+        files = cut_files(
+            pattern, chosen, units=units, scale=scale, page=sheet or "A4", preset=preset
+        )
         written = write_outputs(folder, files)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None

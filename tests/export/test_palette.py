@@ -1,4 +1,5 @@
-"""One palette (:mod:`filletfold.export.palette`) for the SVG, PDF and PNG drawings."""
+"""One palette (:mod:`filletfold.export.palette`) for the PDF and PNG drawings; the SVG follows
+its cutter preset."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ import re
 import zlib
 
 from filletfold.export import pattern_dxf, pattern_pdf, pattern_svg
-from filletfold.export.palette import ASSIGNMENT_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
+from filletfold.export.palette import ASSIGNMENT_COLOR, TAB_HINGE_COLOR
+from filletfold.export.presets import get_preset
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -29,17 +31,19 @@ def pdf_stroke_colors(data: bytes) -> set[str]:
     return colors
 
 
-def test_svg_and_pdf_draw_with_one_palette(cube):
+def test_pdf_draws_with_the_palette_and_svg_with_its_preset(cube):
     svg = pattern_svg(cube.pattern)
     pdf = pattern_pdf(cube.pattern, scale=20.0)
     present = set(cube.pattern.edge_assignment) - {"F"}
     assert {"M", "B"} <= present
     used = {ASSIGNMENT_COLOR[a] for a in present} | {TAB_HINGE_COLOR}
     assert used <= pdf_stroke_colors(pdf)
+    preset = get_preset()  # the SVG's default: Origami Simulator's colours
+    role = {"M": "mountain", "V": "valley", "B": "cut"}
     for a in present:
-        assert f'stroke="{ASSIGNMENT_COLOR[a]}"' in svg, a
-    assert f'stroke="{TAB_HINGE_COLOR}"' in svg
-    assert f'fill="{LABEL_COLOR}"' in svg
+        assert f'stroke="{getattr(preset, role[a]).color}"' in svg, a
+    assert f'stroke="{preset.tab.color}"' in svg
+    assert f'fill="{preset.label.color}"' in svg
 
 
 def test_dxf_classes_are_sorted(cube):

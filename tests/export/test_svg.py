@@ -11,10 +11,10 @@ import pytest
 from numpy.testing import assert_allclose
 
 from filletfold.errors import ParameterError
-from filletfold.export import (
-    pattern_svg,
-)
-from filletfold.export.svg import nice_length
+from filletfold.export import pattern_svg
+from filletfold.export.paths import pattern_extent
+from filletfold.export.presets import PRESETS
+from filletfold.export.svg import MIN_POINT_SPACING, nice_length
 
 from ..conftest import PATTERNS, signed_area, square_pattern, strip_pattern, two_pieces
 from .conftest import arc_pattern
@@ -40,6 +40,24 @@ def _lines(group):
     return group.findall(SVG_NS + "line")
 
 
+def _user_per_mm(root) -> float:
+    """User units per printed millimetre (viewBox width over ``width``)."""
+    _, _, w, _ = map(float, root.get("viewBox").split())
+    return w / float(root.get("width")[:-2])
+
+
+def _endpoints(root, gids) -> np.ndarray:
+    """(k, 2) the end points of the ``<line>`` elements of the groups ``gids``."""
+    pts = [
+        (float(ln.get("x" + k)), float(ln.get("y" + k)))
+        for g in root.iter(SVG_NS + "g")
+        if g.get("id") in gids
+        for ln in _lines(g)
+        for k in ("1", "2")
+    ]
+    return np.array(pts).reshape(-1, 2)
+
+
 @pytest.mark.parametrize(
     ("name", "counts"),
     [
@@ -50,55 +68,50 @@ def _lines(group):
     ],
 )
 def test_svg_groups_and_colours(name, counts):
-    root = _svg(PATTERNS[name]())
-    colour = {"mountain": "#ff0000", "valley": "#0000ff", "border": "#000000"}
+    pattern = PATTERNS[name]()
+    root = _svg(pattern)
+    colour = {"mountain": "#ff0000", "valley": "#0000ff", "border": "#000000", "flat": "#ffff00"}
+    counts = {**counts, "flat": int(np.sum(pattern.edge_assignment == "F"))}
     for gid, n in counts.items():
         lines = _lines(_group(root, gid))
         assert len(lines) == n
         assert all(ln.get("stroke") == colour[gid] for ln in lines)
-    assert not [g for g in root.iter(SVG_NS + "g") if g.get("id") == "flat"]
 
 
 def test_svg_flat_edges_optional():
-    root = _svg(strip_pattern(), flat_edges=True)
-    flat = _lines(_group(root, "flat"))
-    assert len(flat) == 1 and flat[0].get("stroke") == "#dddddd"
+    root = _svg(strip_pattern(), flat_edges=False)
+    assert not [g for g in root.iter(SVG_NS + "g") if g.get("id") == "flat"]
+    flat = _lines(_group(_svg(strip_pattern()), "flat"))
+    assert len(flat) == 1 and flat[0].get("stroke") == "#ffff00"
 
 
 def test_svg_not_mirrored_and_inside_viewbox(pattern):
     root = _svg(pattern)
     x0, y0, w, h = map(float, root.get("viewBox").split())
     assert (x0, y0) == (0.0, 0.0)
-    pts = {}
-    ids = {"mountain", "valley", "border"}
-    for g in root.iter(SVG_NS + "g"):
-        if g.get("id") not in ids:
-            continue
-        for ln in _lines(g):
-            for k in ("1", "2"):
-                x, y = float(ln.get("x" + k)), float(ln.get("y" + k))
-                assert 0 < x < w and 0 < y < h
-                pts[(x, y)] = True
-    # map pattern vertices to drawing coordinates through the border lines: the drawing is a
-    # translation plus a y flip, so faces that are CCW in the pattern have negative signed area
-    # in SVG's y-down coordinates (they look counter-clockwise on screen, not mirrored)
+    pts = _endpoints(root, {"mountain", "valley", "border"})
+    assert ((pts > 0) & (pts < [w, h])).all()
+    # the drawing is a translation, a scale and a y flip, so faces that are CCW in the pattern
+    # have negative signed area in SVG's y-down coordinates (counter-clockwise on screen)
     v = pattern.vertices_2d
     sx = v[:, 0] - v[:, 0].min()
     sy = v[:, 1].max() - v[:, 1]
-    xs = np.array(sorted({p[0] for p in pts}))
-    ys = np.array(sorted({p[1] for p in pts}))
-    assert_allclose(xs - xs.min(), np.unique(np.round(sx, 9)), atol=1e-6)
-    assert_allclose(ys - ys.min(), np.unique(np.round(sy, 9)), atol=1e-6)
+    xs = np.unique(pts[:, 0])
+    ys = np.unique(pts[:, 1])
+    k = np.ptp(xs) / np.ptp(sx)
+    assert_allclose((xs - xs.min()) / k, np.unique(np.round(sx, 9)), atol=1e-6)
+    assert_allclose((ys - ys.min()) / k, np.unique(np.round(sy, 9)), atol=1e-6)
     for f in pattern.faces:
         assert signed_area(np.c_[sx, sy][f]) < 0
 
 
 def test_svg_scale_bar_and_legend():
     root = _svg(two_pieces(), units="cm")
+    user_per_cm = 10 * _user_per_mm(root)
     bar = _group(root, "scale-bar")
     rect = bar.find(SVG_NS + "rect")
     text = bar.find(SVG_NS + "text")
-    length = float(rect.get("width"))
+    length = float(rect.get("width")) / user_per_cm
     label = text.text
     assert re.fullmatch(r"[0-9.]+ cm", label)
     assert float(label.split()[0]) == pytest.approx(length)
@@ -107,41 +120,98 @@ def test_svg_scale_bar_and_legend():
     width = np.ptp(two_pieces().vertices_2d[:, 0])
     assert width / 5 / 2 <= length <= width / 5 * 2
     # below the drawing
-    drawing_bottom = max(
-        float(ln.get(k)) for ln in root.iter(SVG_NS + "line") for k in ("y1", "y2")
-    )
+    drawing_bottom = _endpoints(root, {"mountain", "valley", "border"})[:, 1].max()
     assert float(rect.get("y")) > drawing_bottom
     legend = " ".join(t.text for t in _group(root, "legend").iter(SVG_NS + "text"))
-    for word in ("mountain", "valley", "border / cut"):
+    for word in ("mountain", "valley", "border / cut", "facet"):
         assert word in legend
 
 
 def test_svg_physical_size_and_stroke():
     root = _svg(square_pattern(90.0), units="cm", stroke_mm=0.5)
-    _, _, w, h = map(float, root.get("viewBox").split())
-    assert root.get("width").endswith("mm")
-    assert float(root.get("width")[:-2]) == pytest.approx(w * 10, abs=1e-3)
-    assert float(root.get("height")[:-2]) == pytest.approx(h * 10, abs=1e-3)
-    assert float(_group(root, "border").get("stroke-width")) == pytest.approx(0.05)
+    user = _user_per_mm(root)
+    assert math.log10(user) == pytest.approx(round(math.log10(user)))  # a power of ten
+    assert user >= 1
+    h = float(root.get("viewBox").split()[3])
+    assert float(root.get("height")[:-2]) == pytest.approx(h / user, abs=1e-3)
+    assert float(_group(root, "border").get("stroke-width")) == pytest.approx(0.5 * user)
+    # the 1 x 1 cm square, drawn 10 mm wide
+    pts = _endpoints(root, {"border"})
+    assert np.ptp(pts[:, 0]) / user == pytest.approx(10.0)
 
 
 def test_svg_unitless_prints_200mm():
     root = _svg(square_pattern(90.0))
-    _, _, w, _ = map(float, root.get("viewBox").split())
-    # the 1 x 1 pattern is printed 200 mm wide, so 1 user unit = 200 mm
-    assert float(root.get("width")[:-2]) == pytest.approx(w * 200, abs=1e-3)
+    pts = _endpoints(root, {"border"})
+    # the 1 x 1 pattern is printed 200 mm wide
+    assert np.ptp(pts[:, 0]) / _user_per_mm(root) == pytest.approx(200.0)
+
+
+@pytest.mark.parametrize("n", [40, 4000])
+def test_svg_points_far_apart_for_origami_simulator(n):
+    """The two closest distinct drawn points are >= 30 user units apart: ten times Origami
+    Simulator's vertex merge tolerance, however fine the curve is sampled."""
+    from scipy.spatial import cKDTree
+
+    root = ET.fromstring(pattern_svg(arc_pattern(n)))
+    pts = np.unique(_endpoints(root, {"flat", "border", "mountain", "valley"}), axis=0)
+    d, _ = cKDTree(pts).query(pts, k=2)
+    assert d[:, 1].min() >= MIN_POINT_SPACING
+    assert d[:, 1].min() < 10 * MIN_POINT_SPACING  # the smallest power of ten that does it
 
 
 def test_svg_angle_opacity():
-    root = _svg(two_pieces(), angle_opacity=True)
+    root = _svg(two_pieces())
     (valley,) = _lines(_group(root, "valley"))
     (mountain,) = _lines(_group(root, "mountain"))
-    assert float(valley.get("opacity")) == pytest.approx(60 / 180, abs=1e-4)
-    assert float(mountain.get("opacity")) == pytest.approx(45 / 180, abs=1e-4)
+    assert float(valley.get("stroke-opacity")) == pytest.approx(60 / 180, abs=1e-6)
+    assert float(mountain.get("stroke-opacity")) == pytest.approx(45 / 180, abs=1e-6)
+    root = _svg(two_pieces(), angle_opacity=False)
+    assert _lines(_group(root, "valley"))[0].get("stroke-opacity") is None
+
+
+def test_svg_every_crease_opacity_is_its_angle():
+    pattern = arc_pattern(annotated=True)
+    root = _svg(pattern)
+    v = pattern.vertices_2d
+    lo, hi = pattern_extent(pattern)
+    k = _user_per_mm(root) * 200 / (hi - lo).max()  # unitless: the larger side is 200 mm
+    for code, gid in (("M", "mountain"), ("V", "valley")):
+        sel = np.flatnonzero(pattern.edge_assignment == code)
+        lines = _lines(_group(root, gid))
+        assert len(lines) == len(sel)
+        for e, ln in zip(sel, lines, strict=True):
+            a, b = v[pattern.edges[e]]
+            got = float(ln.get("x2")) - float(ln.get("x1"))
+            assert got == pytest.approx((b[0] - a[0]) * k, abs=1e-6 * k)
+            want = abs(pattern.edge_fold_angle[e]) / 180
+            assert float(ln.get("stroke-opacity")) == pytest.approx(want, abs=5e-7)
+
+
+def test_svg_default_has_no_unstroked_shape_outside_defs(cube):
+    """What Origami Simulator reads: every line, rect, path, polygon and polyline outside
+    ``<defs>`` has one of the stroke colours it knows; the legend sits inside ``<defs>``."""
+    known = {"#000000", "#ff0000", "#0000ff", "#00ff00", "#ffff00", "#ff00ff"}
+    root = ET.fromstring(pattern_svg(cube.pattern))
+    shapes = ("line", "rect", "path", "polygon", "polyline")
+    (defs,) = root.findall(SVG_NS + "defs")
+    hidden = set(map(id, defs.iter()))
+    seen = 0
+    for el in root.iter():
+        if el.tag.removeprefix(SVG_NS) in shapes and id(el) not in hidden:
+            assert el.get("stroke") in known, ET.tostring(el)[:80]
+            seen += 1
+    assert seen > 1000
+    assert any(el.tag == SVG_NS + "rect" for el in defs.iter())  # legend and scale bar
+    (use,) = root.findall(SVG_NS + "use")
+    assert use.get("href") == "#annotation"
+    assert _group(root, "annotation") in list(defs)
 
 
 def test_svg_deterministic():
-    assert pattern_svg(two_pieces(), units="mm") == pattern_svg(two_pieces(), units="mm")
+    for name in PRESETS:
+        a = pattern_svg(arc_pattern(annotated=True), units="mm", preset=name)
+        assert a == pattern_svg(arc_pattern(annotated=True), units="mm", preset=name)
 
 
 @pytest.mark.parametrize(
@@ -150,6 +220,7 @@ def test_svg_deterministic():
         ({"units": "furlong"}, "units must be one of"),
         ({"stroke_mm": 0.0}, "stroke_mm must be a positive"),
         ({"stroke_mm": float("nan")}, "stroke_mm must be a positive"),
+        ({"preset": "lazer"}, "unknown preset 'lazer': choose from origami-simulator, laser"),
     ],
 )
 def test_svg_parameters_rejected(kw, match):
@@ -180,8 +251,10 @@ def test_svg_draws_annotations():
     assert cut.tag == f"{SVG_NS}polyline" and cut.get("stroke") == "#000000"
     assert len(cut.get("points").split()) == 4  # the outline without its hinge
     assert groups["tab-hinge"].get("stroke-dasharray")
-    assert [c.get("stroke") for c in groups["tab-hinge"]] == ["#00a000"]
+    assert [c.get("stroke") for c in groups["tab-hinge"]] == ["#ff00ff"]  # the app's hinge
     assert len(list(groups["sheets"])) == 1
+    (defs,) = root.findall(SVG_NS + "defs")
+    assert groups["sheets"] in list(defs.iter())
     texts = {t.text: t for t in groups["labels"]}
     assert set(texts) == {"P1", "7"}
     assert texts["7"].get("transform").startswith("rotate(-30 ")

@@ -9,8 +9,10 @@ format     files                            content
 ``json``   ``report.json``                  the design report (needs the design, not only
                                             the pattern)
 ``obj``    ``folded.obj``                   the folded form
-``svg``    ``pattern.svg``                  the flat layout (Origami Simulator colours)
-``dxf``    ``pattern.dxf``                  cut file, layers CUT/MOUNTAIN/VALLEY/TAB/LABEL
+``svg``    ``pattern.svg``                  the flat layout (by default Origami Simulator's
+                                            colours; see ``preset``)
+``dxf``    ``pattern.dxf``                  cut file, by default layers CUT/MOUNTAIN/VALLEY/
+                                            TAB/LABEL (see ``preset``)
 ``pdf``    ``pattern.pdf``                  true-scale print, tiled on pages
 ``png``    ``pattern.png``, ``preview.png`` pictures of the layout and the folded form
 =========  ===============================  =================================================
@@ -20,7 +22,8 @@ drawn at ``scale`` (the SVG printed in ``units``; unitless, its larger side is 2
 needs a physical size: with ``units`` it prints at ``scale`` ``units`` per pattern unit; without
 ``units`` but with a ``scale`` it reads the scaled drawing in millimetres; with neither, it
 scales the drawing to fill one page (:func:`fit_page_scale`). FOLD, OBJ and PNG keep the
-design's own coordinates.
+design's own coordinates. A cutter ``preset`` (:mod:`~filletfold.export.presets`) sets the
+colours, layers, line widths and dash or perforation of the SVG and DXF.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
 from .png import pattern_png, preview_png
+from .presets import Preset, get_preset
 from .svg import _pattern_svg
 
 __all__ = [
@@ -207,6 +211,7 @@ def cut_files(
     description: str = "",
     report: Mapping | str | None = None,
     lazy: bool = False,
+    preset: str | Preset | None = None,
 ) -> dict:
     """Build the output files of ``formats`` for a crease pattern (nothing is written).
 
@@ -229,6 +234,9 @@ def cut_files(
         Return, for each file, a function without arguments that builds its contents (for
         :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
         at a time); the pattern is still checked here, once.
+    preset : str or Preset, optional
+        Cutter preset of the SVG and DXF (:data:`~filletfold.export.presets.PRESETS`; default
+        ``origami-simulator``).
 
     Returns
     -------
@@ -239,7 +247,8 @@ def cut_files(
     Raises
     ------
     ParameterError
-        For an unknown format, unit or page, a non-positive scale, or ``json`` without a report.
+        For an unknown format, unit, page or preset, a non-positive scale, or ``json`` without
+        a report.
     ExportError
         When the pattern is inconsistent.
     """
@@ -247,6 +256,7 @@ def cut_files(
     check_units(units, unitless=True)
     scale_given = scale is not None
     scale = 1.0 if scale is None else check_scale(scale)
+    preset = get_preset(preset)
     if "pdf" in formats:
         sheet_size_mm(page, name="page")
     if "json" in formats and report is None:
@@ -273,8 +283,14 @@ def cut_files(
         "fold": {"design.fold": fold},
         "json": {"report.json": lambda: report if isinstance(report, str) else report_json(report)},
         "obj": {"folded.obj": lambda: _folded_obj(pattern, faces)},
-        "svg": {"pattern.svg": lambda: _pattern_svg(scaled_pattern(pattern, scale), units=units)},
-        "dxf": {"pattern.dxf": lambda: pattern_dxf(pattern, units=units, scale=scale)},
+        "svg": {
+            "pattern.svg": lambda: _pattern_svg(
+                scaled_pattern(pattern, scale), units=units, preset=preset
+            )
+        },
+        "dxf": {
+            "pattern.dxf": lambda: pattern_dxf(pattern, units=units, scale=scale, preset=preset)
+        },
         "pdf": {"pattern.pdf": pdf},
         "png": {
             "pattern.png": lambda: pattern_png(pattern),

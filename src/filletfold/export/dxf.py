@@ -1,6 +1,8 @@
 """DXF (R2010) cut file of the flat crease pattern, for laser cutters, plotters and CAD.
 
-Layers and colours (ACI):
+Layers, colours, line weights and line styles come from a cutter preset
+(:mod:`filletfold.export.presets`). The default, ``origami-simulator``, has these layers and
+colours (ACI):
 
 ===========  ======  ==========================================================================
 layer        colour  content
@@ -15,6 +17,14 @@ layer        colour  content
 ``LABEL``    8 grey  ``TEXT`` entities of the labels (centred on their anchor, rotated)
 ``FLAT``     9       ``F`` edges, only with ``flat_edges=True``
 ===========  ======  ==========================================================================
+
+The other presets rename the layers (e.g. ``SCORE_MOUNTAIN``, ``PERF_VALLEY``, ``ENGRAVE``),
+give them true colours besides the ACI, and line weights (:func:`~filletfold.export.presets.
+dxf_lineweight`; a laser hairline is weight 0). A pen with a dash style gets its own linetype
+``DASH_<dash>_<gap>`` (lengths in millimetres, drawn in the drawing unit; unitless, read as
+millimetres); a perforated pen's lines are written as separate dash pieces
+(:func:`~filletfold.export.paths.dash_polylines`), one ``LWPOLYLINE`` each, so that a machine
+that ignores linetypes still perforates.
 
 Edges of one layer are chained end to end through vertices where exactly two of them meet
 (:func:`~filletfold.export.paths.edge_chains`); each chain is cut at corners and spacing jumps
@@ -40,17 +50,25 @@ import numpy as np
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
-from ..units import check_units
-from .paths import chain_runs, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
+from ..units import MM_PER_UNIT, check_units
+from .paths import (
+    chain_runs,
+    dash_polylines,
+    edge_chains,
+    edge_layer_masks,
+    pattern_extent,
+    tab_cut_paths,
+)
+from .presets import Preset, dxf_lineweight, get_preset, hex_rgb
 
 __all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
 
 #: ``$INSUNITS`` code of each drawing unit ("" = unitless): of every cut-file unit.
 DXF_INSUNITS = {"": 0, "in": 1, "mm": 4, "cm": 5, "m": 6}
-#: ACI colour of each layer, in the order the layers are created.
+#: ACI colour of each layer of the default preset, in the order the layers are created.
 LAYER_COLOR = {"CUT": 7, "MOUNTAIN": 1, "VALLEY": 5, "TAB": 3, "LABEL": 8, "FLAT": 9}
-#: Dash length of the TAB layer's linetype, as a share of the drawing's larger side.
-_DASH_SHARE = 0.005
+#: The preset role of each layer kind of :func:`~filletfold.export.paths.edge_layer_masks`.
+_ROLE = {"CUT": "cut", "MOUNTAIN": "mountain", "VALLEY": "valley", "FLAT": "flat"}
 
 
 def check_scale(scale) -> float:
@@ -63,7 +81,12 @@ def check_scale(scale) -> float:
 
 
 def pattern_dxf(
-    pattern: CreasePattern, *, units: str = "", scale: float = 1.0, flat_edges: bool = False
+    pattern: CreasePattern,
+    *,
+    units: str = "",
+    scale: float = 1.0,
+    flat_edges: bool = False,
+    preset: str | Preset | None = None,
 ) -> str:
     """The flat layout of a crease pattern as a DXF R2010 document.
 
@@ -79,7 +102,10 @@ def pattern_dxf(
         Drawing units per pattern length unit: every coordinate and text height is multiplied
         by it.
     flat_edges : bool
-        Also write the ``F`` edges, on layer ``FLAT``.
+        Also write the ``F`` edges, on the preset's flat layer (``FLAT``).
+    preset : str or Preset, optional
+        Cutter preset (:data:`~filletfold.export.presets.PRESETS`); default
+        ``origami-simulator``, whose layers are the table above.
 
     Returns
     -------
@@ -89,7 +115,7 @@ def pattern_dxf(
     Raises
     ------
     ParameterError
-        For an unknown ``units`` or a ``scale`` that is not a positive number.
+        For an unknown ``units`` or ``preset``, or a ``scale`` that is not a positive number.
     ExportError
         When the pattern is inconsistent.
     """
@@ -97,13 +123,14 @@ def pattern_dxf(
 
     check_units(units, unitless=True)
     scale = check_scale(scale)
+    preset = get_preset(preset)
     validate_pattern(pattern)
 
     fixed = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True  # fixed dates, GUIDs and markers
     try:
         doc = ezdxf.new("R2010", setup=False)
-        _fill(doc, pattern, units, scale, flat_edges)
+        _fill(doc, pattern, units, scale, flat_edges, preset)
         _sort_classes(doc)
         stream = io.StringIO()
         doc.write(stream)
@@ -127,7 +154,9 @@ def _sort_classes(doc) -> None:
     doc.classes.classes = OrderedDict(sorted(doc.classes.classes.items()))
 
 
-def _fill(doc, pattern: CreasePattern, units: str, scale: float, flat_edges: bool) -> None:
+def _fill(
+    doc, pattern: CreasePattern, units: str, scale: float, flat_edges: bool, preset: Preset
+) -> None:
     """Add the header variables, layers and entities of :func:`pattern_dxf` to ``doc``."""
     from ezdxf.enums import TextEntityAlignment
 
@@ -135,34 +164,73 @@ def _fill(doc, pattern: CreasePattern, units: str, scale: float, flat_edges: boo
     doc.header["$MEASUREMENT"] = 0 if units == "in" else 1
     lo, hi = pattern_extent(pattern)
     size = max(float((hi - lo).max()) * scale, 1e-12)
-    dash = _DASH_SHARE * size
-    doc.linetypes.add("DASHED", pattern=[2 * dash, dash, -dash], description="Dashed __ __ __")
-    layers = dict(LAYER_COLOR)
+    per_mm = 1.0 / MM_PER_UNIT[units] if units else 1.0  # drawing units per millimetre
+    pens = preset.pens()
     if not flat_edges:
-        del layers["FLAT"]
-    for name, color in layers.items():
-        layer = doc.layers.add(name, color=color)
-        if name == "TAB":
+        del pens["flat"]
+    for pen in pens.values():
+        layer = doc.layers.add(pen.layer, color=pen.aci)
+        if preset.true_color:
+            layer.rgb = hex_rgb(pen.color)
+        layer.dxf.lineweight = dxf_lineweight(pen.width_mm)
+        if pen.dash_share is not None:
+            dash = pen.dash_share * size
+            if "DASHED" not in doc.linetypes:
+                doc.linetypes.add(
+                    "DASHED", pattern=[2 * dash, dash, -dash], description="Dashed __ __ __"
+                )
             layer.dxf.linetype = "DASHED"
+        elif pen.dash_mm is not None:
+            on, off = pen.dash_mm
+            name = f"DASH_{on:g}_{off:g}".replace(".", "_")
+            if name not in doc.linetypes:
+                doc.linetypes.add(
+                    name,
+                    pattern=[(on + off) * per_mm, on * per_mm, -off * per_mm],
+                    description=f"Dashed {on:g} mm on, {off:g} mm off",
+                )
+            layer.dxf.linetype = name
     msp = doc.modelspace()
 
+    def perforated(pen, paths) -> None:
+        cut, gap = (x * per_mm for x in pen.perforation_mm)
+        for pts, closed in paths:
+            for dash in dash_polylines(pts, closed, cut, gap):
+                msp.add_lwpolyline(
+                    [(float(x), float(y)) for x, y in dash],
+                    format="xy",
+                    dxfattribs={"layer": pen.layer},
+                )
+
     v2 = pattern.vertices_2d * scale
-    for layer, mask in edge_layer_masks(pattern, flat_edges=flat_edges).items():
-        for chain, closed in edge_chains(pattern.edges, mask):
-            _add_path(msp, v2[chain], closed, layer)
-        if layer == "CUT":
+    for kind, mask in edge_layer_masks(pattern, flat_edges=flat_edges).items():
+        pen = pens[_ROLE[kind]]
+        chains = [(v2[chain], closed) for chain, closed in edge_chains(pattern.edges, mask)]
+        if pen.perforation_mm is not None:
+            perforated(pen, chains)
+        else:
+            for pts, closed in chains:
+                _add_path(msp, pts, closed, pen.layer)
+        if kind == "CUT":
             for pts, closed in tab_cut_paths(pattern.annotations):
-                _add_path(msp, np.asarray(pts) * scale, closed, "CUT")
-    for hinge in pattern.annotations.tab_hinges:
-        a, b = np.asarray(hinge, dtype=np.float64).reshape(2, 2) * scale
-        msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": "TAB"})
+                _add_path(msp, np.asarray(pts) * scale, closed, pen.layer)
+    tab = pens["tab"]
+    hinges = [
+        np.asarray(h, dtype=np.float64).reshape(2, 2) * scale
+        for h in pattern.annotations.tab_hinges
+    ]
+    if tab.perforation_mm is not None:
+        perforated(tab, [(h, False) for h in hinges])
+    else:
+        for a, b in hinges:
+            msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": tab.layer})
     for label in pattern.annotations.labels:
         pos = np.asarray(label.position, dtype=np.float64).reshape(2) * scale
         text = msp.add_text(
             str(label.text),
             height=float(label.height) * scale,
             rotation=float(label.angle),
-            dxfattribs={"layer": "LABEL"},
+            dxfattribs={"layer": pens["label"].layer},
         )
         text.set_placement(tuple(pos), align=TextEntityAlignment.MIDDLE_CENTER)
     doc.set_modelspace_vport(height=size * 1.1, center=tuple((lo + hi) / 2 * scale))

@@ -415,6 +415,7 @@ def export_design(
     units: str = "",
     scale: float | None = None,
     page: str = "A4",
+    preset=None,
 ) -> list[Path]:
     """Write the design's files into ``folder`` atomically (all of them or none).
 
@@ -434,6 +435,9 @@ def export_design(
     units, scale, page
         Real size of the cut files and PDF page (see
         :func:`~filletfold.export.cutfiles.cut_files`).
+    preset : str or Preset, optional
+        Cutter preset of ``pattern.svg`` and ``pattern.dxf``
+        (:data:`~filletfold.export.presets.PRESETS`; default ``origami-simulator``).
 
     Returns
     -------
@@ -455,6 +459,7 @@ def export_design(
             title=title,
             description="Curved-crease rounded design: vertex modules",
             lazy=True,  # built one at a time as they are written
+            preset=preset,
         )
     if "json" in formats:
 

@@ -1,8 +1,9 @@
-"""Colours of the drawn layouts, the one table shared by the SVG, PDF and PNG writers.
+"""Colours of the drawn pictures, the one table shared by the PDF and PNG writers.
 
 The edge colours are the ones Origami Simulator reads from an SVG (mountain red, valley blue,
-border/cut black); the tab-hinge green is not Origami Simulator's cut green ``#00ff00``. The
-DXF's layers carry AutoCAD colour indices instead (:data:`~filletfold.export.dxf.LAYER_COLOR`).
+border/cut black). The SVG and DXF follow a cutter preset instead
+(:mod:`~filletfold.export.presets`: pens with colours, layers, widths); the SVG uses
+:data:`SHEET_COLOR` for its sheet outlines.
 """
 
 from __future__ import annotations

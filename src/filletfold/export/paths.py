@@ -23,6 +23,7 @@ __all__ = [
     "annotation_points",
     "chain_is_smooth",
     "chain_runs",
+    "dash_polylines",
     "edge_chains",
     "edge_layer_masks",
     "label_positions",
@@ -275,6 +276,50 @@ def chain_runs(points: np.ndarray, closed: bool = False) -> list[tuple[np.ndarra
     if closed and len(runs) == 1 and not runs[0][1]:
         return [(runs[0][0][:-1], False, True)]
     return runs
+
+
+def dash_polylines(points: np.ndarray, closed: bool, dash: float, gap: float) -> list[np.ndarray]:
+    """Cut a path into dashes of length ``dash`` with ``gap`` between them (a perforation).
+
+    The dashes are centred on the path: ``n = floor((L + gap) / (dash + gap))`` of them for a
+    path of length ``L``, with equal leftovers at both ends. A path shorter than one dash and
+    one gap gets one centred dash of ``dash / (dash + gap)`` of its length. A dash follows the
+    path through its corners.
+
+    Parameters
+    ----------
+    points : (k, 2) float
+    closed : bool
+        The path returns from the last point to the first.
+    dash, gap : float
+        Positive lengths.
+
+    Returns
+    -------
+    list of (j, 2) float
+        The dashes, in order along the path, each from its start to its end point.
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    if closed and len(p) > 1:
+        p = np.vstack([p, p[:1]])
+    if len(p) < 2:
+        return []
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    length = float(s[-1])
+    if not length > 0:
+        return []
+    period = dash + gap
+    n = int(np.floor((length + gap) / period))
+    if n == 0:
+        n, dash = 1, length * dash / period
+    start = 0.5 * (length - (n * dash + (n - 1) * gap))
+    a = start + period * np.arange(n)
+    b = a + dash
+    ends = np.c_[np.interp(a, s, p[:, 0]), np.interp(a, s, p[:, 1])]
+    tips = np.c_[np.interp(b, s, p[:, 0]), np.interp(b, s, p[:, 1])]
+    lo = np.searchsorted(s, a, side="right")  # first path point after the dash's start
+    hi = np.searchsorted(s, b, side="left")  # first path point at or after its end
+    return [np.vstack([ends[i], p[lo[i] : hi[i]], tips[i]]) for i in range(n)]
 
 
 def _breaks(p: np.ndarray) -> np.ndarray:

@@ -1,16 +1,28 @@
 """SVG drawing of the flat crease pattern, to print, cut, or load into Origami Simulator.
 
-Each edge is a ``<line>`` carrying its own ``stroke`` colour, in one group per assignment:
-mountain ``#ff0000``, valley ``#0000ff``, border/cut ``#000000`` (the colours Origami Simulator
-reads) and, optionally, flat ``#dddddd``. The y axis is flipped so the drawing is not mirrored.
-The scale bar and legend below the drawing are filled shapes without stroke and text, in a
-separate ``annotation`` group, so stroke-colour readers (Origami Simulator, laser software)
-ignore them.
+The drawing follows a cutter preset (:mod:`filletfold.export.presets`); the default,
+``origami-simulator``, is a file Origami Simulator imports without a warning:
 
-A pattern's annotations are drawn when present: the cut part of each glue-tab outline black
-(group ``tab-cut``), the tab hinges green ``#00a000`` dashed (``tab-hinge``; not Origami
-Simulator's cut green ``#00ff00``), the sheet outlines thin grey ``#999999`` (``sheets``) and
-the labels as filled text, rotated, in the ``annotation`` group (``labels``).
+* each edge is a ``<line>`` carrying its own ``stroke`` colour, in one group per assignment:
+  facet ``#ffff00`` (``F`` edges, group ``flat``), border/cut ``#000000``, valley ``#0000ff``,
+  mountain ``#ff0000``, and each mountain and valley line has ``stroke-opacity`` =
+  |fold angle| / 180 (the app's target fold angle);
+* the tab hinges are magenta ``#ff00ff`` (the app's passive hinge), the cut part of each tab
+  outline black (groups ``tab-hinge``, ``tab-cut``);
+* the scale bar, legend and sheet outlines (groups ``scale-bar``, ``legend``, ``sheets``) sit in
+  a ``<g id="annotation">`` inside ``<defs>``, drawn by a ``<use>``: the app removes ``<defs>``
+  before it reads strokes, every other viewer shows them. Labels are filled ``<text>`` (group
+  ``labels``), which the app does not read;
+* the viewBox is in units of :math:`10^{-j}` mm (``width``/``height`` give the printed size),
+  ``j >= 0`` the smallest that puts the two closest drawn points at least
+  :data:`MIN_POINT_SPACING` user units apart (ten times the app's 3-unit vertex merge
+  tolerance), so no two vertices collapse on import.
+
+The cutter presets draw the edges of a layer joined end to end as ``<polyline>`` (or
+``<polygon>``) paths, their pens' widths and colours, dashed score lines as a
+``stroke-dasharray``, perforated ones as separate dash pieces, and no legend, scale bar or sheet
+outlines (nothing is cut or engraved that is not the pattern). The y axis is flipped so the
+drawing is not mirrored.
 """
 
 from __future__ import annotations
@@ -25,23 +37,40 @@ from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units
-from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
-from .paths import label_positions, pattern_extent, tab_cut_paths
+from .palette import SHEET_COLOR
+from .paths import (
+    dash_polylines,
+    edge_chains,
+    label_positions,
+    pattern_extent,
+    simplify_polyline,
+    tab_cut_paths,
+)
+from .presets import Pen, Preset, get_preset
 
-__all__ = ["nice_length", "pattern_svg"]
+__all__ = ["MIN_POINT_SPACING", "nice_length", "pattern_svg", "svg_user_per_mm"]
 
-#: Group id and legend label of each edge assignment, in drawing order (bottom first).
+#: Group id, assignment and legend label of each edge group, in drawing order (bottom first).
 _GROUPS = (
-    ("F", "flat", "flat"),
+    ("F", "flat", "facet (flat)"),
     ("B", "border", "border / cut"),
     ("V", "valley", "valley"),
     ("M", "mountain", "mountain"),
 )
+#: Role of each assignment's pen in a preset.
+_ROLE = {"F": "flat", "B": "cut", "V": "valley", "M": "mountain"}
 #: Printed size (mm) of the larger side of the drawing when no unit is given.
 _UNITLESS_MM = 200.0
 _MARGIN_MM = 10.0
 _FONT_MM = 3.5
 _SWATCH_MM = 8.0
+#: Smallest distance, in user units, between two distinct drawn points: ten times Origami
+#: Simulator's default vertex merge tolerance (3 user units).
+MIN_POINT_SPACING = 30.0
+#: Largest viewBox side (user units) the spacing rule may ask for.
+_MAX_USER_EXTENT = 1e7
+#: Points closer than this share of the drawing's size are one point (round-off).
+_SAME_POINT = 1e-9
 
 
 def nice_length(target: float) -> float:
@@ -93,9 +122,10 @@ def pattern_svg(
     pattern: CreasePattern,
     *,
     units: str = "",
-    stroke_mm: float = 0.3,
-    flat_edges: bool = False,
-    angle_opacity: bool = False,
+    preset: str | Preset | None = None,
+    stroke_mm: float | None = None,
+    flat_edges: bool | None = None,
+    angle_opacity: bool | None = None,
 ) -> str:
     """The flat layout of a crease pattern as an SVG document.
 
@@ -107,13 +137,16 @@ def pattern_svg(
         Length unit of the pattern coordinates: ``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"pt"``,
         or ``""`` (no physical unit: the larger side is printed 200 mm long). Sets the printed
         size (``width``/``height`` in mm) and the scale bar label.
-    stroke_mm : float
-        Printed line width in millimetres.
-    flat_edges : bool
-        Also draw ``F`` edges, very light grey, in a ``flat`` group.
-    angle_opacity : bool
-        Set each mountain and valley line's ``opacity`` to ``|fold angle| / 180``, which Origami
-        Simulator reads as the target fold angle.
+    preset : str or Preset, optional
+        Cutter preset (:data:`~filletfold.export.presets.PRESETS`); default
+        ``origami-simulator``.
+    stroke_mm : float, optional
+        Printed width of every line in millimetres (default: the preset's pens).
+    flat_edges : bool, optional
+        Draw the ``F`` edges, in a ``flat`` group (default: the preset's).
+    angle_opacity : bool, optional
+        Give each mountain and valley line ``stroke-opacity`` = ``|fold angle| / 180``, which
+        Origami Simulator reads as the target fold angle (default: the preset's).
 
     Returns
     -------
@@ -123,177 +156,289 @@ def pattern_svg(
     Raises
     ------
     ParameterError
-        For an unknown ``units`` or a non-positive ``stroke_mm``.
+        For an unknown ``units`` or ``preset``, or a non-positive ``stroke_mm``.
     ExportError
         When the pattern is inconsistent.
     """
     check_units(units, MM_PER_UNIT, unitless=True)
-    if not (isinstance(stroke_mm, int | float) and math.isfinite(stroke_mm) and stroke_mm > 0):
+    preset = get_preset(preset)
+    if stroke_mm is not None and not (
+        isinstance(stroke_mm, int | float) and math.isfinite(stroke_mm) and stroke_mm > 0
+    ):
         raise ParameterError(
             f"stroke_mm must be a positive number, got {stroke_mm!r}", name="stroke_mm"
         )
     validate_pattern(pattern)
-    return _pattern_svg(pattern, units, stroke_mm, flat_edges, angle_opacity)
+    return _pattern_svg(pattern, units, preset, stroke_mm, flat_edges, angle_opacity)
 
 
-def _pattern_svg(pattern, units="", stroke_mm=0.3, flat_edges=False, angle_opacity=False) -> str:
+def svg_user_per_mm(points: np.ndarray, mm_per_unit: float, extent: float) -> float:
+    """User units per printed millimetre of :func:`pattern_svg`'s viewBox.
+
+    Parameters
+    ----------
+    points : (k, 2) float
+        The drawn points (edge ends, tab corners) in pattern units.
+    mm_per_unit : float
+        Printed millimetres per pattern unit.
+    extent : float
+        The drawing's larger side in pattern units.
+
+    Returns
+    -------
+    float
+        ``10**j`` for the smallest ``j >= 0`` at which the two closest distinct points are at
+        least :data:`MIN_POINT_SPACING` user units apart (points within ``1e-9`` of ``extent``
+        count as one), but no larger than keeps ``extent`` under ``1e7`` user units.
+    """
+    from scipy.spatial import cKDTree
+
+    p = np.unique(np.asarray(points, dtype=np.float64).reshape(-1, 2), axis=0)
+    j = 0
+    if len(p) > 1:
+        d, _ = cKDTree(p).query(p, k=2)
+        d = d[:, 1][d[:, 1] > _SAME_POINT * extent]
+        if len(d):
+            j = max(0, math.ceil(math.log10(MIN_POINT_SPACING / (float(d.min()) * mm_per_unit))))
+    cap = math.floor(math.log10(_MAX_USER_EXTENT / max(extent * mm_per_unit, 1e-300)))
+    return 10.0 ** max(0, min(j, cap))
+
+
+def _pattern_svg(
+    pattern, units="", preset=None, stroke_mm=None, flat_edges=None, angle_opacity=None
+) -> str:
     """:func:`pattern_svg` of a pattern and arguments already checked."""
+    preset = get_preset(preset)
+    flat_edges = preset.flat_edges if flat_edges is None else bool(flat_edges)
+    angle_opacity = preset.angle_opacity if angle_opacity is None else bool(angle_opacity)
     v = pattern.vertices_2d
     lo, hi = pattern_extent(pattern)
     size = hi - lo
     extent = float(size.max())
     if extent <= 0:
         extent = 1.0
-    mm_per_user = MM_PER_UNIT[units] if units else _UNITLESS_MM / extent
-    user = 1.0 / mm_per_user  # user units per mm
-    margin = _MARGIN_MM * user
-    font = _FONT_MM * user
-    decimals = max(0, 8 - math.floor(math.log10(extent + 2 * margin)))
-    fmt = _formatter(decimals)
-
-    # drawing coordinates: x right, y down, pattern's top-left at (margin, margin)
-    x = v[:, 0] - lo[0] + margin
-    y = hi[1] - v[:, 1] + margin
-    used = np.zeros(len(v), dtype=bool)  # only the ends of edges are drawn
-    used[np.asarray(pattern.edges, dtype=np.int64).ravel()] = True
-    xs = np.full(len(v), "", dtype=object)
-    ys = np.full(len(v), "", dtype=object)
-    xs[used] = _format_all(x[used], decimals)
-    ys[used] = _format_all(y[used], decimals)
-
-    edges = np.asarray(pattern.edges, dtype=np.int64)
+    mm_per_unit = MM_PER_UNIT[units] if units else _UNITLESS_MM / extent
+    edges = np.asarray(pattern.edges, dtype=np.int64).reshape(-1, 2)
     assign = np.asarray(pattern.edge_assignment)
     angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64)
-    sw = fmt(stroke_mm * user)
+    ann = pattern.annotations
+    drawn = (assign != "F") | flat_edges
+    paths = tab_cut_paths(ann)
+    hinges = np.array(
+        [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in ann.tab_hinges]
+    ).reshape(-1, 2, 2)
+    points = np.concatenate(
+        [v[np.unique(edges[drawn])], *[q for q, _ in paths], hinges.reshape(-1, 2)]
+    )
+    user = svg_user_per_mm(points, mm_per_unit, extent)  # user units per mm
+    k = mm_per_unit * user  # user units per pattern unit
+    margin = _MARGIN_MM * user
+    font = _FONT_MM * user
+    decimals = max(0, 8 - math.floor(math.log10(extent * k + 2 * margin)))
+    fmt = _formatter(decimals)
+    draw = _Drawing(lo, hi, k, margin, decimals, user, stroke_mm)
 
     body = []
     legend = []
     for code, gid, label in _GROUPS:
         if code == "F" and not flat_edges:
             continue
-        color = ASSIGNMENT_COLOR[code]
-        legend.append((color, label))
-        body.append(f'<g id="{gid}" stroke-width="{sw}" stroke-linecap="round" fill="none">')
-        sel = np.flatnonzero(assign == code)
-        if len(sel):
-            a, b = edges[sel, 0], edges[sel, 1]
-            cols = [xs[a], ys[a], xs[b], ys[b]]
-            line = f'<line x1="%s" y1="%s" x2="%s" y2="%s" stroke="{color}"/>\n'
+        pen = getattr(preset, _ROLE[code])
+        legend.append((pen.color, label))
+        mask = assign == code
+        body.append(draw.group_open(gid, pen))
+        if pen.perforation_mm is not None:
+            dashes = draw.dashes(
+                [(v[c], closed) for c, closed in edge_chains(edges, mask)], pen.perforation_mm
+            )
+            body.append(draw.polylines([(q, False) for q in dashes], pen.color))
+        elif (angle_opacity and code in ("M", "V")) or not preset.join_lines:
+            sel = np.flatnonzero(mask)
+            opacity = None
             if angle_opacity and code in ("M", "V"):
-                line = line[:-3] + ' opacity="%.4f"/>\n'
-                cols.append(np.minimum(np.abs(angle[sel]) / 180.0, 1.0))
-            values = np.stack(cols, axis=1).ravel().tolist()
-            body.append((line * len(sel))[:-1] % tuple(values))
+                opacity = np.clip(np.abs(angle[sel]) / 180.0, 1e-6, 1.0)
+            body.append(draw.lines(v[edges[sel, 0]], v[edges[sel, 1]], pen.color, opacity))
+        else:
+            chains = edge_chains(edges, mask)
+            body.append(
+                draw.polylines(
+                    [(simplify_polyline(v[c], closed), closed) for c, closed in chains], pen.color
+                )
+            )
         body.append("</g>")
-    body.extend(_annotation_groups(pattern, lo, hi, margin, decimals, sw))
+    if paths:
+        body.append(draw.group_open("tab-cut", preset.cut, join=True))
+        body.append(draw.polylines(paths, preset.cut.color))
+        body.append("</g>")
+    if len(hinges):
+        pen = preset.tab
+        legend.append((pen.color, "tab hinge"))
+        body.append(draw.group_open("tab-hinge", pen))
+        if pen.perforation_mm is not None:
+            dashes = draw.dashes([(h, False) for h in hinges], pen.perforation_mm)
+            body.append(draw.polylines([(q, False) for q in dashes], pen.color))
+        else:
+            body.append(draw.lines(hinges[:, 0], hinges[:, 1], pen.color))
+        body.append("</g>")
+    body.extend(_label_group(pattern, draw, preset.label.color))
 
-    # scale bar and legend below the drawing
-    draw_w = float(size[0]) + 2 * margin
-    draw_h = float(size[1]) + 2 * margin
-    bar = nice_length(max(float(size[0]), extent * 0.2) / 5.0)
-    bar_h = 1.0 * user
-    bar_y = draw_h
-    label = f"{bar:g} {units}".rstrip()
-    ann = ['<g id="annotation" stroke="none">']
-    ann.append(
-        f'<g id="scale-bar"><rect x="{fmt(margin)}" y="{fmt(bar_y)}" width="{fmt(bar)}" '
-        f'height="{fmt(bar_h)}" fill="#000000"/>'
-    )
-    ann.append(
-        f'<text x="{fmt(margin + bar + 2 * user)}" y="{fmt(bar_y + bar_h)}" '
-        f'font-family="sans-serif" font-size="{fmt(font)}" fill="#000000">'
-        f"{escape(label)}</text></g>"
-    )
-    leg_y = bar_y + bar_h + 2 * font
-    xcur = margin
-    ann.append('<g id="legend" font-family="sans-serif" fill="#000000">')
-    for color, text in legend:
-        ann.append(
-            f'<rect x="{fmt(xcur)}" y="{fmt(leg_y - 0.5 * font)}" '
-            f'width="{fmt(_SWATCH_MM * user)}" height="{fmt(max(stroke_mm, 0.5) * user)}" '
-            f'fill="{color}"/>'
+    draw_w = float(size[0]) * k + 2 * margin
+    draw_h = float(size[1]) * k + 2 * margin
+    total_w, total_h = draw_w, draw_h
+    ann_text = []
+    if preset.annotations:
+        # scale bar and legend below the drawing, sheet outlines; all in <defs>, shown by <use>
+        bar = nice_length(max(float(size[0]), extent * 0.2) / 5.0)
+        bar_h = 1.0 * user
+        bar_y = draw_h
+        label = f"{bar:g} {units}".rstrip()
+        ann_text = ["<defs>", '<g id="annotation" stroke="none">']
+        ann_text.extend(draw.sheet_group(ann.sheets))
+        ann_text.append(
+            f'<g id="scale-bar"><rect x="{fmt(margin)}" y="{fmt(bar_y)}" width="{fmt(bar * k)}" '
+            f'height="{fmt(bar_h)}" fill="#000000"/>'
         )
-        xcur += (_SWATCH_MM + 2.0) * user
-        ann.append(
-            f'<text x="{fmt(xcur)}" y="{fmt(leg_y)}" font-size="{fmt(font)}">{escape(text)}</text>'
+        ann_text.append(
+            f'<text x="{fmt(margin + bar * k + 2 * user)}" y="{fmt(bar_y + bar_h)}" '
+            f'font-family="sans-serif" font-size="{fmt(font)}" fill="#000000">'
+            f"{escape(label)}</text></g>"
         )
-        xcur += (0.62 * _FONT_MM * len(text) + 6.0) * user
-    ann.append("</g>")
-    ann.extend(_label_group(pattern, lo, hi, margin, decimals))
-    ann.append("</g>")
-
-    total_w = max(
-        draw_w, xcur + margin, margin + bar + (2 + 0.62 * _FONT_MM * len(label)) * user + margin
+        leg_y = bar_y + bar_h + 2 * font
+        xcur = margin
+        ann_text.append('<g id="legend" font-family="sans-serif" fill="#000000">')
+        swatch_h = max(stroke_mm or preset.mountain.width_mm, 0.5) * user
+        for color, text in legend:
+            ann_text.append(
+                f'<rect x="{fmt(xcur)}" y="{fmt(leg_y - 0.5 * font)}" '
+                f'width="{fmt(_SWATCH_MM * user)}" height="{fmt(swatch_h)}" fill="{color}"/>'
+            )
+            xcur += (_SWATCH_MM + 2.0) * user
+            ann_text.append(
+                f'<text x="{fmt(xcur)}" y="{fmt(leg_y)}" font-size="{fmt(font)}">'
+                f"{escape(text)}</text>"
+            )
+            xcur += (0.62 * _FONT_MM * len(text) + 6.0) * user
+        ann_text.extend(["</g>", "</g>", "</defs>"])
+        ann_text.append('<use href="#annotation" xlink:href="#annotation"/>')
+        total_w = max(
+            draw_w,
+            xcur + margin,
+            margin + bar * k + (2 + 0.62 * _FONT_MM * len(label)) * user + margin,
+        )
+        total_h = leg_y + font + margin
+    xlink = ' xmlns:xlink="http://www.w3.org/1999/xlink"' if preset.annotations else ""
+    colours = ", ".join(
+        f"{role} {pen.color}" for role, pen in preset.pens().items() if role != "flat"
     )
-    total_h = leg_y + font + margin
     head = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" version="1.1" '
-        f'width="{total_w * mm_per_user:.3f}mm" height="{total_h * mm_per_user:.3f}mm" '
+        f'<svg xmlns="http://www.w3.org/2000/svg"{xlink} version="1.1" '
+        f'width="{total_w / user:.3f}mm" height="{total_h / user:.3f}mm" '
         f'viewBox="0 0 {fmt(total_w)} {fmt(total_h)}">',
         "<title>filletfold crease pattern</title>",
-        f"<desc>mountain red, valley blue, cut black; units: {escape(units or 'none')}</desc>",
+        f"<desc>preset {escape(preset.name)}: {colours}; units: {escape(units or 'none')}; "
+        f"{fmt(user)} user units per mm</desc>",
     ]
-    return "\n".join([*head, *body, *ann, "</svg>"]) + "\n"
+    return "\n".join([*head, *body, *ann_text, "</svg>"]) + "\n"
 
 
-def _annotation_groups(pattern, lo, hi, margin, decimals, sw) -> list[str]:
-    """SVG groups of the sheet outlines, tab cut paths and tab hinges (empty when none), their
-    numbers formatted in bulk (:func:`_format_all`)."""
-    ann = pattern.annotations
-    fmt = _formatter(decimals)
+class _Drawing:
+    """Pattern coordinates to SVG text: the y flip, scale, margin and number format."""
 
-    def x_of(x: np.ndarray) -> list[str]:
-        return _format_all(x - lo[0] + margin, decimals)
+    def __init__(self, lo, hi, k, margin, decimals, user, stroke_mm):
+        self.lo, self.hi, self.k, self.margin = lo, hi, k, margin
+        self.decimals, self.user, self.stroke_mm = decimals, user, stroke_mm
+        self.fmt = _formatter(decimals)
 
-    def y_of(y: np.ndarray) -> list[str]:
-        return _format_all(hi[1] - y + margin, decimals)
-
-    out = []
-    sheets = np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4)
-    if len(sheets):
-        out.append(f'<g id="sheets" stroke="{SHEET_COLOR}" stroke-width="{sw}" fill="none">')
-        x0, y0, x1, y1 = sheets.T
-        rect = f'<rect x="%s" y="%s" width="%s" height="%s" stroke="{SHEET_COLOR}"/>'
-        columns = (
-            x_of(x0),
-            y_of(y1),
-            _format_all(x1 - x0, decimals),
-            _format_all(y1 - y0, decimals),
+    def x(self, x: np.ndarray) -> list[str]:
+        return _format_all(
+            (np.asarray(x, dtype=np.float64) - self.lo[0]) * self.k + self.margin, self.decimals
         )
-        out.append(_rows(rect, columns))
-        out.append("</g>")
-    paths = tab_cut_paths(ann)
-    if paths:
-        color = ASSIGNMENT_COLOR["B"]
-        out.append(
-            f'<g id="tab-cut" stroke-width="{sw}" stroke-linecap="round" '
-            'stroke-linejoin="round" fill="none">'
+
+    def y(self, y: np.ndarray) -> list[str]:
+        return _format_all(
+            (self.hi[1] - np.asarray(y, dtype=np.float64)) * self.k + self.margin, self.decimals
         )
+
+    def width(self, pen: Pen) -> float:
+        """A pen's stroke width in user units."""
+        return (self.stroke_mm or pen.width_mm) * self.user
+
+    def group_open(self, gid: str, pen: Pen, join: bool = False) -> str:
+        """The opening tag of a group drawn with ``pen`` (width, dash style)."""
+        extra = ""
+        if pen.perforation_mm is None:
+            if pen.dash_mm is not None:
+                extra = (
+                    f' stroke-dasharray="{self.fmt(pen.dash_mm[0] * self.user)} '
+                    f'{self.fmt(pen.dash_mm[1] * self.user)}"'
+                )
+            elif pen.dash_share is not None:
+                d = self.fmt(pen.dash_share * (self.hi - self.lo).max() * self.k)
+                extra = f' stroke-dasharray="{d} {d}"'
+        if join:
+            extra += ' stroke-linejoin="round"'
+        return (
+            f'<g id="{gid}" stroke-width="{self.fmt(self.width(pen))}" stroke-linecap="round"'
+            f'{extra} fill="none">'
+        )
+
+    def lines(self, a: np.ndarray, b: np.ndarray, color: str, opacity=None) -> str:
+        """One ``<line>`` per segment ``a[i]``-``b[i]`` (pattern units), with
+        ``stroke-opacity`` when given."""
+        if len(a) == 0:
+            return ""
+        cols = [self.x(a[:, 0]), self.y(a[:, 1]), self.x(b[:, 0]), self.y(b[:, 1])]
+        if opacity is None:
+            line = f'<line x1="%s" y1="%s" x2="%s" y2="%s" stroke="{color}"/>'
+        else:
+            line = f'<line x1="%s" y1="%s" x2="%s" y2="%s" stroke="{color}" stroke-opacity="%s"/>'
+            cols.append([f"{o:.6f}" for o in np.asarray(opacity).tolist()])
+        return _rows(line, cols)
+
+    def polylines(self, paths: list, color: str) -> str:
+        """One ``<polyline>`` per open path, ``<polygon>`` per closed one (pattern units)."""
+        paths = [(np.asarray(q, dtype=np.float64).reshape(-1, 2), c) for q, c in paths]
+        paths = [(q, c) for q, c in paths if len(q) > 1]
+        if not paths:
+            return ""
         q = np.concatenate([pts for pts, _ in paths])
         shapes = [(closed, len(pts)) for pts, closed in paths]
         template = {
-            (closed, k): f'<{"polygon" if closed else "polyline"} points="'
-            + " ".join(["%s,%s"] * k)
+            (closed, n): f'<{"polygon" if closed else "polyline"} points="'
+            + " ".join(["%s,%s"] * n)
             + f'" stroke="{color}"/>'
-            for closed, k in set(shapes)
+            for closed, n in set(shapes)
         }
         values = tuple(
-            itertools.chain.from_iterable(zip(x_of(q[:, 0]), y_of(q[:, 1]), strict=True))
+            itertools.chain.from_iterable(zip(self.x(q[:, 0]), self.y(q[:, 1]), strict=True))
         )
-        out.append("\n".join(map(template.__getitem__, shapes)) % values)
-        out.append("</g>")
-    if len(ann.tab_hinges):
-        out.append(
-            f'<g id="tab-hinge" stroke-width="{sw}" stroke-dasharray="{fmt(6 * float(sw))} '
-            f'{fmt(4 * float(sw))}" fill="none">'
+        return "\n".join(map(template.__getitem__, shapes)) % values
+
+    def dashes(self, paths: list, perforation_mm) -> list[np.ndarray]:
+        """The perforation dashes of paths (pattern units), lengths given in printed mm."""
+        cut, gap = (x * self.user / self.k for x in perforation_mm)
+        return [d for q, closed in paths for d in dash_polylines(q, closed, cut, gap)]
+
+    def sheet_group(self, sheets) -> list[str]:
+        """The ``sheets`` group: one grey ``<rect>`` per sheet outline (empty when none)."""
+        sheets = np.asarray(sheets, dtype=np.float64).reshape(-1, 4)
+        if not len(sheets):
+            return []
+        x0, y0, x1, y1 = sheets.T
+        sw = self.fmt(self.width(Pen(SHEET_COLOR, "SHEETS", 8, 0.3)))
+        rect = f'<rect x="%s" y="%s" width="%s" height="%s" stroke="{SHEET_COLOR}"/>'
+        columns = (
+            self.x(x0),
+            self.y(y1),
+            _format_all((x1 - x0) * self.k, self.decimals),
+            _format_all((y1 - y0) * self.k, self.decimals),
         )
-        h = np.array([np.asarray(h, dtype=np.float64).reshape(2, 2) for h in ann.tab_hinges])
-        line = f'<line x1="%s" y1="%s" x2="%s" y2="%s" stroke="{TAB_HINGE_COLOR}"/>'
-        columns = (x_of(h[:, 0, 0]), y_of(h[:, 0, 1]), x_of(h[:, 1, 0]), y_of(h[:, 1, 1]))
-        out.append(_rows(line, columns))
-        out.append("</g>")
-    return out
+        return [
+            f'<g id="sheets" stroke="{SHEET_COLOR}" stroke-width="{sw}" fill="none">',
+            _rows(rect, columns),
+            "</g>",
+        ]
 
 
 def _rows(template: str, columns) -> str:
@@ -305,23 +450,27 @@ def _rows(template: str, columns) -> str:
     )
 
 
-def _label_group(pattern, lo, hi, margin, decimals) -> list[str]:
+def _label_group(pattern, draw: _Drawing, color: str) -> list[str]:
     """The ``labels`` group: filled text, centred on each anchor, rotated (empty when none)."""
     labels = pattern.annotations.labels
     if not labels:
         return []
     out = [
-        f'<g id="labels" font-family="sans-serif" fill="{LABEL_COLOR}" text-anchor="middle" '
-        'dominant-baseline="central">'
+        f'<g id="labels" font-family="sans-serif" fill="{color}" stroke="none" '
+        'text-anchor="middle" dominant-baseline="central">'
     ]
     position = label_positions(labels)
-    tx = _format_all(position[:, 0] - lo[0] + margin, decimals)
-    ty = _format_all(hi[1] - position[:, 1] + margin, decimals)
-    size = _format_all(np.array([float(lb.height) for lb in labels], dtype=np.float64), decimals)
+    tx = draw.x(position[:, 0])
+    ty = draw.y(position[:, 1])
+    size = _format_all(
+        np.array([float(lb.height) for lb in labels], dtype=np.float64) * draw.k, draw.decimals
+    )
     angle = np.array([lb.angle for lb in labels], dtype=object)
     turned = np.flatnonzero(angle.astype(bool))  # the truth of each angle, as it is
     rot = [""] * len(labels)
-    turns = _format_all(np.array([-float(a) for a in angle[turned]], dtype=np.float64), decimals)
+    turns = _format_all(
+        np.array([-float(a) for a in angle[turned]], dtype=np.float64), draw.decimals
+    )
     for i, r in zip(turned.tolist(), turns, strict=True):
         rot[i] = f' transform="rotate({r} {tx[i]} {ty[i]})"'
     kinds = [str(lb.kind) for lb in labels]
