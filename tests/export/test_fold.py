@@ -125,8 +125,13 @@ def test_fold_cylinder_face_join_is_flat():
     by_edge = dict(zip(map(tuple, doc["edges_vertices"]), doc["edges_assignment"], strict=True))
     assert (by_edge[(1, 6)], by_edge[(2, 5)]) == ("F", "M")
     root = ET.fromstring(pattern_svg(p))
-    assert all(g.get("id") != "flat" for g in root.iter(SVG_NS + "g"))
-    assert len(root.findall(f".//{SVG_NS}line")) == 9
+    groups = {g.get("id"): g.findall(f"{SVG_NS}line") for g in root.iter(SVG_NS + "g")}
+    # the join is a facet line (drawn for Origami Simulator), not a crease
+    assert len(groups["flat"]) == 1 and len(groups["mountain"]) == 1
+    assert not groups["valley"]
+    (join,) = groups["flat"]
+    assert join.get("x1") == join.get("x2") != groups["mountain"][0].get("x1")
+    assert len(root.findall(f".//{SVG_NS}line")) == 10
 
 
 def test_fold_two_pieces():
