@@ -195,7 +195,12 @@ def test_net_on_sheets_with_all_formats(tmp_path, capsys):
     assert names == [
         "assembly.txt",
         "design.fold",
+        "folded.3dm",
+        "folded.glb",
         "folded.obj",
+        "folded.ply",
+        "folded.stl",
+        "pattern.3dm",
         "pattern.dxf",
         "pattern.pdf",
         "pattern.png",

@@ -16,7 +16,18 @@ import pytest
 import filletfold
 
 #: Imported where they are used, never by ``import filletfold`` or the command line's start.
-HEAVY = ("scipy", "shapely", "trimesh", "meshio", "numba", "matplotlib", "ezdxf", "viser")
+HEAVY = (
+    "scipy",
+    "shapely",
+    "trimesh",
+    "meshio",
+    "numba",
+    "matplotlib",
+    "ezdxf",
+    "viser",
+    "rhino3dm",
+    "compas",
+)
 
 _REPORT = (
     "import json, sys\n"

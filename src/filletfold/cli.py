@@ -89,7 +89,7 @@ def examples():
 
 
 #: Formats ``filletfold export`` can write from a ``design.fold``.
-EXPORT_FORMATS = ("obj", "svg", "dxf", "pdf", "png")
+EXPORT_FORMATS = ("obj", "svg", "dxf", "pdf", "png", "3dm", "glb", "ply", "stl")
 
 FormatOption = Annotated[
     str | None,
@@ -97,7 +97,8 @@ FormatOption = Annotated[
         "--format",
         "-f",
         help="Comma-separated output formats: fold, json, obj, svg, dxf, pdf, png (pattern.png "
-        "and preview.png), or all.",
+        "and preview.png), 3dm (pattern.3dm and folded.3dm, needs rhino3dm), glb (or gltf), "
+        "ply, stl, or all.",
     ),
 ]
 UnitsOption = Annotated[
@@ -112,7 +113,7 @@ ScaleOption = Annotated[
     float | None,
     typer.Option(
         "--scale",
-        help="Drawing units per mesh length unit in the DXF, SVG and PDF (default 1).",
+        help="Drawing units per mesh length unit in the DXF, SVG, PDF and 3DM (default 1).",
     ),
 ]
 PresetOption = Annotated[
@@ -401,8 +402,9 @@ def export_cmd(
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
     Formats: dxf (pattern.dxf), pdf (pattern.pdf, tiled at true scale), svg (pattern.svg), png
-    (pattern.png and preview.png), obj (folded.obj); all of them with --format all. The files
-    are written into FOLDER, all or nothing.
+    (pattern.png and preview.png), obj (folded.obj), 3dm (pattern.3dm, folded.3dm), glb, ply,
+    stl (folded.glb, .ply, .stl); all of them with --format all. The files are written into
+    FOLDER, all or nothing.
     """
     from .export import write_outputs
     from .export.cutfiles import cut_files, parse_formats
@@ -410,7 +412,10 @@ def export_cmd(
 
     try:
         spec = formats if formats is not None else "dxf,pdf,svg,png"
-        chosen = EXPORT_FORMATS if spec.strip().lower() == "all" else parse_formats(spec)
+        every = parse_formats("all") if spec.strip().lower() == "all" else None
+        chosen = (
+            parse_formats(spec) if every is None else tuple(f for f in every if f in EXPORT_FORMATS)
+        )
         bad = [f for f in chosen if f not in EXPORT_FORMATS]
         if bad:
             raise _error(

@@ -68,6 +68,11 @@ def test_cut_files_names_and_types():
         "pattern.pdf",
         "pattern.png",
         "preview.png",
+        "pattern.3dm",
+        "folded.3dm",
+        "folded.glb",
+        "folded.ply",
+        "folded.stl",
     ]
     assert isinstance(files["pattern.pdf"], bytes) and isinstance(files["pattern.dxf"], str)
     assert json.loads(files["report.json"]) == {"a": 1}
@@ -121,6 +126,11 @@ def test_export_design_all_formats(cube, tmp_path):
         "pattern.pdf",
         "pattern.png",
         "preview.png",
+        "pattern.3dm",
+        "folded.3dm",
+        "folded.glb",
+        "folded.ply",
+        "folded.stl",
         "assembly.txt",
         "timings.json",
     ]
@@ -191,12 +201,12 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 10 files" in capsys.readouterr().out
+    assert "wrote 15 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 
 
 def test_cli_round_bad_format_fails_before_solving(tmp_path, capsys):
-    assert main(["round", "cube", "-o", str(tmp_path / "x"), "--format", "fold,stl"]) == 2
-    assert "unknown format 'stl'" in capsys.readouterr().err
+    assert main(["round", "cube", "-o", str(tmp_path / "x"), "--format", "fold,step"]) == 2
+    assert "unknown format 'step'" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()

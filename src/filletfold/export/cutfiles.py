@@ -15,7 +15,18 @@ format     files                            content
                                             TAB/LABEL (see ``preset``)
 ``pdf``    ``pattern.pdf``                  true-scale print, tiled on pages
 ``png``    ``pattern.png``, ``preview.png`` pictures of the layout and the folded form
+``3dm``    ``pattern.3dm``, ``folded.3dm``  Rhino files of the pattern (layers CUT/MOUNTAIN/
+                                            VALLEY/TAB/LABEL) and of the folded form (a mesh
+                                            per patch, creases as curves); needs rhino3dm
+``glb``    ``folded.glb``                   glTF binary of the folded form, a material per
+                                            patch kind (``gltf`` is the same format)
+``ply``    ``folded.ply``                   the folded form, welded triangles, face colours
+``stl``    ``folded.stl``                   the folded form, welded triangles
 =========  ===============================  =================================================
+
+``all`` means every format whose library is installed: ``3dm`` only when rhino3dm imports
+(:data:`OPTIONAL_FORMATS`; a warning says when it is left out), while asking for ``3dm`` without
+it is an error.
 
 Real size: ``scale`` drawing units per pattern length unit, in ``units``. DXF and SVG are
 drawn at ``scale`` (the SVG printed in ``units``; unitless, its larger side is 200 mm). The PDF
@@ -24,11 +35,17 @@ needs a physical size: with ``units`` it prints at ``scale`` ``units`` per patte
 scales the drawing to fill one page (:func:`fit_page_scale`). FOLD, OBJ and PNG keep the
 design's own coordinates. A cutter ``preset`` (:mod:`~filletfold.export.presets`) sets the
 colours, layers, line widths and dash or perforation of the SVG and DXF.
+
+Both 3dm files are drawn at ``scale`` in ``units`` (the folded form too, so the two overlay at
+one size); GLB, PLY and STL keep the design's own coordinates, as OBJ does.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
+import logging
+import sys
 from collections.abc import Iterable, Mapping
 
 import numpy as np
@@ -49,7 +66,9 @@ from .svg import _pattern_svg
 __all__ = [
     "ALL_FORMATS",
     "DEFAULT_FORMATS",
+    "FORMAT_ALIASES",
     "FORMAT_FILES",
+    "OPTIONAL_FORMATS",
     "cut_files",
     "fit_page_scale",
     "output_names",
@@ -66,11 +85,30 @@ FORMAT_FILES = {
     "dxf": ("pattern.dxf",),
     "pdf": ("pattern.pdf",),
     "png": ("pattern.png", "preview.png"),
+    "3dm": ("pattern.3dm", "folded.3dm"),
+    "glb": ("folded.glb",),
+    "ply": ("folded.ply",),
+    "stl": ("folded.stl",),
 }
-#: Every format, in canonical order (what ``"all"`` means).
+#: Other names of formats.
+FORMAT_ALIASES = {"gltf": "glb"}
+#: Formats that need an optional library: format -> (module, the extra that installs it).
+OPTIONAL_FORMATS = {"3dm": ("rhino3dm", "rhino")}
+#: Every format, in canonical order (what ``"all"`` means, less the optional formats whose
+#: library is not installed).
 ALL_FORMATS = tuple(FORMAT_FILES)
 #: What ``filletfold round`` and :meth:`Design.export` write by default.
 DEFAULT_FORMATS = ("fold", "json", "obj", "svg")
+
+_log = logging.getLogger(__name__)
+
+
+def _installed(fmt: str) -> bool:
+    """Whether the library of an optional format can be imported (without importing it)."""
+    module = OPTIONAL_FORMATS[fmt][0]
+    if module in sys.modules:  # imported already, or blocked (None)
+        return sys.modules[module] is not None
+    return importlib.util.find_spec(module) is not None
 
 
 def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
@@ -90,7 +128,9 @@ def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
     Raises
     ------
     ParameterError
-        For an unknown format or an empty list.
+        For an unknown format, an empty list, or an optional format (:data:`OPTIONAL_FORMATS`)
+        named whose library is not installed. ``"all"`` leaves such a format out, with a
+        warning.
     """
     if isinstance(formats, str):
         items = formats.split(",")
@@ -107,11 +147,28 @@ def parse_formats(formats: str | Iterable[str]) -> tuple[str, ...]:
         if not isinstance(item, str):
             raise ParameterError(f"format names must be strings, got {item!r}", name="format")
         name = item.strip().lower()
+        name = FORMAT_ALIASES.get(name, name)
         if not name:
             continue
         if name == "all":
-            names.update(ALL_FORMATS)
+            missing = [f for f in OPTIONAL_FORMATS if not _installed(f)]
+            for f in missing:
+                module, extra = OPTIONAL_FORMATS[f]
+                _log.warning(
+                    "format %s left out of 'all': %s is not installed "
+                    "(pip install 'filletfold[%s]')",
+                    f,
+                    module,
+                    extra,
+                )
+            names.update(f for f in ALL_FORMATS if f not in missing)
         elif name in FORMAT_FILES:
+            if name in OPTIONAL_FORMATS and not _installed(name):
+                module, extra = OPTIONAL_FORMATS[name]
+                raise ParameterError(
+                    f"format {name} needs {module}: pip install 'filletfold[{extra}]'",
+                    name="format",
+                )
             names.add(name)
         else:
             raise ParameterError(
@@ -221,7 +278,8 @@ def cut_files(
     formats : str or iterable of str
         See :func:`parse_formats` and the module docstring.
     units : str
-        ``""``, ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: the drawing unit of DXF, SVG and PDF.
+        ``""``, ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: the drawing unit of DXF, SVG, PDF and
+        3DM.
     scale : float, optional
         Drawing units per pattern unit (default 1; see the module docstring for the PDF).
     page : str
@@ -242,7 +300,7 @@ def cut_files(
     -------
     dict of str to str or bytes (or to callables, with ``lazy``)
         File name to contents, in the order of :func:`output_names`. Text formats are ``str``,
-        PDF and PNG ``bytes``.
+        PDF, PNG, 3DM, GLB, PLY and STL ``bytes``.
 
     Raises
     ------
@@ -267,6 +325,7 @@ def cut_files(
         )
     faces = validated_faces(pattern)  # checked once here for fold, obj and svg
 
+    from .mesh3d import _folded_glb, _folded_ply, _folded_stl
     from .report import report_json
 
     def fold():
@@ -278,6 +337,15 @@ def cut_files(
         if not units and not scale_given:
             pdf_scale = fit_page_scale(pattern, page)
         return pattern_pdf(pattern, page=page, units=pdf_units, scale=pdf_scale)
+
+    def rhino(which):
+        def build():
+            from . import rhino
+
+            write = rhino.pattern_3dm if which == "pattern" else rhino.folded_3dm
+            return write(pattern, units=units, scale=scale)
+
+        return build
 
     builders = {
         "fold": {"design.fold": fold},
@@ -296,6 +364,10 @@ def cut_files(
             "pattern.png": lambda: pattern_png(pattern),
             "preview.png": lambda: preview_png(pattern),
         },
+        "3dm": {"pattern.3dm": rhino("pattern"), "folded.3dm": rhino("folded")},
+        "glb": {"folded.glb": lambda: _folded_glb(pattern)},
+        "ply": {"folded.ply": lambda: _folded_ply(pattern)},
+        "stl": {"folded.stl": lambda: _folded_stl(pattern)},
     }
     out = {name: build for fmt in formats for name, build in builders[fmt].items()}
     return out if lazy else {name: build() for name, build in out.items()}

@@ -1,0 +1,256 @@
+"""The folded form as a triangle mesh: glTF binary (GLB), PLY and STL, written through trimesh.
+
+* ``folded.glb`` -- a glTF 2.0 scene with one mesh (and one node) per patch kind present
+  (``cone``, ``cylinder``, ``fillet``, ``face``, in that order), each with its own PBR material
+  named after the kind and coloured as in the preview picture
+  (:data:`~filletfold.export.png.PATCH_COLOR`), double sided, not metallic. Vertices are split
+  between patches, so each patch is shaded smooth (area-weighted vertex normals of its own
+  faces) and the creases between patches stay sharp. glTF is y-up: the design's z axis is
+  written as +y (``(x, y, z) -> (x, z, -y)``, a rotation, so faces keep their winding).
+* ``folded.ply`` -- binary PLY of the whole folded surface, vertices welded where they coincide
+  (the two sides of a seam become one vertex), one colour per face (its patch kind's).
+* ``folded.stl`` -- binary STL of the same welded triangles (STL has no colour).
+
+PLY and STL keep the design's own axes and coordinates (z up), as ``folded.obj`` does.
+Polygons are triangulated in the flat layout, where they are simple and counter-clockwise
+(:func:`~filletfold.app.view.triangulate_faces`); every triangle is front-facing in 3D as its
+polygon is. Same pattern, same bytes.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from ..surface.pattern import CreasePattern, FaceRows
+from ..surface.validate import validated_faces
+from .obj import vertex_normal_3d
+from .png import PATCH_COLOR
+
+__all__ = [
+    "KIND_ORDER",
+    "folded_glb",
+    "folded_ply",
+    "folded_stl",
+    "folded_triangles",
+    "patch_kind",
+    "weld_vertices",
+]
+
+#: Patch kinds in the order their meshes are written (others follow, sorted by name).
+KIND_ORDER = ("cone", "cylinder", "fillet", "face")
+#: Colour (RGB, 0..1) of a patch of a kind :data:`PATCH_COLOR` does not know.
+_OTHER_COLOR = (0.8, 0.8, 0.8)
+#: glTF is y-up: the design's (x, y, z) is written as (x, z, -y).
+Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+#: Vertices closer than this share of the folded form's size are welded (PLY and STL).
+WELD_RTOL = 1e-9
+
+
+def patch_kind(patch: str) -> str:
+    """The kind of a patch name: its first word (``"cone 3"`` -> ``"cone"``)."""
+    words = str(patch).split()
+    return words[0] if words else "patch"
+
+
+def kinds_present(face_patch) -> list[str]:
+    """The patch kinds of ``face_patch`` (a list of patch names), in :data:`KIND_ORDER`, then
+    any others sorted by name."""
+    kinds = set(map(patch_kind, dict.fromkeys(face_patch)))
+    return [k for k in KIND_ORDER if k in kinds] + sorted(kinds - set(KIND_ORDER))
+
+
+def folded_triangles(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of the pattern's faces (their corners are pattern vertices).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+
+    Returns
+    -------
+    triangles : (t, 3) int
+        Counter-clockwise in 2D, so front-facing in 3D; a face of ``k`` corners gives
+        ``k - 2`` triangles.
+    face : (t,) int
+        The face each triangle comes from (non-decreasing).
+    """
+    from ..app.view import triangulate_faces
+
+    return triangulate_faces(pattern.vertices_2d, pattern.faces)
+
+
+def weld_vertices(points: np.ndarray, rtol: float = WELD_RTOL) -> tuple[np.ndarray, np.ndarray]:
+    """Merge points that coincide up to ``rtol`` times the points' bounding-box diagonal.
+
+    Parameters
+    ----------
+    points : (n, 3) float
+    rtol : float
+
+    Returns
+    -------
+    unique : (u, 3) float
+        One point per group, the first of the group in input order, groups in order of their
+        first point.
+    inverse : (n,) int
+        The group of each input point: ``unique[inverse]`` is within the tolerance of
+        ``points``.
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(p) == 0:
+        return p.copy(), np.zeros(0, dtype=np.int64)
+    size = float(np.linalg.norm(np.ptp(p, axis=0)))
+    step = rtol * size if size > 0 else 1.0
+    key = np.round((p - p.min(axis=0)) / step).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # groups in order of their first point
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return p[first[order]], rank[inverse.ravel()]
+
+
+def _kind_meshes(pattern: CreasePattern) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
+    """Per patch kind present: ``(kind, vertices (u, 3), triangles (t, 3), normals (u, 3))``
+    with the vertices split between patches (one copy of a pattern vertex per patch)."""
+    tris, face = folded_triangles(pattern)
+    patches = dict.fromkeys(pattern.face_patch)
+    for k, name in enumerate(patches):
+        patches[name] = k
+    face_patch = np.fromiter(
+        map(patches.__getitem__, pattern.face_patch), np.int64, len(pattern.face_patch)
+    )
+    patch_kinds = np.array([patch_kind(p) for p in patches] or [""])
+    tri_kind = patch_kinds[face_patch[face]] if len(face) else np.zeros(0, dtype=str)
+    n = len(pattern.vertices_3d)
+    out = []
+    for kind in kinds_present(pattern.face_patch):
+        sel = np.flatnonzero(tri_kind == kind)
+        t = tris[sel]
+        key = face_patch[face[sel]][:, None] * n + t  # one vertex per (patch, pattern vertex)
+        uniq, local = np.unique(key.ravel(), return_inverse=True)
+        v = pattern.vertices_3d[uniq % n]
+        local = local.reshape(-1, 3)
+        normals = vertex_normal_3d(v, FaceRows.of_sizes(local.ravel(), np.full(len(local), 3)))
+        out.append((kind, v, local, normals))
+    return out
+
+
+def _rgba(kind: str) -> list[int]:
+    """The colour of a patch kind as RGBA bytes."""
+    rgb = PATCH_COLOR.get(kind, _OTHER_COLOR)
+    return [round(255 * c) for c in rgb] + [255]
+
+
+def folded_glb(pattern: CreasePattern) -> bytes:
+    """The folded form as a glTF 2.0 binary file (see the module docstring).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
+
+    Returns
+    -------
+    bytes
+        The GLB; same input, same bytes.
+
+    Raises
+    ------
+    ExportError
+        When the pattern is inconsistent.
+    """
+    validated_faces(pattern)
+    return _folded_glb(pattern)
+
+
+def _folded_glb(pattern: CreasePattern) -> bytes:
+    """:func:`folded_glb` of a pattern already checked."""
+    import trimesh
+    from trimesh.exchange.gltf import export_glb
+    from trimesh.visual.material import PBRMaterial
+
+    scene = trimesh.Scene()
+    for kind, v, t, normals in _kind_meshes(pattern):
+        material = PBRMaterial(
+            name=kind,
+            baseColorFactor=_rgba(kind),
+            metallicFactor=0.0,
+            roughnessFactor=0.8,
+            doubleSided=True,
+        )
+        mesh = trimesh.Trimesh(
+            vertices=v @ Y_UP.T,
+            faces=t,
+            vertex_normals=normals @ Y_UP.T,
+            visual=trimesh.visual.TextureVisuals(material=material),
+            process=False,
+        )
+        scene.add_geometry(mesh, geom_name=kind, node_name=kind)
+    return export_glb(scene, include_normals=True)
+
+
+def _welded(pattern: CreasePattern):
+    """The folded surface as one trimesh, vertices welded (:func:`weld_vertices`), one face
+    colour per patch kind."""
+    import trimesh
+
+    tris, face = folded_triangles(pattern)
+    v, inverse = weld_vertices(pattern.vertices_3d)
+    colours = np.array([_rgba(patch_kind(p)) for p in pattern.face_patch], dtype=np.uint8)
+    return trimesh.Trimesh(
+        vertices=v,
+        faces=inverse[tris].reshape(-1, 3),
+        face_colors=colours[face].reshape(-1, 4),
+        process=False,
+    )
+
+
+def folded_ply(pattern: CreasePattern) -> bytes:
+    """The folded form as a binary PLY (welded vertices, a colour per face).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
+
+    Returns
+    -------
+    bytes
+        Same input, same bytes.
+    """
+    validated_faces(pattern)
+    return _folded_ply(pattern)
+
+
+def _folded_ply(pattern: CreasePattern) -> bytes:
+    """:func:`folded_ply` of a pattern already checked."""
+    from trimesh.exchange.ply import export_ply
+
+    return export_ply(_welded(pattern), encoding="binary", include_attributes=False)
+
+
+def folded_stl(pattern: CreasePattern) -> bytes:
+    """The folded form as a binary STL (the welded triangles of :func:`folded_ply`).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Checked with :func:`~filletfold.surface.validate.validate_pattern`.
+
+    Returns
+    -------
+    bytes
+        Same input, same bytes.
+    """
+    validated_faces(pattern)
+    return _folded_stl(pattern)
+
+
+def _folded_stl(pattern: CreasePattern) -> bytes:
+    """:func:`folded_stl` of a pattern already checked."""
+    from trimesh.exchange.stl import export_stl
+
+    buffer = io.BytesIO(export_stl(_welded(pattern)))
+    return buffer.getvalue()
