@@ -77,7 +77,7 @@ def cylinder_chord_errors(design):
 @pytest.mark.parametrize("name", ["icosahedron", "cube", "torus"])
 @pytest.mark.parametrize("chord_tol", ["0.1%", "0.01%"])
 def test_every_folded_chord_of_a_cylinder_is_within_the_tolerance(name, chord_tol):
-    d = filletfold.round_mesh(name, chord_tol=chord_tol, samples=1000, tabs=False)
+    d = filletfold.round_mesh(name, chord_tol=chord_tol, arc_step=0, samples=1000, tabs=False)
     tol = resolve_chord_tol(chord_tol, d.mesh.mean_edge_length)
     err = cylinder_chord_errors(d)
     size = d.certificate.size
@@ -89,8 +89,10 @@ def test_every_folded_chord_of_a_cylinder_is_within_the_tolerance(name, chord_to
 def test_a_smaller_fillet_gets_fewer_points():
     """Two cubes' edges alike but for their radii: the one with half the radius gets about
     1 / sqrt(2) of the steps for the same tolerance (the arc step would give both alike)."""
-    big = filletfold.round_mesh("cube", radius="20%", chord_tol="0.001%", samples=1000)
-    small = filletfold.round_mesh("cube", radius="10%", chord_tol="0.001%", samples=1000)
+    big = filletfold.round_mesh("cube", radius="20%", chord_tol="0.001%", arc_step=0, samples=1000)
+    small = filletfold.round_mesh(
+        "cube", radius="10%", chord_tol="0.001%", arc_step=0, samples=1000
+    )
     nb, ns = big.stages.samples, small.stages.samples
     assert len(set(nb.tolist())) == 1 and len(set(ns.tolist())) == 1
     assert (nb[0] - 1) / (ns[0] - 1) == pytest.approx(np.sqrt(2), rel=0.04)
@@ -115,7 +117,9 @@ def test_mismatch_converges_as_the_chord_tolerance_shrinks():
     absolute one by 8."""
     rel, ab = [], []
     for tol in ("0.004%", "0.001%", "0.00025%"):
-        p = filletfold.round_mesh("icosahedron", chord_tol=tol, samples=1000, tabs=False).pattern
+        p = filletfold.round_mesh(
+            "icosahedron", chord_tol=tol, arc_step=0, samples=1000, tabs=False
+        ).pattern
         rel.append(relative_mismatch(p).max())
         ab.append(edge_mismatch(p).max())
     assert 3.5 < rel[0] / rel[1] < 4.5 and 3.5 < rel[1] / rel[2] < 4.5
