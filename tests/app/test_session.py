@@ -56,14 +56,14 @@ def test_arc_step_reaches_the_design_and_its_download():
     s = AppSession()
     s.load("geodesic-sphere")  # arcs of about 20 degrees: the step decides their points
     fine = len(s.design.pattern.faces)
-    s.set_params(arc_step=5.0)
-    coarse = s.recompute()
-    assert coarse.params.arc_step == 5.0 and len(coarse.pattern.faces) < fine
+    s.set_params(arc_step=1.5)  # finer than the default 5 (and the default chord tolerance)
+    dense = s.recompute()
+    assert dense.params.arc_step == 1.5 and len(dense.pattern.faces) > fine
     files = dict(s.export_files())
     fold = json.loads(files["design.fold"])
-    assert json.loads(files["report.json"])["parameters"]["arc_step"] == 5.0
+    assert json.loads(files["report.json"])["parameters"]["arc_step"] == 1.5
     cp = [len(f) for f in fold["faces_vertices"]]
-    assert len(cp) >= len(coarse.pattern.faces) and len(cp) < fine
+    assert len(cp) >= len(dense.pattern.faces) > fine
 
 
 def test_older_request_never_replaces_a_newer_result():
