@@ -34,10 +34,18 @@ def design_of(
     samples: int = 24,
     arc_step: float = 1.5,
     sharp: str = "auto",
+    chord_tol=0,
 ) -> filletfold.Design:
-    """Round a built-in example (cached: designs are read-only in the tests)."""
+    """Round a built-in example (cached: designs are read-only in the tests); sampled by the
+    arc step alone unless a chord tolerance is given."""
     return filletfold.round_mesh(
-        name, radius=radius, depth=depth, samples=samples, arc_step=arc_step, sharp=sharp
+        name,
+        radius=radius,
+        depth=depth,
+        samples=samples,
+        arc_step=arc_step,
+        sharp=sharp,
+        chord_tol=chord_tol,
     )
 
 

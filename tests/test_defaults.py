@@ -31,4 +31,14 @@ def test_the_defaults_are_valid_parameters():
     assert defaults.DEFAULT_RADIUS.endswith("%") and float(defaults.DEFAULT_RADIUS[:-1]) > 0
     assert defaults.DEFAULT_DEPTH.endswith("%") and float(defaults.DEFAULT_DEPTH[:-1]) > 0
     assert isinstance(defaults.DEFAULT_SAMPLES, int) and defaults.DEFAULT_SAMPLES >= 3
-    assert 0 < defaults.DEFAULT_ARC_STEP < 90
+    assert 0 <= defaults.DEFAULT_ARC_STEP < 90
+    tol = defaults.DEFAULT_CHORD_TOL
+    assert tol.endswith("%") and float(tol[:-1]) > 0
+
+
+def test_the_chord_tolerance_defaults_alike_in_the_api_and_the_command_line():
+    params = inspect.signature(inspect.unwrap(round_mesh)).parameters
+    assert params["chord_tol"].default == defaults.DEFAULT_CHORD_TOL
+    command = typer.main.get_command(app)
+    options = {p.name: p for p in command.commands["round"].params}
+    assert options["chord_tol"].default == defaults.DEFAULT_CHORD_TOL

@@ -5,7 +5,7 @@ Commands
 ``filletfold examples``
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
-``[--coplanar-tol DEG]``
+``[--chord-tol TOL] [--coplanar-tol DEG]``
 ``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
@@ -36,6 +36,7 @@ from rich.markup import escape
 from . import __version__
 from .defaults import (
     DEFAULT_ARC_STEP,
+    DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
     DEFAULT_RADIUS,
     DEFAULT_SAMPLES,
@@ -193,18 +194,28 @@ def round_cmd(
             "--samples",
             "-n",
             min=3,
-            help="Points per cylinder arc (arcs that turn little get fewer: see --arc-step).",
+            help="Most points per arc, both ends included (with --chord-tol 0 and "
+            "--arc-step 0: every arc gets this many).",
         ),
     ] = DEFAULT_SAMPLES,
     arc_step: Annotated[
         float,
         typer.Option(
             "--arc-step",
-            help="Largest turn between two samples of an arc (degrees): an arc that turns "
-            "less than (samples - 1) steps gets one point per step, at least 2. 0: every arc "
-            "gets --samples points.",
+            help="Largest turn between two samples of an arc (degrees): every arc gets at "
+            "least one point per step (at most --samples). 0: no limit.",
         ),
     ] = DEFAULT_ARC_STEP,
+    chord_tol: Annotated[
+        str,
+        typer.Option(
+            "--chord-tol",
+            help="Largest distance between an arc and its chords: a length, or a percentage "
+            "of the mean edge length. An arc of radius r turning by t gets "
+            "ceil(t / (2 acos(1 - tol / r))) + 1 points (at least 2, at most --samples). "
+            "0: no limit.",
+        ),
+    ] = DEFAULT_CHORD_TOL,
     clamp: Annotated[
         bool | None,
         typer.Option(
@@ -335,6 +346,7 @@ def round_cmd(
                 depth=depth,
                 samples=samples,
                 arc_step=arc_step,
+                chord_tol=chord_tol,
                 clamp=clamp,
                 fit_vertices=fit_vertices,
                 strict=strict,

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,6 +18,7 @@ import numpy as np
 
 from .defaults import (
     DEFAULT_ARC_STEP,
+    DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
     DEFAULT_RADIUS,
     DEFAULT_SAMPLES,
@@ -111,7 +113,10 @@ class Parameters:
     samples : int
         Most points per cylinder arc.
     arc_step : float
-        Largest turn between two samples of an arc (degrees; 0: every arc gets ``samples``).
+        Largest turn between two samples of an arc (degrees; 0: no limit).
+    chord_tol : float or str
+        As given: the largest distance of an arc's chord from the arc (absolute, ``"N%"`` of
+        the mean edge length; 0: no limit, and with ``arc_step`` 0 every arc gets ``samples``).
     clamp : bool
         Whether radii over their limit were reduced to fit (the default; off with ``strict``).
     fit_vertices : bool
@@ -135,6 +140,7 @@ class Parameters:
     depth: object = DEFAULT_DEPTH
     samples: int = DEFAULT_SAMPLES
     arc_step: float = DEFAULT_ARC_STEP
+    chord_tol: object = DEFAULT_CHORD_TOL
     clamp: bool = True
     material_loss: bool = False
     max_loss: object = None
@@ -153,6 +159,7 @@ class Parameters:
             "depth": plain(self.depth),
             "samples": self.samples,
             "arc_step": self.arc_step,
+            "chord_tol": self.chord_tol,
             "clamp": self.clamp,
             "material_loss": self.material_loss,
             "max_loss": plain(self.max_loss) if self.max_loss is not None else None,
@@ -413,6 +420,7 @@ def round_mesh(
     *,
     samples: int = DEFAULT_SAMPLES,
     arc_step: float = DEFAULT_ARC_STEP,
+    chord_tol=DEFAULT_CHORD_TOL,
     clamp: bool | None = None,
     material_loss: bool = False,
     max_loss=None,
@@ -443,14 +451,22 @@ def round_mesh(
         Apex depth ``d`` along the vertex normal (``P = U + d D``): absolute, a percentage of the
         mean edge length, per vertex, or ``{"default": ..., vertex: value}``.
     samples : int
-        Points per cylinder arc, both ends included (>= 3): every arc gets this many, except
-        arcs that turn by less than ``(samples - 1) * arc_step``.
+        Most points per arc, both ends included (>= 3). With ``chord_tol`` and ``arc_step``
+        both 0, every arc gets this many.
     arc_step : float
-        Largest turn between two samples of an arc, in degrees (default 1.5): an arc that turns
-        less gets fewer points, one per ``arc_step`` and at least 2, so a fine mesh, whose arcs
-        turn by a few degrees, is not sampled as densely as a cube's quarter turns. The chord
-        then deviates from the cylinder by at most ``r (1 - cos(arc_step / 2))`` (8.6e-5 r at
-        1.5 degrees). 0 gives every arc ``samples`` points.
+        Largest turn between two samples of an arc, in degrees (default 5; 0: no limit): an
+        arc gets at least one point per ``arc_step`` it turns (and at least 2), at most
+        ``samples``; the relative 2D - 3D mismatch of a chord grows with the square of its
+        turn, which an absolute ``chord_tol`` alone leaves large on small fillets.
+        ``chord_tol=0, arc_step=1.5`` is the sampling before the chord tolerance.
+    chord_tol : float or str
+        Largest distance between a chord of an arc and the arc: absolute, or a percentage of
+        the mean edge length (default ``"0.01%"``). An arc of radius ``r`` turning by
+        ``2 gamma`` gets ``ceil(2 gamma / (2 acos(1 - chord_tol / r))) + 1`` points (at least
+        2, at most ``samples``; a conical fillet counts with twice its midpoint radius, the
+        most it reaches on a module), so that the files grow with the curvature the geometry
+        has, not with the number of edges: a small fillet gets fewer points than a large one.
+        0: no limit (see ``arc_step``).
     clamp : bool, optional
         Reduce radii over their edge's limit to 90% of it (see
         :func:`filletfold.rounding.edges.clamp_radii`) instead of raising. Default: on, off with
@@ -522,8 +538,8 @@ def round_mesh(
     MeshError
         Unreadable or invalid mesh.
     ParameterError
-        Invalid radius, depth, samples, arc step or sheet (a radius over an edge's limit names
-        the edge).
+        Invalid radius, depth, samples, arc step, chord tolerance or sheet (a radius over an
+        edge's limit names the edge).
     SolverError
         With ``material_loss``: the programme has no solution with positive losses (the
         message names the binding vertices and edges); with ``layout="sheet"``: the modules do
@@ -532,6 +548,7 @@ def round_mesh(
     timings = {}
     t0 = time.perf_counter()
     _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale)
+    resolve_chord_tol(chord_tol, 1.0)  # refuse a bad one before any work
     progress = callers_progress(progress)
     strict = bool(strict)
     clamp = (not strict) if clamp is None else bool(clamp)
@@ -558,6 +575,7 @@ def round_mesh(
         depth=depth,
         samples=int(samples),
         arc_step=float(arc_step),
+        chord_tol=chord_tol,
         clamp=clamp,
         material_loss=bool(material_loss),
         max_loss=max_loss,
@@ -569,6 +587,7 @@ def round_mesh(
     )
     ref = pm.mean_edge_length
     size = mesh_size(pm)
+    chord = resolve_chord_tol(chord_tol, ref)
     min_width = 0.0 if strict else tol.min_fillet * size
 
     key = _stage_key(pm, radius, clamp, material_loss, max_loss, coplanar_deg, sharp_spec)
@@ -632,7 +651,11 @@ def round_mesh(
     t = time.perf_counter()
     _stage("vertex modules")
     points = rounding.arc_points(
-        int(samples), float(arc_step), min_chord=0.0 if strict else 2 * tol.ruling * size
+        int(samples),
+        float(arc_step),
+        min_chord=0.0 if strict else 2 * tol.ruling * size,
+        chord_tol=chord,
+        radius_scale=np.where(conical_sides(frames, pm.n_edges), 2.0, 1.0),
     )
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
@@ -804,6 +827,44 @@ def _apices(
     ]
     set_treatments(res, np.array([f.sharp for f in frames], dtype=bool))
     return frames, classified, rounding, centres, solved, kept, rescue
+
+
+def resolve_chord_tol(value, reference: float) -> float:
+    """The chord tolerance of :func:`round_mesh` as a length: a number, or a ``"N%"`` string
+    of ``reference`` (the mean edge length); 0 (or ``"0"``, ``"0%"``) for none.
+
+    Raises
+    ------
+    ParameterError
+        When it is not a finite number >= 0 or such a percentage.
+    """
+    if isinstance(value, bool):
+        raise ParameterError(
+            f"chord tolerance must be a length or 'N%', got {value!r}", name="chord_tol"
+        )
+    text = value.strip() if isinstance(value, str) else None
+    try:
+        number = float(text.removesuffix("%")) if text is not None else float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"chord tolerance must be a length or a percentage like '0.01%', got {value!r}",
+            name="chord_tol",
+        ) from None
+    if not (math.isfinite(number) and number >= 0):
+        raise ParameterError(
+            f"chord tolerance must be finite and >= 0 (0: none), got {value!r}", name="chord_tol"
+        )
+    if text is not None and text.endswith("%"):
+        return number / 100.0 * float(reference)
+    return number
+
+
+def conical_sides(frames, n_edges: int) -> np.ndarray:
+    """(n_edges,) bool: the edges some vertex frame rounds by a conical fillet."""
+    out = np.zeros(n_edges, dtype=bool)
+    edges = [side.edge for f in frames for side in f.sides if side.S is not None]
+    out[np.asarray(edges, dtype=np.int64)] = True
+    return out
 
 
 def _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale) -> None:

@@ -269,12 +269,26 @@ class EdgeRounding:
     uniform_limit: float
     sharp: np.ndarray | None = None
 
-    def arc_points(self, samples: int, step_deg: float = 0.0, min_chord: float = 0.0) -> np.ndarray:
+    def arc_points(
+        self,
+        samples: int,
+        step_deg: float = 0.0,
+        min_chord: float = 0.0,
+        chord_tol: float = 0.0,
+        radius_scale=1.0,
+    ) -> np.ndarray:
         """Points to sample on each edge's arc (both ends included).
 
-        An arc gets ``samples`` points, or fewer when it turns little: one point per
-        ``step_deg`` degrees it turns (``2 gamma``), and at least 2. Flat and boundary edges
-        (no arc) get 1. ``step_deg = 0`` gives every arc ``samples`` points.
+        With a chord tolerance, an arc of radius ``r`` that turns by ``2 gamma`` gets
+
+            n = ceil(2 gamma / (2 acos(1 - chord_tol / r))) + 1
+
+        points, at least 2: the fewest whose chords stay within ``chord_tol`` of the arc
+        (a chord over the turn ``phi`` is ``r (1 - cos(phi / 2))`` from it at its middle), so
+        that a small fillet gets fewer points than a large one turning alike. With an arc step,
+        it gets at least one point per ``step_deg`` degrees it turns (at least 2). With
+        neither, every arc gets ``samples`` points; ``samples`` is the most any arc gets.
+        Flat and boundary edges (no arc) get 1.
 
         Parameters
         ----------
@@ -285,22 +299,60 @@ class EdgeRounding:
         min_chord : float
             Shortest step along an arc (length): a tiny arc gets fewer points, at least 2, so
             that its steps are no pattern slivers. 0 for no limit.
+        chord_tol : float
+            Largest distance between a chord and its arc (a length); 0 for no limit.
+        radius_scale : float or (n_edges,) float
+            The largest radius of each edge's rounding over its radius in the midpoint
+            cross-section (2 on a conical fillet, whose radius grows from its sharp end;
+            1 on a cylinder), for the chord tolerance.
 
         Returns
         -------
         (n_edges,) int
         """
-        n = np.full(len(self.arc_length), int(samples))
-        if step_deg > 0:
-            turn = np.degrees(2 * self.half_angle)
-            steps = np.ceil(
-                turn / step_deg - tol.relative
-            )  # an exact multiple of the step gains none
-            n = np.minimum(n, np.maximum(2, steps + 1).astype(int))
+        n_arcs = len(self.arc_length)
+        turn = 2 * self.half_angle
+        if step_deg <= 0 and chord_tol <= 0:
+            n = np.full(n_arcs, int(samples))
+        else:
+            need = np.full(n_arcs, 2)
+            if step_deg > 0:
+                steps = np.ceil(  # an exact multiple of the step gains none
+                    np.degrees(turn) / step_deg - tol.relative
+                )
+                need = np.maximum(need, steps + 1).astype(int)
+            if chord_tol > 0:
+                need = np.maximum(need, chord_counts(turn, self.radius * radius_scale, chord_tol))
+            n = np.minimum(int(samples), need)
         if min_chord > 0:
             fit = np.floor(self.arc_length / min_chord) + 1
             n = np.minimum(n, np.maximum(2, fit).astype(int))
         return np.where(self.arc_length > 0, n, 1)
+
+
+def chord_counts(turn, radius, chord_tol: float) -> np.ndarray:
+    """Fewest points, ends included and at least 2, on an arc of ``radius`` turning by
+    ``turn`` (radians) whose chords stay within ``chord_tol`` of it:
+    ``ceil(turn / (2 acos(1 - chord_tol / r))) + 1`` (2 where ``r`` is 0).
+
+    Parameters
+    ----------
+    turn, radius : array_like of float
+    chord_tol : float
+        A length > 0.
+
+    Returns
+    -------
+    int array, shaped as ``turn`` and ``radius`` broadcast
+    """
+    turn, radius = np.broadcast_arrays(np.asarray(turn, float), np.asarray(radius, float))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(radius > 0, chord_tol / radius, np.inf)
+    # the turn of the longest chord, 2 acos(1 - x) = 4 asin(sqrt(x / 2)) without cancellation
+    step = 4.0 * np.arcsin(np.sqrt(np.minimum(0.5 * ratio, 1.0)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        steps = np.where(step > 0, np.ceil(turn / step - tol.relative), 1.0)
+    return np.maximum(2, steps + 1).astype(int)
 
 
 def round_edges(
