@@ -226,7 +226,7 @@ def _fabrication_report(design) -> dict:
     """Pieces, glue tabs, and (with sheets) pieces per sheet and material use."""
     out = {"pieces": int(design.pattern.n_pieces)}
     for k, v in design.fabrication.items():
-        out[k] = v if isinstance(v, list) else int(v)
+        out[k] = v if isinstance(v, list | dict) else int(v)
     return out
 
 
