@@ -24,10 +24,10 @@ from examples import machine
 
 #: (mesh, sheet, mm per mesh unit, round_mesh options)
 CASES = [
-    ("cube", "A4", 30.0, {}),
-    ("cube", "A3", 30.0, {}),
-    ("icosahedron", "A4", 40.0, {}),
-    ("icosahedron", "A3", 40.0, {}),
+    ("cube", "A4", 60.0, {}),
+    ("cube", "A3", 60.0, {}),
+    ("icosahedron", "A4", 60.0, {}),
+    ("icosahedron", "A3", 60.0, {}),
     ("dodecahedron", "A4", 60.0, {}),
     ("dodecahedron", "A3", 60.0, {}),
     ("torus", "A4", 30.0, {}),

@@ -194,3 +194,29 @@ def test_cli_nest_sparrow_reports_the_nester(tmp_path):
     assert fab["nesting"]["nester"] == "sparrow"
     assert fab["sheets"] == len(fab["pieces_per_sheet"]) == len(fab["material_use"])
     assert 0 < fab["nesting"]["material_use"] <= fab["nesting"]["strip_use"] <= 1
+
+
+@pytest.mark.parametrize("fault", ["overlap", "more sheets"])
+def test_a_bad_or_worse_nesting_gives_way_to_the_shelves(monkeypatch, fault):
+    from filletfold.layout import arrange
+
+    pieces = [_square(1.0), _square(1.0, (5, 0))]
+    original = [p.arrays()[0].copy() for p in pieces]
+    sheet, gap = (5.0, 3.5), 0.1
+
+    def fake(pieces, sheet, gap, seconds):
+        for p in pieces:  # turned, as nest_on_sheets does
+            p.points_2d = list(p.arrays()[0] @ nest.turn(90).T)
+        if fault == "overlap":
+            return np.zeros((2, 2)), np.array([[0.0, 0.0, 5.0, 3.5]]), np.zeros(2, int), 1
+        boxes = np.array([[0.0, 0.0, 5.0, 3.5], [6.0, 0.0, 11.0, 3.5]])
+        return np.array([[2.0, 1.0], [8.0, -4.0]]), boxes, np.arange(2), 1
+
+    monkeypatch.setattr(nest, "have_sparrow", lambda: True)
+    monkeypatch.setattr(arrange, "nest_on_sheets", fake)
+    offsets, boxes, sheet_of, nesting = arrange.place_on_sheets(pieces, sheet, gap, "sparrow")
+    assert nesting["nester"] == "shelf" and len(boxes) == 1
+    assert ("placement refused" if fault == "overlap" else "more sheets") in nesting["note"]
+    for p, ref in zip(pieces, original, strict=True):
+        assert np.array_equal(p.arrays()[0], ref)
+    assert nest.placement_errors(pieces, offsets, boxes, sheet_of, gap) == []

@@ -168,7 +168,8 @@ def place_on_sheets(pieces: list, sheet_box, gap: float, nest: str):
     """Translations placing oriented pieces on sheets, by the shelf packer or sparrow.
 
     sparrow's placement is checked (:func:`~filletfold.layout.nest.placement_errors`); a
-    faulty one is replaced by the shelf packer's, and the note says why.
+    faulty one, or one on more sheets than the shelf packer's, is replaced by the shelf
+    packer's, and the note says why.
 
     Returns
     -------
@@ -177,17 +178,24 @@ def place_on_sheets(pieces: list, sheet_box, gap: float, nest: str):
     sheet_of : (n_pieces,) int
     nesting : dict
         ``nester`` (``"shelf"`` or ``"sparrow"``), and for sparrow ``seconds`` (per run),
-        ``runs``, ``seed``; ``note`` when sparrow's placement was refused.
+        ``runs``, ``seed``; ``note`` when sparrow's placement was not kept.
     """
     nester, seconds = choose_nester(nest, sheet_box)
     nesting = {"nester": nester}
+    shelf = pack_on_sheets(pieces, sheet_box, gap)
     if nester == "sparrow":
+        before = [piece.points_2d for piece in pieces]  # nest_on_sheets turns them
         offsets, boxes, sheet_of, runs = nest_on_sheets(pieces, sheet_box, gap, seconds=seconds)
         faults = placement_errors(pieces, offsets, boxes, sheet_of, gap)
         nesting.update(seconds=seconds, runs=runs, seed=SEED)
-        if not faults:
+        if not faults and len(boxes) <= len(shelf[1]):
             return offsets, boxes, sheet_of, nesting
-        pieces[:] = [orient(piece) for piece in pieces]
-        nesting.update(nester="shelf", note=f"sparrow's placement refused: {faults[0]}")
-    offsets, boxes, sheet_of = pack_on_sheets(pieces, sheet_box, gap)
-    return offsets, boxes, sheet_of, nesting
+        for piece, points in zip(pieces, before, strict=True):
+            piece.points_2d = points
+        why = (
+            f"sparrow's placement refused: {faults[0]}"
+            if faults
+            else f"sparrow used more sheets than the shelves ({len(boxes)} against {len(shelf[1])})"
+        )
+        nesting.update(nester="shelf", note=why)
+    return (*shelf, nesting)

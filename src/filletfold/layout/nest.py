@@ -2,16 +2,18 @@
 
 The nester is sparrow (a strip-packing solver for irregular polygons) through its Python
 wrapper ``spyrrow``, an optional dependency (``pip install 'filletfold[nest]'``). Sheets are
-filled one after the other: the pieces left are strip-packed on a strip as high as the sheet,
-the pieces that lie within the first sheet width are kept on a new sheet, and the rest is
-packed again (:func:`nest_on_sheets`). Each piece is packed as its outline (holes filled)
-grown by half the gap, so that placed pieces keep the gap between them and from the sheet's
-edges, as on the shelves; the glue tabs, added after the placement, fit in that gap.
+filled first-fit by decreasing area (:func:`nest_on_sheets`): a sheet is opened with the largest
+piece left, and each other piece joins it when sparrow strip-packs the sheet's pieces, on a
+strip as high as the sheet, within one sheet width. Each piece is packed as its outline (holes
+filled) grown by half the gap, so that placed pieces keep the gap between them and from the
+sheet's edges, as on the shelves; the glue tabs, added after the placement, fit in that gap.
+:func:`placement_errors` checks a placement from the pieces themselves.
 
-sparrow stops on a time budget (whole seconds per packing run), so its result depends on how
-far it got in that time: with one worker and a fixed seed the same input gives the same
-placement on an idle machine, but a loaded machine may stop at another one. The shelf packer
-(:func:`~filletfold.layout.fabrication.pack_on_sheets`) is exact and stays the default.
+sparrow's search stops on the clock (whole seconds per packing run), so what it finds depends
+on the machine's load. Without a search budget (:data:`DEFAULT_SECONDS`) only its constructive
+placement runs, with a fixed seed and one worker: the same input then gives the same placement
+(and the same bytes) whatever the load. The shelf packer
+(:func:`~filletfold.layout.fabrication.pack_on_sheets`) stays the default.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from ..errors import ParameterError
 from ..surface.faces import face_polygons
 from ..surface.piece import Piece
 from ..tolerances import tol
+from .fabrication import pack_on_sheets
 
 #: The nesters ``round_mesh(nest=...)`` and ``--nest`` accept.
 NESTERS = ("shelf", "sparrow", "auto")
@@ -223,10 +226,10 @@ def nest_on_sheets(
 ):
     """Place pieces on sheets with sparrow; turn them in place (rigidly), return translations.
 
-    First fit by decreasing area, sparrow deciding what fits: a sheet is opened with the
-    largest piece left; every other piece left, largest first, joins it when sparrow packs
-    the sheet's pieces and it within a sheet width (their area ruling out the hopeless ones
-    first); then the next sheet.
+    First fit by decreasing area: a sheet is opened with the largest piece left; every other
+    piece left, largest first, joins it when sparrow packs the sheet's pieces and it within a
+    sheet width, or else the shelf rows hold them on one sheet (their area rules out the
+    hopeless ones first); then the next sheet.
 
     Parameters
     ----------
@@ -302,19 +305,23 @@ def nest_on_sheets(
             trial = [*members, k]
             packed = _strip_pack([shapes[j] for j in trial], height, seconds, seed, turns)
             runs += 1
-            if packed is None:
-                continue
-            rot, shift = packed
-            moved = zip(trial, rot, shift, strict=True)
-            extent = np.array([_extent(shapes[j], r, t) for j, r, t in moved])
-            if (
-                extent[:, :2].min() >= -slack
-                and extent[:, 2].max() <= width + slack
-                and extent[:, 3].max() <= height + slack
-            ):
-                members, used = trial, used + area[k]
-                rotation[trial], place[trial] = rot, shift
-                left.remove(k)
+            if packed is not None:
+                rot, shift = packed
+                moved = zip(trial, rot, shift, strict=True)
+                extent = np.array([_extent(shapes[j], r, t) for j, r, t in moved])
+                fits = (
+                    extent[:, :2].min() >= -slack
+                    and extent[:, 2].max() <= width + slack
+                    and extent[:, 3].max() <= height + slack
+                )
+            if packed is None or not fits:  # the shelf rows may still hold them
+                rows, boxes, _ = pack_on_sheets([pieces[j] for j in trial], (w, h), gap)
+                if len(boxes) != 1:
+                    continue
+                rot, shift = np.zeros(len(trial)), rows + centre[trial] - 0.5 * gap
+            members, used = trial, used + area[k]
+            rotation[trial], place[trial] = rot, shift
+            left.remove(k)
         sheet_of[members] = n_sheets
         n_sheets += 1
     step = w + 4 * gap
