@@ -186,12 +186,14 @@ def test_cli_errors_are_one_line(tmp_path, capsys, monkeypatch):
 
 
 @needs_sparrow
-def test_cli_nest_sparrow_reports_the_nester(tmp_path):
+def test_cli_nest_sparrow_reports_the_nester(tmp_path, capsys):
     out = tmp_path / "c"
-    args = ["round", "cube", "--sheet", "A4", "--units", "mm", "--scale", "30", "-q"]
+    args = ["round", "cube", "--sheet", "A4", "--units", "mm", "--scale", "30"]
     assert main([*args, "--nest", "sparrow", "-o", str(out), "--format", "json"]) == 0
     fab = json.loads((out / "report.json").read_text())["fabrication"]
     assert fab["nesting"]["nester"] == "sparrow"
+    use = f"{fab['nesting']['material_use']:.0%}"
+    assert f"sheets: {fab['sheets']} (sparrow, material use {use})" in capsys.readouterr().out
     assert fab["sheets"] == len(fab["pieces_per_sheet"]) == len(fab["material_use"])
     assert 0 < fab["nesting"]["material_use"] <= fab["nesting"]["strip_use"] <= 1
 
