@@ -6,7 +6,7 @@ Commands
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
 ``[--chord-tol TOL] [--coplanar-tol DEG]``
-``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME]``
+``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME] [--nest NESTER]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
     pictures).
@@ -303,6 +303,16 @@ def round_cmd(
     no_tabs: Annotated[
         bool, typer.Option("--no-tabs", help="No glue tabs, seam labels or part numbers.")
     ] = False,
+    nest: Annotated[
+        str,
+        typer.Option(
+            "--nest",
+            help="How pieces are placed on --sheet sheets: 'shelf' (rows of bounding "
+            "rectangles), 'sparrow' (the irregular nester, needs the 'nest' extra; "
+            "'sparrow:S' searches S seconds per packing run, which is not byte-reproducible) "
+            "or 'auto' (sparrow when installed, else shelf).",
+        ),
+    ] = "shelf",
 ):
     """Round every edge and vertex of MESH; write the design into the output folder.
 
@@ -358,6 +368,7 @@ def round_cmd(
                 units=units or "mm",
                 scale=scale if scale is not None else 1.0,
                 tabs=not no_tabs,
+                nest=nest,
                 coplanar_deg=coplanar_tol,
                 progress=progress,
                 keep_stages=False,  # nothing is reused: let frames and modules go early

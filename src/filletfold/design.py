@@ -37,6 +37,7 @@ from .errors import (
 from .errors import stage as _stage
 from .layout.arrange import arrange
 from .layout.fabrication import sheet_in_pattern_units
+from .layout.nest import choose_nester
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh, mesh_size
 from .rounding.conical import conical_material_loss, is_conical, use_cone_axes
@@ -437,6 +438,7 @@ def round_mesh(
     fit_vertices: bool | None = None,
     certify: bool = True,
     sharp: str | None = DEFAULT_SHARP,
+    nest: str = "shelf",
 ) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
@@ -490,6 +492,11 @@ def round_mesh(
         Size of the material sheets (``"A4"``, ``"A3"``, ``"A2"``, ``"A1"``, ``"Letter"``,
         ``"Legal"`` or ``"WIDTHxHEIGHT"`` in mm): nets are split to fit and the pieces are
         placed on as few sheets as found.
+    nest : str
+        How the pieces are placed on the sheets: ``"shelf"`` (rows of bounding rectangles, the
+        default), ``"sparrow"`` (the irregular nester of the ``nest`` extra, ``"sparrow:S"``
+        for S seconds per packing run; needs ``sheet``) or ``"auto"`` (sparrow when installed
+        and ``sheet`` is given, else the shelves). See :mod:`filletfold.layout.nest`.
     units, scale : str, float
         One pattern unit is ``scale`` ``units`` on the sheet (``units`` in mm, cm, m, in).
     tabs : bool
@@ -549,6 +556,7 @@ def round_mesh(
     t0 = time.perf_counter()
     _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale)
     resolve_chord_tol(chord_tol, 1.0)  # refuse a bad one before any work
+    choose_nester(nest, sheet)  # refuse a bad nester, or a missing one, before the solve
     progress = callers_progress(progress)
     strict = bool(strict)
     clamp = (not strict) if clamp is None else bool(clamp)
@@ -705,6 +713,7 @@ def round_mesh(
         units=units,
         scale=scale,
         tabs=tabs,
+        nest=nest,
         stage=_stage,
         timings=timings,
     )

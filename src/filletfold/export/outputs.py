@@ -226,7 +226,7 @@ def _fabrication_report(design) -> dict:
     """Pieces, glue tabs, and (with sheets) pieces per sheet and material use."""
     out = {"pieces": int(design.pattern.n_pieces)}
     for k, v in design.fabrication.items():
-        out[k] = v if isinstance(v, list) else int(v)
+        out[k] = v if isinstance(v, list | dict) else int(v)
     return out
 
 
@@ -318,7 +318,11 @@ def design_summary(design, max_listed: int = 8) -> str:
             + (f", {fab['untabbed']} with labels only (no room)" if fab["untabbed"] else "")
         )
     if len(pat.annotations.sheets):
-        lines.append(f"sheets: {len(pat.annotations.sheets)}")
+        nesting = fab.get("nesting", {})
+        placed = (
+            f" ({nesting['nester']}, material use {nesting['material_use']:.0%})" if nesting else ""
+        )
+        lines.append(f"sheets: {len(pat.annotations.sheets)}{placed}")
     flagged = [u for u, st in enumerate(design.vertices.status) if st not in ("ok", "boundary")]
     for u in flagged[:max_listed]:
         reason = design.vertices.reason[u]

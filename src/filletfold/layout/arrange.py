@@ -16,6 +16,7 @@ from ..surface.assemble import assemble_pattern
 from ..surface.piece import piece_area
 from ..tolerances import tol
 from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
+from .nest import SEED, choose_nester, nest_on_sheets, placement_errors, use_figures
 from .sheet import glue_pieces
 from .shelf import shelf_offsets
 from .tabs import add_tabs_and_labels
@@ -40,6 +41,7 @@ def arrange(
     units: str,
     scale,
     tabs: bool,
+    nest: str = "shelf",
     stage=lambda name: None,
     timings: dict | None = None,
 ):
@@ -65,10 +67,14 @@ def arrange(
     sheet, units, scale
         The sheet of material (None: none) and how a pattern unit is drawn.
     tabs : bool
+    nest : str
+        How pieces are placed on sheets: ``"shelf"``, ``"sparrow"`` or ``"auto"``, optionally
+        ``":SECONDS"`` (:func:`~filletfold.layout.nest.choose_nester`).
     stage : callable
         Called with the name of each sub-stage as it starts (``"glue tabs"``).
     timings : dict, optional
-        Gets ``"tabs"``: the seconds the glue tabs took (when ``tabs``).
+        Gets ``"tabs"``: the seconds the glue tabs took (when ``tabs``), and ``"nest"``: the
+        seconds the placement on sheets took (with a sheet).
 
     Returns
     -------
@@ -126,11 +132,15 @@ def arrange(
         layout_used = "net"
     if sheet is not None:
         pieces = [orient(piece) for piece in pieces]
-        offsets, boxes, sheet_of = pack_on_sheets(pieces, sheet_box, gap)
+        t = time.perf_counter()
+        offsets, boxes, sheet_of, nesting = place_on_sheets(pieces, sheet_box, gap, nest)
+        if timings is not None:
+            timings["nest"] = time.perf_counter() - t
         pattern = assemble_pattern(pieces, offsets)
         pattern.annotations.sheets = boxes
         area = np.array([piece_area(piece) for piece in pieces])
         sheet_area = sheet_box[0] * sheet_box[1]
+        nesting.update(use_figures(area, pieces, offsets, boxes, sheet_of, gap))
         sheet_stats = {
             "sheets": len(boxes),
             "sheet_size": [float(max(sheet_box)), float(min(sheet_box))],
@@ -138,6 +148,7 @@ def arrange(
             "material_use": (
                 np.bincount(sheet_of, weights=area, minlength=len(boxes)) / sheet_area
             ).tolist(),
+            "nesting": nesting,
         }
     else:
         pattern = assemble_pattern(pieces, shelf_offsets(pieces, gap))
@@ -151,3 +162,40 @@ def arrange(
     if sheet is not None:
         fab.update(sheet_stats)
     return pattern, layout_used, layout_note, fab
+
+
+def place_on_sheets(pieces: list, sheet_box, gap: float, nest: str):
+    """Translations placing oriented pieces on sheets, by the shelf packer or sparrow.
+
+    sparrow's placement is checked (:func:`~filletfold.layout.nest.placement_errors`); a
+    faulty one, or one on more sheets than the shelf packer's, is replaced by the shelf
+    packer's, and the note says why.
+
+    Returns
+    -------
+    offsets : (n_pieces, 2) float
+    boxes : (n_sheets, 4) float
+    sheet_of : (n_pieces,) int
+    nesting : dict
+        ``nester`` (``"shelf"`` or ``"sparrow"``), and for sparrow ``seconds`` (per run),
+        ``runs``, ``seed``; ``note`` when sparrow's placement was not kept.
+    """
+    nester, seconds = choose_nester(nest, sheet_box)
+    nesting = {"nester": nester}
+    shelf = pack_on_sheets(pieces, sheet_box, gap)
+    if nester == "sparrow":
+        before = [piece.points_2d for piece in pieces]  # nest_on_sheets turns them
+        offsets, boxes, sheet_of, runs = nest_on_sheets(pieces, sheet_box, gap, seconds=seconds)
+        faults = placement_errors(pieces, offsets, boxes, sheet_of, gap)
+        nesting.update(seconds=seconds, runs=runs, seed=SEED)
+        if not faults and len(boxes) <= len(shelf[1]):
+            return offsets, boxes, sheet_of, nesting
+        for piece, points in zip(pieces, before, strict=True):
+            piece.points_2d = points
+        why = (
+            f"sparrow's placement refused: {faults[0]}"
+            if faults
+            else f"sparrow used more sheets than the shelves ({len(boxes)} against {len(shelf[1])})"
+        )
+        nesting.update(nester="shelf", note=why)
+    return (*shelf, nesting)
