@@ -95,8 +95,8 @@ FormatOption = Annotated[
     typer.Option(
         "--format",
         "-f",
-        help="Comma-separated output formats: fold, json, obj, svg, dxf, pdf, png (pattern.png "
-        "and preview.png), or all.",
+        help="Comma-separated output formats: fold, simulator (simulator.fold, for Origami "
+        "Simulator), json, obj, svg, dxf, pdf, png (pattern.png and preview.png), or all.",
     ),
 ]
 UnitsOption = Annotated[
