@@ -208,6 +208,7 @@ def test_net_on_sheets_with_all_formats(tmp_path, capsys):
         "pattern.svg",
         "preview.png",
         "report.json",
+        "simulator.fold",
         "timings.json",
     ]
     fab = json.loads((out / "report.json").read_text())["fabrication"]

@@ -97,9 +97,9 @@ FormatOption = Annotated[
     typer.Option(
         "--format",
         "-f",
-        help="Comma-separated output formats: fold, json, obj, svg, dxf, pdf, png (pattern.png "
-        "and preview.png), 3dm (pattern.3dm and folded.3dm, needs rhino3dm), glb (or gltf), "
-        "ply, stl, or all.",
+        help="Comma-separated output formats: fold, simulator (simulator.fold, for Origami "
+        "Simulator), json, obj, svg, dxf, pdf, png (pattern.png and preview.png), 3dm "
+        "(pattern.3dm and folded.3dm, needs rhino3dm), glb (or gltf), ply, stl, or all.",
     ),
 ]
 UnitsOption = Annotated[

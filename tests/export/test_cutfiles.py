@@ -61,6 +61,7 @@ def test_cut_files_names_and_types():
     files = cut_files(arc_pattern(annotated=True), "all", units="mm", scale=40.0, report={"a": 1})
     assert list(files) == [
         "design.fold",
+        "simulator.fold",
         "report.json",
         "folded.obj",
         "pattern.svg",
@@ -119,6 +120,7 @@ def test_export_design_all_formats(cube, tmp_path):
     written = export_design(cube, tmp_path / "all", formats="all", units="mm", scale=60.0)
     assert [p.name for p in written] == [
         "design.fold",
+        "simulator.fold",
         "report.json",
         "folded.obj",
         "pattern.svg",
@@ -201,7 +203,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 15 files" in capsys.readouterr().out
+    assert "wrote 16 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 

@@ -72,7 +72,10 @@ def test_fold_round_trip_values(pattern):
     assert_allclose(doc["file_frames"][0]["vertices_coords"], pattern.vertices_3d, atol=ATOL)
     assert doc["edges_vertices"] == pattern.edges.tolist()
     assert doc["edges_assignment"] == pattern.edge_assignment.tolist()
-    assert_allclose(doc["edges_foldAngle"], pattern.edge_fold_angle, atol=ATOL)
+    crease = np.isin(pattern.edge_assignment, ["M", "V"])
+    angle = np.array([np.nan if a is None else a for a in doc["edges_foldAngle"]])
+    assert_allclose(angle[crease], pattern.edge_fold_angle[crease], atol=ATOL)
+    assert np.isnan(angle[pattern.edge_assignment == "B"]).all()
     assert doc["faces_vertices"] == [list(f) for f in pattern.faces]
 
 
@@ -86,13 +89,48 @@ def test_fold_faces_ccw(pattern):
 def test_fold_assignment_matches_angle_sign(pattern):
     doc = json.loads(fold_json(fold_document(pattern)))
     for a, angle in zip(doc["edges_assignment"], doc["edges_foldAngle"], strict=True):
+        if a == "B":
+            assert angle is None
+            continue
         assert -180.0 <= angle <= 180.0
         if a == "V":
             assert angle > 0
         elif a == "M":
             assert angle < 0
-        else:
-            assert angle == pytest.approx(0.0, abs=ATOL)
+
+
+def _frame_dihedral(doc: dict, edge: int) -> float:
+    """The fold angle (valley positive) of ``edge`` measured in the folded frame of a FOLD
+    document: the signed angle between its two faces' normals, from the frame alone."""
+    v3 = np.array(doc["file_frames"][0]["vertices_coords"])
+    a, b = doc["edges_vertices"][edge]
+    sides = []
+    for f in doc["faces_vertices"]:
+        k = len(f)
+        for i in range(k):
+            if {f[i], f[(i + 1) % k]} == {a, b}:
+                p = v3[f]
+                n = np.sum(np.cross(p - p.mean(0), np.roll(p, -1, 0) - p.mean(0)), axis=0)
+                sides.append((f[i] == a, n / np.linalg.norm(n)))
+    assert len(sides) == 2
+    (_, n1), (_, n2) = sorted(sides, key=lambda s: not s[0])
+    d = (v3[b] - v3[a]) / np.linalg.norm(v3[b] - v3[a])
+    return -np.degrees(np.arctan2(np.cross(n1, n2) @ d, n1 @ n2))
+
+
+def test_fold_facet_angles_are_the_folded_dihedrals():
+    """F edges inside the cylinders and cones carry the folded form's dihedral (not 0), M/V
+    edges their crease angle, on a real design."""
+    from ..conftest import design_of
+
+    p = design_of("tetrahedron", samples=6).pattern
+    doc = json.loads(fold_json(fold_document(p)))
+    inner = [e for e, a in enumerate(doc["edges_assignment"]) if a != "B"]
+    measured = np.array([_frame_dihedral(doc, e) for e in inner])
+    written = np.array([doc["edges_foldAngle"][e] for e in inner])
+    assert_allclose(written, measured, atol=1e-7)
+    flat = np.array([doc["edges_assignment"][e] == "F" for e in inner])
+    assert flat.any() and (np.abs(written[flat]) > 1e-3).any()
 
 
 @pytest.mark.parametrize(("angle", "assignment"), [(90.0, "V"), (-90.0, "M")])

@@ -6,6 +6,9 @@ Formats and their files:
 format     files                            content
 =========  ===============================  =================================================
 ``fold``   ``design.fold``                  FOLD 1.2: crease pattern + folded form
+``simulator`` ``simulator.fold``            FOLD 1.2 for Origami Simulator: the pattern
+                                            coarsened and triangulated (see
+                                            :func:`~filletfold.export.simulator.simulator_pattern`)
 ``json``   ``report.json``                  the design report (needs the design, not only
                                             the pattern)
 ``obj``    ``folded.obj``                   the folded form
@@ -79,6 +82,7 @@ __all__ = [
 #: Files written for each format, in writing order.
 FORMAT_FILES = {
     "fold": ("design.fold",),
+    "simulator": ("simulator.fold",),
     "json": ("report.json",),
     "obj": ("folded.obj",),
     "svg": ("pattern.svg",),
@@ -332,6 +336,21 @@ def cut_files(
         doc = _fold_document(pattern, faces, title=title, description=description, arrays=True)
         return fold_json(doc)
 
+    def simulator():
+        from .simulator import SIM_MAX_TURN, SIM_MIN_ANGLE, simulator_pattern
+
+        coarse = simulator_pattern(pattern)
+        settings = {"max_turn": SIM_MAX_TURN, "min_angle": SIM_MIN_ANGLE}
+        doc = _fold_document(
+            coarse,
+            validated_faces(coarse),
+            title=title,
+            description=description,
+            extra={"filletfold:simulator": settings},
+            arrays=True,
+        )
+        return fold_json(doc)
+
     def pdf():
         pdf_units, pdf_scale = units or "mm", scale
         if not units and not scale_given:
@@ -349,6 +368,7 @@ def cut_files(
 
     builders = {
         "fold": {"design.fold": fold},
+        "simulator": {"simulator.fold": simulator},
         "json": {"report.json": lambda: report if isinstance(report, str) else report_json(report)},
         "obj": {"folded.obj": lambda: _folded_obj(pattern, faces)},
         "svg": {

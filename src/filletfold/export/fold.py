@@ -29,6 +29,7 @@ __all__ = [
     "FOLD_SPEC",
     "NAMESPACE",
     "annotations_document",
+    "edge_dihedrals",
     "face_arrays",
     "file_creator",
     "fold_document",
@@ -77,8 +78,10 @@ def fold_document(
     dict
         Keys in a fixed order: file metadata, key-frame metadata, ``vertices_coords`` (n, 2),
         ``edges_vertices`` (m, 2), ``edges_assignment`` (m,), ``edges_foldAngle`` (m,) degrees
-        (valley positive), ``faces_vertices`` (counter-clockwise), ``filletfold:faces_patch`` and
-        ``filletfold:faces_piece`` (n_faces,), ``filletfold:pieces_vertex`` (n_pieces,),
+        (valley positive; ``null`` on borders, the folded form's dihedral on ``F`` edges, see
+        :func:`edge_dihedrals`), ``faces_vertices`` (counter-clockwise),
+        ``filletfold:faces_patch`` and ``filletfold:faces_piece`` (n_faces,),
+        ``filletfold:pieces_vertex`` (n_pieces,),
         ``file_frames`` (the folded form: a child of the key frame with 3D ``vertices_coords``
         (n, 3)), ``filletfold:annotations`` when the pattern has any (see
         :func:`annotations_document`), then ``extra``.
@@ -134,7 +137,7 @@ def _fold_document(
         "vertices_coords": as_data(pattern.vertices_2d),
         "edges_vertices": as_data(np.asarray(pattern.edges, dtype=np.int64)),
         "edges_assignment": _assignment_data(pattern.edge_assignment, arrays),
-        "edges_foldAngle": as_data(np.asarray(pattern.edge_fold_angle, dtype=np.float64)),
+        "edges_foldAngle": _fold_angle_data(pattern, arrays),
         "faces_vertices": faces_vertices,
         NAMESPACE + "faces_patch": list(map(str, pattern.face_patch)),
         NAMESPACE + "faces_piece": as_data(pattern.face_piece),
@@ -166,6 +169,71 @@ def _fold_document(
             )
         doc[key] = value
     return doc
+
+
+def edge_dihedrals(pattern: CreasePattern) -> np.ndarray:
+    """(m,) the folded form's dihedral at every pattern edge, in FOLD's sign (valley positive).
+
+    The angle between the 3D normals of the edge's two faces, signed as
+    :class:`~filletfold.surface.pattern.CreasePattern` signs its creases; NaN on an edge with
+    fewer than two faces. On M and V edges it is ``pattern.edge_fold_angle``; on F edges it is
+    the small bend of a sampled cylinder or cone between two of its facets (the pattern itself
+    keeps 0 there).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+
+    Returns
+    -------
+    (m,) float
+    """
+    edges = np.asarray(pattern.edges, dtype=np.int64).reshape(-1, 2)
+    ef = pattern.edge_faces
+    if ef is None:  # a pattern read from a file
+        from .fold_read import _edge_faces
+
+        ef = _edge_faces(edges, list(pattern.faces), len(pattern.vertices_2d))
+    ef = np.asarray(ef, dtype=np.int64).reshape(-1, 2)
+    out = np.full(len(edges), np.nan)
+    inner = (ef >= 0).all(axis=1)
+    if not inner.any():
+        return out
+    normals = pattern.face_normal_3d()
+    # an edge lo -> hi is traversed forward by its first face, as CreasePattern orders them
+    na, nb = normals[ef[inner, 0]], normals[ef[inner, 1]]
+    d = pattern.vertices_3d[edges[inner, 1]] - pattern.vertices_3d[edges[inner, 0]]
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
+    cos = np.einsum("ij,ij->i", na, nb)
+    out[inner] = -np.degrees(np.arctan2(sin, cos))
+    return out
+
+
+def _fold_angle_data(pattern: CreasePattern, raw: bool) -> list | _Raw:
+    """``edges_foldAngle``: M and V edges as the pattern has them, F edges the folded form's
+    dihedral (:func:`edge_dihedrals`), B edges ``null``; a list, or with ``raw`` JSON text."""
+    angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64).copy()
+    assign = np.asarray(pattern.edge_assignment, dtype=str)
+    flat = assign == "F"
+    if flat.any():
+        angle[flat] = edge_dihedrals(pattern)[flat]
+    border = assign == "B"
+    angle[border] = 0.0
+    if not np.isfinite(angle).all():
+        bad = int(np.nonzero(~np.isfinite(angle))[0][0])
+        raise ExportError(f"pattern edge {bad} has no finite fold angle")
+    if not raw:
+        items: list = angle.tolist()
+        for e in np.nonzero(border)[0].tolist():
+            items[e] = None
+        return items
+    if len(angle) == 0:
+        return _Raw("[]")
+    texts = _item_texts(angle)
+    for e in np.nonzero(border)[0].tolist():
+        texts[e] = "null"
+    return _Raw("[" + ",".join(texts) + "]")
 
 
 def _assignment_data(assignment, raw: bool) -> list | _Raw:

@@ -105,6 +105,8 @@ def pattern_from_fold(doc: dict) -> CreasePattern:
         edges = np.asarray(doc["edges_vertices"], dtype=np.int64).reshape(-1, 2)
         assign = np.asarray([str(a) for a in doc["edges_assignment"]], dtype="<U1")
         angle = np.asarray(doc["edges_foldAngle"], dtype=np.float64).reshape(-1)
+        if len(angle) == len(assign):  # borders are null and facets bent in the file: 0 here
+            angle = np.where((assign == "B") | (assign == "F"), 0.0, angle)
         face_piece = np.asarray(doc[NAMESPACE + "faces_piece"], dtype=np.int64).reshape(-1)
         patches = [str(p) for p in doc[NAMESPACE + "faces_patch"]]
     except (TypeError, ValueError) as exc:

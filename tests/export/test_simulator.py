@@ -1,0 +1,190 @@
+"""``simulator.fold`` (:mod:`filletfold.export.simulator`): what Origami Simulator needs, read
+back from the written file, on real designs. No browser: the checks are the geometric
+conditions the simulator's solver relies on."""
+
+from __future__ import annotations
+
+import functools
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.spatial import cKDTree
+
+import filletfold
+from filletfold.errors import ParameterError
+from filletfold.export import cut_files
+from filletfold.export.simulator import SIM_MIN_ANGLE, simulator_pattern, triangle_min_angles
+
+from ..conftest import design_of
+
+CORPUS = Path(__file__).parent.parent / "data" / "corpus"
+#: Origami Simulator's shader reads at most 100 beams (and creases) per vertex.
+MAX_VALENCE = 30
+
+
+@functools.cache
+def _design(name: str) -> filletfold.Design:
+    if name == "icosahedron net":
+        return filletfold.round_mesh("icosahedron", layout="net")
+    if name == "miura material-loss":
+        return filletfold.round_mesh("miura", material_loss=True)
+    if name == "compas-boxes":
+        return filletfold.round_mesh(str(CORPUS / "compas-boxes.obj"))
+    return design_of(name)
+
+
+DESIGNS = ["cube", "icosahedron net", "miura material-loss", "compas-boxes"]
+
+
+@functools.cache
+def _file(name: str) -> dict:
+    text = cut_files(_design(name).pattern, "simulator")["simulator.fold"]
+    return json.loads(text)
+
+
+def _arrays(doc: dict):
+    v2 = np.array(doc["vertices_coords"], dtype=float)
+    v3 = np.array(doc["file_frames"][0]["vertices_coords"], dtype=float)
+    edges = np.array(doc["edges_vertices"], dtype=np.int64)
+    faces = np.array(doc["faces_vertices"], dtype=np.int64)
+    return v2, v3, edges, faces
+
+
+def _frame_dihedrals(v3, edges, faces) -> np.ndarray:
+    """The fold angle (valley positive) of every edge with two faces, from the folded frame
+    alone; NaN on the others. The face that runs an edge a -> b is its left face."""
+    n = len(v3)
+    left = {}
+    for f, (a, b, c) in enumerate(faces.tolist()):
+        for u, w in ((a, b), (b, c), (c, a)):
+            left[(u, w)] = f
+    p = v3[faces]
+    normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    out = np.full(len(edges), np.nan)
+    for e, (a, b) in enumerate(edges.tolist()):
+        fa, fb = left.get((a, b)), left.get((b, a))
+        if fa is None or fb is None:
+            continue
+        d = (v3[b] - v3[a]) / np.linalg.norm(v3[b] - v3[a])
+        n1, n2 = normal[fa], normal[fb]
+        out[e] = -np.degrees(np.arctan2(np.cross(n1, n2) @ d, n1 @ n2))
+    assert n == len(v3)
+    return out
+
+
+@pytest.mark.parametrize("name", DESIGNS)
+def test_simulator_triangles_have_no_slivers(name):
+    v2, v3, _, faces = _arrays(_file(name))
+    assert faces.shape[1] == 3  # the simulator adds no flat diagonals of its own
+    assert triangle_min_angles(v2, faces).min() >= SIM_MIN_ANGLE
+    assert triangle_min_angles(v3, faces).min() > 0.1  # no folded triangle is degenerate
+
+
+@pytest.mark.parametrize("name", DESIGNS)
+def test_simulator_valence_is_bounded(name):
+    v2, _, edges, _ = _arrays(_file(name))
+    valence = np.bincount(edges.ravel(), minlength=len(v2))
+    assert valence.max() <= MAX_VALENCE
+    fine = _design(name).pattern
+    assert len(v2) < len(fine.vertices_2d) / 2  # coarser than design.fold
+
+
+@pytest.mark.parametrize("name", DESIGNS)
+def test_simulator_fold_angles_are_the_folded_dihedrals(name):
+    doc = _file(name)
+    _, v3, edges, faces = _arrays(doc)
+    assign = np.array(doc["edges_assignment"])
+    angle = doc["edges_foldAngle"]
+    border = assign == "B"
+    assert all(angle[e] is None for e in np.nonzero(border)[0])
+    measured = _frame_dihedrals(v3, edges, faces)
+    assert np.isnan(measured[border]).all() and np.isfinite(measured[~border]).all()
+    written = np.array([angle[e] for e in np.nonzero(~border)[0]], dtype=float)
+    assert_allclose(written, measured[~border], atol=1e-6)
+    # M/V as the sign says; facets bend where a cylinder or cone bends
+    a = assign[~border]
+    assert (written[a == "V"] > 0).all() and (written[a == "M"] < 0).all()
+    assert (np.abs(written[a == "F"]) > 1.0).any()
+
+
+@pytest.mark.parametrize("name", DESIGNS)
+def test_simulator_sheet_folds_without_stretch(name):
+    """Flat and folded edge lengths agree: a coarse cell's chord across a dropped stretch of
+    arc is shorter folded than flat by about turn**2 / 24 of its width only."""
+    v2, v3, edges, _ = _arrays(_file(name))
+    l2 = np.linalg.norm(v2[edges[:, 0]] - v2[edges[:, 1]], axis=1)
+    l3 = np.linalg.norm(v3[edges[:, 0]] - v3[edges[:, 1]], axis=1)
+    size = np.linalg.norm(np.ptp(v3, axis=0))
+    assert np.abs(l2 - l3).max() <= 2e-3 * size
+    assert np.median(np.abs(l2 - l3) / l2) < 1e-3
+
+
+@pytest.mark.parametrize("name", DESIGNS)
+def test_simulator_keeps_the_pieces_and_their_topology(name):
+    doc = _file(name)
+    v2, v3, edges, faces = _arrays(doc)
+    fine = _design(name).pattern
+    piece = np.array(doc["filletfold:faces_piece"])
+    assert sorted(set(piece.tolist())) == sorted(set(fine.face_piece.tolist()))
+    for k in set(piece.tolist()):
+        f = faces[piece == k]
+        verts = np.unique(f)
+        e = np.unique(
+            np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0
+        )
+        fine_faces = [
+            np.asarray(x) for x, p in zip(fine.faces, fine.face_piece, strict=True) if p == k
+        ]
+        fine_verts = np.unique(np.concatenate(fine_faces))
+        fine_e = np.unique(
+            np.sort(np.concatenate([np.c_[x, np.roll(x, -1)] for x in fine_faces]), axis=1), axis=0
+        )
+        assert len(verts) - len(e) + len(f) == len(fine_verts) - len(fine_e) + len(fine_faces)
+    # every edge has one or two faces, each face side is one edge
+    sides = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    _, count = np.unique(sides, axis=0, return_counts=True)
+    assert count.max() <= 2 and len(count) == len(edges)
+    # counter-clockwise flat, and the same folded positions as design.fold where not merged
+    p = v2[faces]
+    u, w = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    area = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
+    assert (area > 0).all()
+    # every point is a point of design.fold, or a merge of points closer than 1 % of the size
+    size = np.linalg.norm(np.ptp(fine.vertices_3d, axis=0))
+    for mine, theirs in ((v2, fine.vertices_2d), (v3, fine.vertices_3d)):
+        gap, _ = cKDTree(theirs).query(mine)
+        assert gap.max() <= 1e-2 * size
+        assert np.mean(gap <= 1e-9 * size) >= 0.75
+
+
+def test_simulator_cube_keeps_exact_points():
+    """Without collapsed cylinders every point of simulator.fold is a point of design.fold."""
+    v2, v3, _, _ = _arrays(_file("cube"))
+    fine = _design("cube").pattern
+    keys = {
+        tuple(np.round(np.r_[a, b], 9))
+        for a, b in zip(fine.vertices_2d, fine.vertices_3d, strict=True)
+    }
+    assert all(tuple(np.round(np.r_[a, b], 9)) in keys for a, b in zip(v2, v3, strict=True))
+
+
+def test_simulator_file_is_reproducible_and_documented():
+    pattern = _design("cube").pattern
+    a = cut_files(pattern, "simulator")["simulator.fold"]
+    assert a == cut_files(pattern, "simulator")["simulator.fold"]
+    doc = json.loads(a)
+    assert doc["filletfold:simulator"]["min_angle"] == SIM_MIN_ANGLE
+    assert doc["frame_classes"] == ["creasePattern"]
+    assert len(doc["file_frames"][0]["vertices_coords"]) == len(doc["vertices_coords"])
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"), [({"max_turn": 0.0}, "max_turn"), ({"min_angle": 90}, "min_angle")]
+)
+def test_simulator_rejects_bad_settings(kw, name):
+    with pytest.raises(ParameterError, match=name):
+        simulator_pattern(_design("cube").pattern, **kw)
