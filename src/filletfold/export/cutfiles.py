@@ -2,30 +2,30 @@
 
 Formats and their files:
 
-=========  ===============================  =================================================
-format     files                            content
-=========  ===============================  =================================================
-``fold``   ``design.fold``                  FOLD 1.2: crease pattern + folded form
-``simulator`` ``simulator.fold``            FOLD 1.2 for Origami Simulator: the pattern
-                                            coarsened and triangulated (see
-                                            :func:`~filletfold.export.simulator.simulator_pattern`)
-``json``   ``report.json``                  the design report (needs the design, not only
-                                            the pattern)
-``obj``    ``folded.obj``                   the folded form
-``svg``    ``pattern.svg``                  the flat layout (by default Origami Simulator's
-                                            colours; see ``preset``)
-``dxf``    ``pattern.dxf``                  cut file, by default layers CUT/MOUNTAIN/VALLEY/
-                                            TAB/LABEL (see ``preset``)
-``pdf``    ``pattern.pdf``                  true-scale print, tiled on pages
-``png``    ``pattern.png``, ``preview.png`` pictures of the layout and the folded form
-``3dm``    ``pattern.3dm``, ``folded.3dm``  Rhino files of the pattern (layers CUT/MOUNTAIN/
-                                            VALLEY/TAB/LABEL) and of the folded form (a mesh
-                                            per patch, creases as curves); needs rhino3dm
-``glb``    ``folded.glb``                   glTF binary of the folded form, a material per
-                                            patch kind (``gltf`` is the same format)
-``ply``    ``folded.ply``                   the folded form, welded triangles, face colours
-``stl``    ``folded.stl``                   the folded form, welded triangles
-=========  ===============================  =================================================
+=============  ===============================  =================================================
+format         files                            content
+=============  ===============================  =================================================
+``fold``       ``design.fold``                  FOLD 1.2: crease pattern + folded form
+``simulator``  ``simulator.fold``               FOLD 1.2 for Origami Simulator: the pattern
+                                                coarsened and triangulated (see
+                                                :mod:`~filletfold.export.simulator`)
+``json``       ``report.json``                  the design report (needs the design, not only
+                                                the pattern)
+``obj``        ``folded.obj``                   the folded form
+``svg``        ``pattern.svg``                  the flat layout (by default Origami Simulator's
+                                                colours; see ``preset``)
+``dxf``        ``pattern.dxf``                  cut file, by default layers CUT/MOUNTAIN/VALLEY/
+                                                TAB/LABEL (see ``preset``)
+``pdf``        ``pattern.pdf``                  true-scale print, tiled on pages
+``png``        ``pattern.png``, ``preview.png`` pictures of the layout and the folded form
+``3dm``        ``pattern.3dm``, ``folded.3dm``  Rhino files of the pattern (layers CUT/MOUNTAIN/
+                                                VALLEY/TAB/LABEL) and of the folded form (a mesh
+                                                per patch, creases as curves); needs rhino3dm
+``glb``        ``folded.glb``                   glTF binary of the folded form, a material per
+                                                patch kind (``gltf`` is the same format)
+``ply``        ``folded.ply``                   the folded form, welded triangles, face colours
+``stl``        ``folded.stl``                   the folded form, welded triangles
+=============  ===============================  =================================================
 
 ``all`` means every format whose library is installed: ``3dm`` only when rhino3dm imports
 (:data:`OPTIONAL_FORMATS`; a warning says when it is left out), while asking for ``3dm`` without
