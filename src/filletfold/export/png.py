@@ -275,10 +275,8 @@ def preview_png(
     triangles, tri_face = triangulate_faces(pattern.vertices_2d, pattern.faces)
     if len(pattern.face_patch):
         normal = np.nan_to_num(pattern.face_normal_3d())
-        kinds = sorted({_kind(p) for p in pattern.face_patch})
-        table = np.array([PATCH_COLOR.get(k, (0.8, 0.8, 0.8)) for k in kinds])
-        kind_index = {k: i for i, k in enumerate(kinds)}
-        base = table[[kind_index[_kind(p)] for p in pattern.face_patch]]
+        color_of = {p: PATCH_COLOR.get(_kind(p), (0.8, 0.8, 0.8)) for p in set(pattern.face_patch)}
+        base = np.array([color_of[p] for p in pattern.face_patch], dtype=np.float64)
         facing = normal @ eye
         shade = _AMBIENT + (1.0 - _AMBIENT) * np.abs(normal @ light)
         shade = np.where(facing < 0.0, _BACK_SIDE * shade, shade)

@@ -230,11 +230,11 @@ def render(
     tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     px, py, pd = to_pixels(cam)
     zbuf, ident = _zbuffer(px, py, pd, tris, w_ss, h_ss)
-    bg = np.asarray(background, dtype=np.float64).reshape(3)
+    bg = np.asarray(background, dtype=np.float32).reshape(3)
     img = np.broadcast_to(bg, (w_ss * h_ss, 3)).copy()
     hit = ident >= 0
-    col = np.asarray(colors, dtype=np.float64).reshape(-1, 3)
-    img[hit] = np.clip(np.nan_to_num(col[ident[hit]], nan=0.5), 0.0, 1.0)
+    col = np.clip(np.nan_to_num(np.asarray(colors, dtype=np.float32).reshape(-1, 3), nan=0.5), 0, 1)
+    img[hit] = col[ident[hit]]
     face_of = np.arange(len(tris)) if triangle_face is None else np.asarray(triangle_face, np.int64)
     face_at = np.full(len(ident), -1, dtype=np.int64)
     face_at[hit] = face_of[ident[hit]]
@@ -271,10 +271,10 @@ def render(
         qx = (cx[:, None] + dx[None, :]).ravel()
         qy = (cy[:, None] + dy[None, :]).ravel()
         keep = (qx >= 0) & (qx < w_ss) & (qy >= 0) & (qy < h_ss)
-        img[qy[keep] * w_ss + qx[keep]] = np.asarray(rgb, dtype=np.float64).reshape(3)
+        img[qy[keep] * w_ss + qx[keep]] = np.asarray(rgb, dtype=np.float32).reshape(3)
 
-    img = img.reshape(height, ss, width, ss, 3).mean(axis=(1, 3))
-    return np.round(np.clip(img, 0.0, 1.0) * 255.0).astype(np.uint8)
+    img = img.reshape(height, ss, width, ss, 3).sum(axis=(1, 3), dtype=np.float32)
+    return np.round(np.clip(img * (255.0 / ss**2), 0.0, 255.0)).astype(np.uint8)
 
 
 def png_bytes(image: np.ndarray) -> bytes:
@@ -284,6 +284,6 @@ def png_bytes(image: np.ndarray) -> bytes:
 
     buf = io.BytesIO()
     Image.fromarray(np.ascontiguousarray(image, dtype=np.uint8)).save(
-        buf, format="PNG", optimize=True
+        buf, format="PNG", compress_level=6
     )
     return buf.getvalue()
