@@ -6,13 +6,14 @@ Commands
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
 ``[--coplanar-tol DEG]``
-``[--format LIST] [--units U] [--scale S] [--sheet PAGE]``
+``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--view V]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
     pictures).
 ``filletfold app [MESH] [--port N] [--host ADDR]``
     Start the browser app (viser) on MESH and print its address.
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
+``[--view V]``
     Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
     ``pattern.svg``) and pictures (``pattern.png``, ``preview.png``) into ``DIR``.
 ``filletfold check DIR [--json]``
@@ -112,6 +113,14 @@ ScaleOption = Annotated[
     typer.Option(
         "--scale",
         help="Drawing units per mesh length unit in the DXF, SVG and PDF (default 1).",
+    ),
+]
+ViewOption = Annotated[
+    str | None,
+    typer.Option(
+        "--view",
+        help="Direction preview.png is seen from: front, back, top, side or AZIMUTH,ELEVATION "
+        "in degrees [default: front, i.e. -60,25].",
     ),
 ]
 SheetOption = Annotated[
@@ -276,6 +285,7 @@ def round_cmd(
     units: UnitsOption = "",
     scale: ScaleOption = None,
     sheet: SheetOption = None,
+    view: ViewOption = None,
     no_tabs: Annotated[
         bool, typer.Option("--no-tabs", help="No glue tabs, seam labels or part numbers.")
     ] = False,
@@ -296,8 +306,8 @@ def round_cmd(
     target = out if out is not None else _default_out(mesh)
     try:
         chosen = parse_formats(formats if formats is not None else DEFAULT_FORMATS)
-        # check units, scale and page before the (slow) design
-        _check_export_options(units, scale, sheet)
+        # check units, scale, page and view before the (slow) design
+        _check_export_options(units, scale, sheet, view)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
     try:
@@ -342,7 +352,13 @@ def round_cmd(
         if dry_run:
             return
         written = export_design(
-            design, target, formats=chosen, units=units, scale=scale, page=sheet or "A4"
+            design,
+            target,
+            formats=chosen,
+            units=units,
+            scale=scale,
+            page=sheet or "A4",
+            view=view,
         )
     except typer.Exit:
         raise
@@ -354,11 +370,15 @@ def round_cmd(
         raise _error(f"the design fails its certificate ({names}): see report.json")
 
 
-def _check_export_options(units: str, scale, sheet: str | None) -> None:
-    """Raise the ParameterError that writing would raise for ``units``, ``scale`` or ``sheet``."""
+def _check_export_options(units: str, scale, sheet: str | None, view: str | None = None) -> None:
+    """Raise the ParameterError that writing would raise for ``units``, ``scale``, ``sheet`` or
+    ``view``."""
     from .export.dxf import check_scale
+    from .export.png import parse_view
     from .units import check_units, sheet_size_mm
 
+    if view is not None:
+        parse_view(view)
     check_units(units, unitless=True)
     if scale is not None:
         check_scale(scale)
@@ -375,6 +395,7 @@ def export_cmd(
     units: UnitsOption = "",
     scale: ScaleOption = None,
     sheet: SheetOption = None,
+    view: ViewOption = None,
 ):
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
@@ -395,14 +416,14 @@ def export_cmd(
                 f"format {bad[0]} cannot be written from design.fold (export writes "
                 f"{', '.join(EXPORT_FORMATS)}; use 'filletfold round' for fold and json)"
             )
-        _check_export_options(units, scale, sheet)
+        _check_export_options(units, scale, sheet, view)
         if not folder.is_dir():
             raise _error(f"{folder}: no such folder (write a design with 'filletfold round')")
         source = folder / "design.fold"
         if not source.is_file():
             raise _error(f"{source}: no design.fold in {folder} (write it with 'filletfold round')")
         pattern = read_fold(source)
-        files = cut_files(pattern, chosen, units=units, scale=scale, page=sheet or "A4")
+        files = cut_files(pattern, chosen, units=units, scale=scale, page=sheet or "A4", view=view)
         written = write_outputs(folder, files)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None

@@ -330,7 +330,7 @@ class Design:
         ----------
         folder : str or Path
         **options
-            ``title``, ``formats``, ``units``, ``scale``, ``page``: those of
+            ``title``, ``formats``, ``units``, ``scale``, ``page``, ``view``: those of
             :func:`~filletfold.export.outputs.export_design` (the same defaults).
 
         Returns

@@ -10,6 +10,7 @@ from matplotlib.image import imread
 
 from filletfold.errors import ParameterError
 from filletfold.export import pattern_png, preview_png
+from filletfold.export.png import DEFAULT_VIEW, VIEWS, parse_view
 from filletfold.surface.pattern import CreasePattern
 
 from ..conftest import tiny_square
@@ -87,3 +88,13 @@ def test_preview_hides_creases_behind_the_surface():
     assert blue_pixels(above) == 0  # under the lid
     side = preview_png(pattern, width_px=300, elev=0.0, azim=-90.0)
     assert blue_pixels(side) > 10
+
+
+def test_parse_view():
+    assert parse_view("front") == DEFAULT_VIEW == VIEWS["front"]
+    assert parse_view(" Back ") == VIEWS["back"]
+    assert parse_view("30,-10.5") == (30.0, -10.5)
+    assert parse_view((10, 20)) == (10.0, 20.0)
+    for bad in ("", "north", "1,2,3", "nan,3", "1,inf", (1,), None, 5):
+        with pytest.raises(ParameterError, match="view must be front, back, top, side"):
+            parse_view(bad)

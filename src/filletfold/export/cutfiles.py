@@ -39,7 +39,7 @@ from .fold import _fold_document, fold_json
 from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
-from .png import pattern_png, preview_png
+from .png import parse_view, pattern_png, preview_png
 from .svg import _pattern_svg
 
 __all__ = [
@@ -207,6 +207,7 @@ def cut_files(
     description: str = "",
     report: Mapping | str | None = None,
     lazy: bool = False,
+    view=None,
 ) -> dict:
     """Build the output files of ``formats`` for a crease pattern (nothing is written).
 
@@ -225,6 +226,9 @@ def cut_files(
         FOLD ``file_title`` and ``file_description``.
     report : mapping or str, optional
         The ``report.json`` content (a dict, or its text); required for the ``json`` format.
+    view : str or (2,) float, optional
+        The direction ``preview.png`` is seen from: ``front`` (the default), ``back``, ``top``,
+        ``side`` or ``"AZIMUTH,ELEVATION"`` in degrees (:func:`~filletfold.export.png.parse_view`).
     lazy : bool
         Return, for each file, a function without arguments that builds its contents (for
         :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
@@ -244,6 +248,7 @@ def cut_files(
         When the pattern is inconsistent.
     """
     formats = parse_formats(formats)
+    azim, elev = parse_view("front" if view is None else view)
     check_units(units, unitless=True)
     scale_given = scale is not None
     scale = 1.0 if scale is None else check_scale(scale)
@@ -278,7 +283,7 @@ def cut_files(
         "pdf": {"pattern.pdf": pdf},
         "png": {
             "pattern.png": lambda: pattern_png(pattern),
-            "preview.png": lambda: preview_png(pattern),
+            "preview.png": lambda: preview_png(pattern, azim=azim, elev=elev),
         },
     }
     out = {name: build for fmt in formats for name, build in builders[fmt].items()}

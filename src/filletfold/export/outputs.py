@@ -415,6 +415,7 @@ def export_design(
     units: str = "",
     scale: float | None = None,
     page: str = "A4",
+    view=None,
 ) -> list[Path]:
     """Write the design's files into ``folder`` atomically (all of them or none).
 
@@ -434,6 +435,9 @@ def export_design(
     units, scale, page
         Real size of the cut files and PDF page (see
         :func:`~filletfold.export.cutfiles.cut_files`).
+    view : str or (2,) float, optional
+        The direction ``preview.png`` is seen from (see
+        :func:`~filletfold.export.cutfiles.cut_files`).
 
     Returns
     -------
@@ -452,6 +456,7 @@ def export_design(
             units=units,
             scale=scale,
             page=page,
+            view=view,
             title=title,
             description="Curved-crease rounded design: vertex modules",
             lazy=True,  # built one at a time as they are written
