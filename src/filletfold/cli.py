@@ -120,7 +120,8 @@ ViewOption = Annotated[
     typer.Option(
         "--view",
         help="Direction preview.png is seen from: front, back, top, side or AZIMUTH,ELEVATION "
-        "in degrees [default: front, i.e. -60,25].",
+        "in degrees, optionally followed by ,y (or ,x) for a model whose up is +y "
+        "[default: front, i.e. -60,25].",
     ),
 ]
 SheetOption = Annotated[

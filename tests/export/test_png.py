@@ -91,10 +91,12 @@ def test_preview_hides_creases_behind_the_surface():
 
 
 def test_parse_view():
-    assert parse_view("front") == DEFAULT_VIEW == VIEWS["front"]
-    assert parse_view(" Back ") == VIEWS["back"]
-    assert parse_view("30,-10.5") == (30.0, -10.5)
-    assert parse_view((10, 20)) == (10.0, 20.0)
-    for bad in ("", "north", "1,2,3", "nan,3", "1,inf", (1,), None, 5):
+    assert parse_view("front") == (*DEFAULT_VIEW, "z") == (*VIEWS["front"], "z")
+    assert parse_view(" Back ,Y") == (*VIEWS["back"], "y")
+    assert parse_view("30,-10.5") == (30.0, -10.5, "z")
+    assert parse_view("30,-10.5,x") == (30.0, -10.5, "x")
+    assert parse_view((10, 20)) == (10.0, 20.0, "z")
+    assert parse_view((10, 20, "y")) == (10.0, 20.0, "y")
+    for bad in ("", "north", "1,2,3", "nan,3", "1,inf", "front,w", "y", (1,), None, 5):
         with pytest.raises(ParameterError, match="view must be front, back, top, side"):
             parse_view(bad)

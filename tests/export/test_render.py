@@ -46,6 +46,14 @@ def test_view_frame_is_orthonormal_and_upright():
         assert np.allclose(np.cross(f[0], f[1]), f[2], atol=1e-12)  # right-handed
         assert f[1, 2] >= -1e-12 and abs(f[0, 2]) < 1e-12
     assert np.allclose(view_frame(0, 0)[2], [1, 0, 0])
+    # another up axis: the same frame with the axes renamed cyclically (a rotation)
+    for up, axis, eye0 in (("y", 1, [0, 0, 1]), ("x", 0, [0, 1, 0])):
+        for azim, elev in [(-60, 25), (120, 25), (10, -30)]:
+            f = view_frame(azim, elev, up)
+            assert np.allclose(np.cross(f[0], f[1]), f[2], atol=1e-12)
+            assert f[1, axis] > 0 and abs(f[0, axis]) < 1e-12
+        assert np.allclose(view_frame(0, 0, up)[2], eye0)
+        assert np.allclose(view_frame(0, 0, up)[1, axis], 1)
 
 
 @pytest.mark.parametrize("order", [(0, 1, 2, 3), (2, 3, 0, 1)])

@@ -228,7 +228,8 @@ def cut_files(
         The ``report.json`` content (a dict, or its text); required for the ``json`` format.
     view : str or (2,) float, optional
         The direction ``preview.png`` is seen from: ``front`` (the default), ``back``, ``top``,
-        ``side`` or ``"AZIMUTH,ELEVATION"`` in degrees (:func:`~filletfold.export.png.parse_view`).
+        ``side`` or ``"AZIMUTH,ELEVATION"`` in degrees, optionally followed by ``",y"`` for a
+        model whose up is +y (:func:`~filletfold.export.png.parse_view`).
     lazy : bool
         Return, for each file, a function without arguments that builds its contents (for
         :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
@@ -248,7 +249,7 @@ def cut_files(
         When the pattern is inconsistent.
     """
     formats = parse_formats(formats)
-    azim, elev = parse_view("front" if view is None else view)
+    azim, elev, up = parse_view("front" if view is None else view)
     check_units(units, unitless=True)
     scale_given = scale is not None
     scale = 1.0 if scale is None else check_scale(scale)
@@ -283,7 +284,7 @@ def cut_files(
         "pdf": {"pattern.pdf": pdf},
         "png": {
             "pattern.png": lambda: pattern_png(pattern),
-            "preview.png": lambda: preview_png(pattern, azim=azim, elev=elev),
+            "preview.png": lambda: preview_png(pattern, azim=azim, elev=elev, up=up),
         },
     }
     out = {name: build for fmt in formats for name, build in builders[fmt].items()}

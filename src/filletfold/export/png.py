@@ -175,14 +175,22 @@ DEFAULT_VIEW = (-60.0, 25.0)
 #: Named views of :func:`preview_png` (azimuth, elevation): ``back`` is the default turned
 #: half round, ``top`` looks down, ``side`` along +y.
 VIEWS = {"front": DEFAULT_VIEW, "back": (120.0, 25.0), "top": (-90.0, 90.0), "side": (-90.0, 0.0)}
-_AMBIENT = 0.3
+#: Shading: ambient + key * |n . light| + headlight * |n . eye| (a light at the eye).
+_AMBIENT, _KEY, _HEAD = 0.3, 0.5, 0.2
 _BACK_SIDE = 0.8  # the back of a face (seen through a hole, or inside an open shell) darker
 _SEAM_COLOR = "#606060"
 
 
-def parse_view(view) -> tuple[float, float]:
-    """Azimuth and elevation (degrees) from a view: a name of :data:`VIEWS`, ``"AZ,EL"`` or a
-    pair of numbers.
+def parse_view(view) -> tuple[float, float, str]:
+    """Azimuth, elevation (degrees) and up axis of a view.
+
+    Parameters
+    ----------
+    view : str or sequence
+        ``"NAME"`` (one of :data:`VIEWS`) or ``"AZIMUTH,ELEVATION"``, either followed by
+        ``",x"``, ``",y"`` or ``",z"`` (the axis up in the picture, default z: see
+        :func:`~filletfold.export.render.view_frame`); or a sequence ``(azim, elev)`` or
+        ``(azim, elev, up)``.
 
     Raises
     ------
@@ -190,25 +198,29 @@ def parse_view(view) -> tuple[float, float]:
         For anything else, naming ``view``.
     """
     if isinstance(view, str):
-        text = view.strip().lower()
-        if text in VIEWS:
-            return VIEWS[text]
-        parts = text.split(",")
+        parts = [p.strip().lower() for p in view.split(",")]
+    elif isinstance(view, list | tuple):
+        parts = [p.strip().lower() if isinstance(p, str) else p for p in view]
+    else:
+        parts = []
+    up = "z"
+    if len(parts) in (2, 3) and parts[-1] in ("x", "y", "z"):
+        up = parts.pop()
+    values: tuple = ()
+    if len(parts) == 1 and parts[0] in VIEWS:
+        values = VIEWS[parts[0]]
+    elif len(parts) == 2:
         try:
             values = tuple(float(p) for p in parts)
-        except ValueError:
-            values = ()
-    else:
-        try:
-            values = tuple(float(v) for v in view)
         except (TypeError, ValueError):
             values = ()
     if len(values) != 2 or not all(math.isfinite(v) for v in values):
         raise ParameterError(
-            f"view must be {', '.join(VIEWS)} or 'AZIMUTH,ELEVATION' in degrees, got {view!r}",
+            f"view must be {', '.join(VIEWS)} or 'AZIMUTH,ELEVATION' in degrees, optionally "
+            f"followed by ',y' or ',x' (the axis up in the picture), got {view!r}",
             name="view",
         )
-    return values
+    return float(values[0]), float(values[1]), up
 
 
 def _rgb(hex_color: str) -> tuple[float, float, float]:
@@ -222,15 +234,16 @@ def preview_png(
     width_px: int = 1000,
     elev: float = DEFAULT_VIEW[1],
     azim: float = DEFAULT_VIEW[0],
+    up: str = "z",
 ) -> bytes:
     """A shaded picture of the folded form, hidden surfaces and hidden lines removed.
 
     Drawn by :func:`filletfold.export.render.render` (a numpy z-buffer, supersampled twice):
     each face in its patch's colour (:data:`~filletfold.export.palette.PATCH_COLOR`),
     flat-shaded by the angle between its normal and a light above and to the left of the viewer
-    (two-sided, with ambient light; the back of a face is darker); over them the visible
-    creases (mountain red, valley blue), the sheet's outline (black) and the seams between
-    pieces (grey, thinner).
+    and one at the viewer (two-sided, with ambient light; the back of a face is darker); over
+    them the visible creases (mountain red, valley blue), the sheet's outline (black) and the
+    seams between pieces (grey, thinner).
 
     Parameters
     ----------
@@ -241,6 +254,8 @@ def preview_png(
     elev, azim : float
         Viewing elevation and azimuth in degrees (matplotlib's convention; default
         :data:`DEFAULT_VIEW`, :data:`VIEWS` has named ones).
+    up : {"z", "y", "x"}
+        The axis up in the picture (:func:`~filletfold.export.render.view_frame`).
 
     Returns
     -------
@@ -251,7 +266,7 @@ def preview_png(
     Raises
     ------
     ParameterError
-        For a width outside 16..20000 or a non-finite angle.
+        For a width outside 16..20000, a non-finite angle or another up axis.
     ExportError
         When the pattern is inconsistent.
     """
@@ -266,10 +281,12 @@ def preview_png(
             or not math.isfinite(value)
         ):
             raise ParameterError(f"{name} must be a finite number of degrees", name=name)
+    if up not in ("x", "y", "z"):
+        raise ParameterError(f"up must be 'x', 'y' or 'z', got {up!r}", name="up")
     validate_pattern(pattern)
     height_px = round(0.75 * width_px)
-    right, up, eye = view_frame(float(azim), float(elev))
-    light = eye + 0.6 * up - 0.4 * right
+    right, upward, eye = view_frame(float(azim), float(elev), up)
+    light = eye + 0.6 * upward - 0.4 * right
     light /= np.linalg.norm(light)
 
     triangles, tri_face = triangulate_faces(pattern.vertices_2d, pattern.faces)
@@ -278,7 +295,7 @@ def preview_png(
         color_of = {p: PATCH_COLOR.get(_kind(p), (0.8, 0.8, 0.8)) for p in set(pattern.face_patch)}
         base = np.array([color_of[p] for p in pattern.face_patch], dtype=np.float64)
         facing = normal @ eye
-        shade = _AMBIENT + (1.0 - _AMBIENT) * np.abs(normal @ light)
+        shade = _AMBIENT + _KEY * np.abs(normal @ light) + _HEAD * np.abs(facing)
         shade = np.where(facing < 0.0, _BACK_SIDE * shade, shade)
         face_color = np.clip(base * shade[:, None], 0.0, 1.0)
     else:
@@ -309,5 +326,6 @@ def preview_png(
         height=height_px,
         azim=float(azim),
         elev=float(elev),
+        up=up,
     )
     return png_bytes(image)

@@ -9,7 +9,10 @@ smooths the edges of triangles and lines.
 
 Camera: orthographic, looking at the centre of the drawn points from the direction given by an
 azimuth and an elevation in degrees, as in matplotlib's 3D axes (:func:`view_frame`): azimuth 0
-looks from +x, 90 from +y; elevation 90 looks down from +z. The picture is fitted to the
+looks from +x, 90 from +y; elevation 90 looks down from +z. A model whose up is +y (as most
+scans are) or +x is seen the same way with ``up="y"`` (``"x"``): the axes are renamed cyclically
+so that the up axis plays the part of z (for y up, azimuth 0 looks from +z and 90 from +x).
+The picture is fitted to the
 projected points with a margin of :data:`MARGIN` of the image on every side.
 """
 
@@ -30,26 +33,34 @@ _CHUNK = 1 << 22
 _LINE_STEP = 0.5
 
 
-def view_frame(azim: float, elev: float) -> np.ndarray:
+#: World coordinates of the (x, y, z) of the z-up view frame, for each up axis: a cyclic
+#: renaming of the axes (a rotation, never a mirror image).
+_UP_AXES = {"z": [0, 1, 2], "y": [1, 2, 0], "x": [2, 0, 1]}
+
+
+def view_frame(azim: float, elev: float, up: str = "z") -> np.ndarray:
     """The camera's axes for a view direction.
 
     Parameters
     ----------
     azim, elev : float
         Azimuth and elevation of the eye in degrees (matplotlib's convention).
+    up : {"z", "y", "x"}
+        The axis that points up in the picture (the others renamed cyclically: for ``"y"``,
+        z plays the part of x and x that of y).
 
     Returns
     -------
     (3, 3) float
-        Rows ``right``, ``up`` and ``towards the eye``, orthonormal; ``up`` has a non-negative
-        z-component, and ``right`` is horizontal (at elevation ±90 it is the azimuth's
-        ``(-sin a, cos a, 0)``).
+        Rows ``right``, ``up`` and ``towards the eye``, orthonormal and right-handed; ``up``
+        has a non-negative component along the up axis, and ``right`` is perpendicular to it
+        (at elevation ±90 it is the azimuth's ``(-sin a, cos a, 0)``).
     """
     e, a = math.radians(elev), math.radians(azim)
     eye = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
     right = np.array([-math.sin(a), math.cos(a), 0.0])
-    up = np.cross(eye, right)
-    return np.vstack([right, up, eye])
+    frame = np.vstack([right, np.cross(eye, right), eye])
+    return frame[:, _UP_AXES[up]]
 
 
 def _fit(xy: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float]:
@@ -172,6 +183,7 @@ def render(
     height: int = 600,
     azim: float = -60.0,
     elev: float = 25.0,
+    up: str = "z",
     supersample: int = 2,
     background=(1.0, 1.0, 1.0),
     depth_bias: float = 1.5,
@@ -198,6 +210,8 @@ def render(
         Image size in pixels.
     azim, elev : float
         View direction in degrees (:func:`view_frame`).
+    up : {"z", "y", "x"}
+        The axis up in the picture (:func:`view_frame`).
     supersample : int
         Drawn at this many times the size, then averaged down.
     background : sequence of 3 float
@@ -212,7 +226,7 @@ def render(
     """
     ss = int(supersample)
     w_ss, h_ss = width * ss, height * ss
-    frame = view_frame(azim, elev)
+    frame = view_frame(azim, elev, up)
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     with np.errstate(invalid="ignore", over="ignore"):
         cam = pts @ frame.T  # (n, 3): right, up, towards the eye
