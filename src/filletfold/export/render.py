@@ -29,7 +29,8 @@ __all__ = ["MARGIN", "png_bytes", "render", "view_frame"]
 MARGIN = 0.04
 #: Candidate pixels (triangle bounding boxes) tested at once: bounds the temporaries' memory.
 _CHUNK = 1 << 22
-#: Samples of a line per (supersampled) pixel of its length.
+#: Step between the samples of a line, in (supersampled) pixels; a line wider than 1.33 pixels
+#: is sampled every 3/4 of its half width instead.
 _LINE_STEP = 0.5
 
 
@@ -267,7 +268,8 @@ def render(
             ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
             a, b, fc = a[ok], b[ok], fc[ok]
             length = np.hypot(*(b - a)[:, :2].T)
-            n = np.minimum(np.ceil(length / _LINE_STEP).astype(np.int64), 4 * (w_ss + h_ss)) + 1
+            step = max(_LINE_STEP, 0.75 * 0.5 * lw * ss)  # a disc's radius: no gaps
+            n = np.minimum(np.ceil(length / step).astype(np.int64), 4 * (w_ss + h_ss)) + 1
         seg = np.repeat(np.arange(len(a)), n)
         first = np.cumsum(n) - n
         u = (np.arange(len(seg)) - np.repeat(first, n)) / np.maximum(n[seg] - 1, 1)
@@ -287,8 +289,12 @@ def render(
         keep = (qx >= 0) & (qx < w_ss) & (qy >= 0) & (qy < h_ss)
         img[qy[keep] * w_ss + qx[keep]] = np.asarray(rgb, dtype=np.float32).reshape(3)
 
-    img = img.reshape(height, ss, width, ss, 3).sum(axis=(1, 3), dtype=np.float32)
-    return np.round(np.clip(img * (255.0 / ss**2), 0.0, 255.0)).astype(np.uint8)
+    img = img.reshape(height, ss, width, ss, 3)
+    out = np.zeros((height, width, 3), dtype=np.float32)
+    for i in range(ss):  # the ss x ss samples of each pixel, added one sample at a time
+        for j in range(ss):
+            out += img[:, i, :, j]
+    return np.round(np.clip(out * (255.0 / ss**2), 0.0, 255.0)).astype(np.uint8)
 
 
 def png_bytes(image: np.ndarray) -> bytes:
