@@ -29,7 +29,8 @@ import filletfold
 from filletfold.export.png import preview_png
 
 ROOT = Path(__file__).resolve().parent.parent
-#: (input, name, sharp, views): front is azimuth -60 degrees, back 120.
+#: (input, name, sharp, views): front is azimuth -60 degrees, back 120 (elevation 25; the bunny
+#: with +y up).
 PICTURES = [
     ("bunny-loop2", "bunny-1k", "none", ("front",)),
     ("bunny-loop2", "bunny-1k", "auto", ("front", "back")),
@@ -55,7 +56,8 @@ def main(argv=None) -> int:
             f"{d.certificate['holes'].detail}; certificate {'ok' if d.certificate.ok else 'FAILS'}"
         )
         for view in views:
-            png = preview_png(d.pattern, width_px=900, azim=AZIMUTH[view])
+            up = "y" if source.startswith("bunny") else "z"  # the bunny's up is +y
+            png = preview_png(d.pattern, width_px=900, azim=AZIMUTH[view], up=up)
             (out / f"{name}-{state}-{view}.png").write_bytes(png)
     return 0
 

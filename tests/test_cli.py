@@ -84,6 +84,7 @@ def test_file_input_and_clamp(tmp_path):
         (["round", "cube", "--radius", "3", "--strict"], "exceeds its limit"),
         (["round", "cube", "--depth", "abc"], "depth must be a number"),
         (["round", "cube", "--arc-step", "-1"], "arc step must be in [0, 180] degrees"),
+        (["round", "cube", "--view", "sideways"], "view must be front, back, top, side"),
     ],
 )
 def test_errors_are_one_line_with_exit_code_2(args, match, capsys, tmp_path):
@@ -219,3 +220,19 @@ def test_no_tabs(tmp_path):
     assert main(["round", "cube", "--no-tabs", "-o", str(tmp_path / "c")]) == 0
     fab = json.loads((tmp_path / "c" / "report.json").read_text())["fabrication"]
     assert fab["tabs"] == 0 and fab["cut_borders"] == 0
+
+
+def test_view_turns_the_preview_only(tmp_path):
+    """--view back draws preview.png from the other side; the other files keep their bytes."""
+    for view in ("front", "back"):
+        args = ["round", "tetrahedron", "--format", "fold,png,svg", "--view", view, "-q"]
+        assert main([*args, "-o", str(tmp_path / view)]) == 0
+    front, back = tmp_path / "front", tmp_path / "back"
+    assert (front / "pattern.svg").read_bytes() == (back / "pattern.svg").read_bytes()
+    assert (front / "pattern.png").read_bytes() == (back / "pattern.png").read_bytes()
+    assert (front / "preview.png").read_bytes() != (back / "preview.png").read_bytes()
+    # export reads design.fold (coordinates rounded in the file): the same file, the same view
+    assert (front / "design.fold").read_bytes() == (back / "design.fold").read_bytes()
+    assert main(["export", str(front), "--format", "png", "--view", "back"]) == 0
+    assert main(["export", str(back), "--format", "png", "--view", "120,25"]) == 0
+    assert (front / "preview.png").read_bytes() == (back / "preview.png").read_bytes()

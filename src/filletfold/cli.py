@@ -7,13 +7,14 @@ Commands
 ``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
 ``[--chord-tol TOL] [--coplanar-tol DEG]``
 ``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME] [--nest NESTER]``
+``[--view V]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
     pictures).
 ``filletfold app [MESH] [--port N] [--host ADDR]``
     Start the browser app (viser) on MESH and print its address.
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
-``[--preset NAME]``
+``[--preset NAME] [--view V]``
     Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
     ``pattern.svg``) and pictures (``pattern.png``, ``preview.png``) into ``DIR``.
 ``filletfold check DIR [--json]``
@@ -125,6 +126,15 @@ PresetOption = Annotated[
         "Simulator's colours and fold-angle opacities; DXF layers CUT/MOUNTAIN/VALLEY/TAB/LABEL), "
         "laser (hairlines, cut red, scores blue/green), plotter (dashed score lines) or card "
         "(perforated fold lines) [default: origami-simulator].",
+    ),
+]
+ViewOption = Annotated[
+    str | None,
+    typer.Option(
+        "--view",
+        help="Direction preview.png is seen from: front, back, top, side or AZIMUTH,ELEVATION "
+        "in degrees, optionally followed by ,y (or ,x) for a model whose up is +y "
+        "[default: front, i.e. -60,25].",
     ),
 ]
 SheetOption = Annotated[
@@ -300,6 +310,7 @@ def round_cmd(
     scale: ScaleOption = None,
     sheet: SheetOption = None,
     preset: PresetOption = None,
+    view: ViewOption = None,
     no_tabs: Annotated[
         bool, typer.Option("--no-tabs", help="No glue tabs, seam labels or part numbers.")
     ] = False,
@@ -330,8 +341,8 @@ def round_cmd(
     target = out if out is not None else _default_out(mesh)
     try:
         chosen = parse_formats(formats if formats is not None else DEFAULT_FORMATS)
-        # check units, scale and page before the (slow) design
-        _check_export_options(units, scale, sheet, preset)
+        # check units, scale, page, preset and view before the (slow) design
+        _check_export_options(units, scale, sheet, preset, view)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
     try:
@@ -385,6 +396,7 @@ def round_cmd(
             scale=scale,
             page=sheet or "A4",
             preset=preset,
+            view=view,
         )
     except typer.Exit:
         raise
@@ -396,13 +408,18 @@ def round_cmd(
         raise _error(f"the design fails its certificate ({names}): see report.json")
 
 
-def _check_export_options(units: str, scale, sheet: str | None, preset=None) -> None:
-    """Raise the ParameterError that writing would raise for ``units``, ``scale``, ``sheet`` or
-    ``preset``."""
+def _check_export_options(
+    units: str, scale, sheet: str | None, preset=None, view: str | None = None
+) -> None:
+    """Raise the ParameterError that writing would raise for ``units``, ``scale``, ``sheet``,
+    ``preset`` or ``view``."""
     from .export.dxf import check_scale
+    from .export.png import parse_view
     from .export.presets import get_preset
     from .units import check_units, sheet_size_mm
 
+    if view is not None:
+        parse_view(view)
     check_units(units, unitless=True)
     if scale is not None:
         check_scale(scale)
@@ -421,6 +438,7 @@ def export_cmd(
     scale: ScaleOption = None,
     sheet: SheetOption = None,
     preset: PresetOption = None,
+    view: ViewOption = None,
 ):
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
@@ -445,7 +463,7 @@ def export_cmd(
                 f"format {bad[0]} cannot be written from design.fold (export writes "
                 f"{', '.join(EXPORT_FORMATS)}; use 'filletfold round' for fold and json)"
             )
-        _check_export_options(units, scale, sheet, preset)
+        _check_export_options(units, scale, sheet, preset, view)
         if not folder.is_dir():
             raise _error(f"{folder}: no such folder (write a design with 'filletfold round')")
         source = folder / "design.fold"
@@ -453,7 +471,7 @@ def export_cmd(
             raise _error(f"{source}: no design.fold in {folder} (write it with 'filletfold round')")
         pattern = read_fold(source)
         files = cut_files(
-            pattern, chosen, units=units, scale=scale, page=sheet or "A4", preset=preset
+            pattern, chosen, units=units, scale=scale, page=sheet or "A4", preset=preset, view=view
         )
         written = write_outputs(folder, files)
     except FilletfoldError as exc:

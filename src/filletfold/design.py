@@ -338,7 +338,7 @@ class Design:
         ----------
         folder : str or Path
         **options
-            ``title``, ``formats``, ``units``, ``scale``, ``page``, ``preset``: those of
+            ``title``, ``formats``, ``units``, ``scale``, ``page``, ``preset``, ``view``: those of
             :func:`~filletfold.export.outputs.export_design` (the same defaults).
 
         Returns

@@ -270,3 +270,48 @@ def test_load_mesh_by_example_name():
     mesh, log = load_mesh("icosahedron")
     assert mesh.n_faces == 20
     assert log.merged_faces == 0
+
+
+@pytest.mark.parametrize("spec", ["shell", "shell:3x1", "shell:8x5,opening=170,sag=0.4"])
+def test_shell_is_a_vault_of_planar_quads(spec):
+    v, faces = example_mesh(spec)
+    a, b = (6, 4) if spec == "shell" else (3, 1) if spec == "shell:3x1" else (8, 5)
+    assert len(v) == (a + 1) * (b + 1) and len(faces) == a * b
+    assert all(len(f) == 4 for f in faces)
+    mesh = PolyMesh(v, faces)
+    for f, n in zip(faces, mesh.face_normal, strict=True):
+        assert np.abs((v[f] - v[f].mean(axis=0)) @ n).max() < 1e-12  # planar
+        assert n[2] > 0  # counter-clockwise seen from above
+    assert abs(v[:, 2].min()) < 1e-12
+    inner = ~mesh.is_boundary_vertex
+    assert inner.sum() == (a - 1) * (b - 1)
+    assert (mesh.vertex_angle_sum[inner] < 2 * np.pi - 1e-6).all()  # convex: positive defect
+
+
+def test_shell_without_sag_is_a_developable_barrel_vault():
+    mesh = PolyMesh(*example_mesh("shell:5x3,sag=0"))
+    inner = ~mesh.is_boundary_vertex
+    assert_allclose(mesh.vertex_angle_sum[inner], 2 * np.pi, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("spec", "match"),
+    [
+        ("shell:1x3", "2..24 quads across"),
+        ("shell:4x3,opening=10", "opening"),
+        ("shell:4x3,sag=1", "sag"),
+    ],
+)
+def test_shell_parameters_checked(spec, match):
+    with pytest.raises(MeshReadError, match=match):
+        example_mesh(spec)
+
+
+def test_shell_rounds_with_every_inner_vertex_a_cone():
+    import filletfold
+
+    d = filletfold.round_mesh("shell", tabs=False)
+    assert d.certificate.ok
+    inner = ~d.mesh.is_boundary_vertex
+    treatment = np.asarray(d.vertices.treatment)
+    assert (treatment[inner] == "cone").all()

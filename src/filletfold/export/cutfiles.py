@@ -62,7 +62,7 @@ from .fold import _fold_document, fold_json
 from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
-from .png import pattern_png, preview_png
+from .png import parse_view, pattern_png, preview_png
 from .presets import Preset, get_preset
 from .svg import _pattern_svg
 
@@ -273,6 +273,7 @@ def cut_files(
     report: Mapping | str | None = None,
     lazy: bool = False,
     preset: str | Preset | None = None,
+    view=None,
 ) -> dict:
     """Build the output files of ``formats`` for a crease pattern (nothing is written).
 
@@ -292,6 +293,10 @@ def cut_files(
         FOLD ``file_title`` and ``file_description``.
     report : mapping or str, optional
         The ``report.json`` content (a dict, or its text); required for the ``json`` format.
+    view : str or (2,) float, optional
+        The direction ``preview.png`` is seen from: ``front`` (the default), ``back``, ``top``,
+        ``side`` or ``"AZIMUTH,ELEVATION"`` in degrees, optionally followed by ``",y"`` for a
+        model whose up is +y (:func:`~filletfold.export.png.parse_view`).
     lazy : bool
         Return, for each file, a function without arguments that builds its contents (for
         :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
@@ -315,6 +320,7 @@ def cut_files(
         When the pattern is inconsistent.
     """
     formats = parse_formats(formats)
+    azim, elev, up = parse_view("front" if view is None else view)
     check_units(units, unitless=True)
     scale_given = scale is not None
     scale = 1.0 if scale is None else check_scale(scale)
@@ -382,7 +388,7 @@ def cut_files(
         "pdf": {"pattern.pdf": pdf},
         "png": {
             "pattern.png": lambda: pattern_png(pattern),
-            "preview.png": lambda: preview_png(pattern),
+            "preview.png": lambda: preview_png(pattern, azim=azim, elev=elev, up=up),
         },
         "3dm": {"pattern.3dm": rhino("pattern"), "folded.3dm": rhino("folded")},
         "glb": {"folded.glb": lambda: _folded_glb(pattern)},

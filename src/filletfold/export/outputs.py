@@ -420,6 +420,7 @@ def export_design(
     scale: float | None = None,
     page: str = "A4",
     preset=None,
+    view=None,
 ) -> list[Path]:
     """Write the design's files into ``folder`` atomically (all of them or none).
 
@@ -442,6 +443,9 @@ def export_design(
     preset : str or Preset, optional
         Cutter preset of ``pattern.svg`` and ``pattern.dxf``
         (:data:`~filletfold.export.presets.PRESETS`; default ``origami-simulator``).
+    view : str or (2,) float, optional
+        The direction ``preview.png`` is seen from (see
+        :func:`~filletfold.export.cutfiles.cut_files`).
 
     Returns
     -------
@@ -460,6 +464,7 @@ def export_design(
             units=units,
             scale=scale,
             page=page,
+            view=view,
             title=title,
             description="Curved-crease rounded design: vertex modules",
             lazy=True,  # built one at a time as they are written

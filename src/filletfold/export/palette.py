@@ -8,7 +8,7 @@ border/cut black). The SVG and DXF follow a cutter preset instead
 
 from __future__ import annotations
 
-__all__ = ["ASSIGNMENT_COLOR", "LABEL_COLOR", "SHEET_COLOR", "TAB_HINGE_COLOR"]
+__all__ = ["ASSIGNMENT_COLOR", "LABEL_COLOR", "PATCH_COLOR", "SHEET_COLOR", "TAB_HINGE_COLOR"]
 
 #: Stroke colour of each edge assignment.
 ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
@@ -18,3 +18,11 @@ TAB_HINGE_COLOR = "#00a000"
 SHEET_COLOR = "#999999"
 #: Labels (part numbers, seam labels).
 LABEL_COLOR = "#404040"
+#: Base colour (RGB, 0..1) of each patch kind in the folded preview: cone orange, cylinder blue,
+#: conical fillet teal, flat face piece green.
+PATCH_COLOR = {
+    "cone": (0.96, 0.62, 0.25),
+    "cylinder": (0.35, 0.6, 0.9),
+    "fillet": (0.24, 0.78, 0.78),
+    "face": (0.45, 0.78, 0.45),
+}

@@ -1,8 +1,10 @@
 """PNG pictures of a design: the flat layout and a shaded view of the folded form.
 
-Both are drawn with matplotlib's Agg renderer on a bare :class:`~matplotlib.figure.Figure` (no
-pyplot, no display). Patch fills: cone orange, cylinder blue, flat face green (light tints in the
-layout, shaded in the preview); creases mountain red, valley blue, borders black; tabs light
+The layout is drawn with matplotlib's Agg renderer on a bare :class:`~matplotlib.figure.Figure`
+(no pyplot, no display); the folded form by the z-buffer of :mod:`filletfold.export.render`,
+with hidden surfaces and hidden lines removed. Patch fills: cone orange, cylinder blue, conical
+fillet teal, flat face green (light tints in the layout, shaded in the preview); creases
+mountain red, valley blue, borders black (seams between pieces grey in the preview); tabs light
 grey with a black outline and a green dashed hinge; sheets grey outlines; labels dark grey.
 """
 
@@ -16,18 +18,19 @@ import numpy as np
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
-from .palette import LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
+from .palette import LABEL_COLOR, PATCH_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 
-__all__ = ["LAYOUT_FILL", "PATCH_COLOR", "pattern_png", "preview_png"]
+__all__ = [
+    "DEFAULT_VIEW",
+    "LAYOUT_FILL",
+    "PATCH_COLOR",
+    "VIEWS",
+    "parse_view",
+    "pattern_png",
+    "preview_png",
+]
 
-#: Base colour (RGB, 0..1) of each patch kind in the folded preview.
-PATCH_COLOR = {
-    "cone": (0.96, 0.62, 0.25),
-    "cylinder": (0.35, 0.6, 0.9),
-    "fillet": (0.24, 0.78, 0.78),
-    "face": (0.45, 0.78, 0.45),
-}
 #: Light fill of each patch kind in the flat layout.
 LAYOUT_FILL = {"cone": "#ffd8a8", "cylinder": "#cfe2ff", "fillet": "#c5f6f6", "face": "#d3f9d8"}
 _OTHER_FILL = "#eeeeee"
@@ -166,18 +169,81 @@ def pattern_png(pattern: CreasePattern, *, width_px: int = 1600) -> bytes:
     return _render(fig)
 
 
+#: Default view of the folded preview: azimuth and elevation in degrees (matplotlib's
+#: convention: the eye at azimuth 0 is on +x, at 90 on +y; elevation 90 looks down from +z).
+DEFAULT_VIEW = (-60.0, 25.0)
+#: Named views of :func:`preview_png` (azimuth, elevation): ``back`` is the default turned
+#: half round, ``top`` looks down, ``side`` along +y.
+VIEWS = {"front": DEFAULT_VIEW, "back": (120.0, 25.0), "top": (-90.0, 90.0), "side": (-90.0, 0.0)}
+#: Shading: ambient + key * |n . light| + headlight * |n . eye| (a light at the eye).
+_AMBIENT, _KEY, _HEAD = 0.3, 0.5, 0.2
+_BACK_SIDE = 0.8  # the back of a face (seen through a hole, or inside an open shell) darker
+_SEAM_COLOR = "#606060"
+
+
+def parse_view(view) -> tuple[float, float, str]:
+    """Azimuth, elevation (degrees) and up axis of a view.
+
+    Parameters
+    ----------
+    view : str or sequence
+        ``"NAME"`` (one of :data:`VIEWS`) or ``"AZIMUTH,ELEVATION"``, either followed by
+        ``",x"``, ``",y"`` or ``",z"`` (the axis up in the picture, default z: see
+        :func:`~filletfold.export.render.view_frame`); or a sequence ``(azim, elev)`` or
+        ``(azim, elev, up)``.
+
+    Raises
+    ------
+    ParameterError
+        For anything else, naming ``view``.
+    """
+    if isinstance(view, str):
+        parts = [p.strip().lower() for p in view.split(",")]
+    elif isinstance(view, list | tuple):
+        parts = [p.strip().lower() if isinstance(p, str) else p for p in view]
+    else:
+        parts = []
+    up = "z"
+    if len(parts) in (2, 3) and parts[-1] in ("x", "y", "z"):
+        up = parts.pop()
+    values: tuple = ()
+    if len(parts) == 1 and parts[0] in VIEWS:
+        values = VIEWS[parts[0]]
+    elif len(parts) == 2:
+        try:
+            values = tuple(float(p) for p in parts)
+        except (TypeError, ValueError):
+            values = ()
+    if len(values) != 2 or not all(math.isfinite(v) for v in values):
+        raise ParameterError(
+            f"view must be {', '.join(VIEWS)} or 'AZIMUTH,ELEVATION' in degrees, optionally "
+            f"followed by ',y' or ',x' (the axis up in the picture), got {view!r}",
+            name="view",
+        )
+    return float(values[0]), float(values[1]), up
+
+
+def _rgb(hex_color: str) -> tuple[float, float, float]:
+    h = hex_color.lstrip("#")
+    return tuple(int(h[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
+
+
 def preview_png(
     pattern: CreasePattern,
     *,
-    width_px: int = 1200,
-    elev: float = 25.0,
-    azim: float = -60.0,
+    width_px: int = 1000,
+    elev: float = DEFAULT_VIEW[1],
+    azim: float = DEFAULT_VIEW[0],
+    up: str = "z",
 ) -> bytes:
-    """A shaded picture of the folded form.
+    """A shaded picture of the folded form, hidden surfaces and hidden lines removed.
 
-    Each face is flat-shaded by the angle between its normal and a light above and to the left
-    of the viewer (two-sided, with ambient light), in its patch's colour. Creases are drawn in
-    3D where at least one face beside them faces the viewer (exact for convex forms).
+    Drawn by :func:`filletfold.export.render.render` (a numpy z-buffer, supersampled twice):
+    each face in its patch's colour (:data:`~filletfold.export.palette.PATCH_COLOR`),
+    flat-shaded by the angle between its normal and a light above and to the left of the viewer
+    and one at the viewer (two-sided, with ambient light; the back of a face is darker); over
+    them the visible creases (mountain red, valley blue), the sheet's outline (black) and the
+    seams between pieces (grey, thinner).
 
     Parameters
     ----------
@@ -186,104 +252,80 @@ def preview_png(
     width_px : int
         Image width in pixels (the height is three quarters of it).
     elev, azim : float
-        Viewing elevation and azimuth in degrees (matplotlib's convention).
+        Viewing elevation and azimuth in degrees (matplotlib's convention; default
+        :data:`DEFAULT_VIEW`, :data:`VIEWS` has named ones).
+    up : {"z", "y", "x"}
+        The axis up in the picture (:func:`~filletfold.export.render.view_frame`).
 
     Returns
     -------
     bytes
-        PNG image, white background, equal scale on the three axes, no axes drawn.
+        PNG image, white background, orthographic, fitted to the form; the same pattern and
+        view give the same bytes.
 
     Raises
     ------
     ParameterError
-        For a width outside 16..20000 or a non-finite angle.
+        For a width outside 16..20000, a non-finite angle or another up axis.
     ExportError
         When the pattern is inconsistent.
     """
-    from matplotlib.figure import Figure
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+    from ..app.view import triangulate_faces
+    from .render import png_bytes, render, view_frame
 
     width_px = _check_pixels(width_px, "width_px")
     for name, value in (("elev", elev), ("azim", azim)):
         if (
             isinstance(value, bool)
-            or not isinstance(value, int | float)
+            or not isinstance(value, int | float | np.floating | np.integer)
             or not math.isfinite(value)
         ):
             raise ParameterError(f"{name} must be a finite number of degrees", name=name)
+    if up not in ("x", "y", "z"):
+        raise ParameterError(f"up must be 'x', 'y' or 'z', got {up!r}", name="up")
     validate_pattern(pattern)
     height_px = round(0.75 * width_px)
-    fig = Figure(figsize=(width_px / _DPI, height_px / _DPI), dpi=_DPI, facecolor="white")
-    ax = fig.add_axes((0.0, 0.0, 1.0, 1.0), projection="3d", proj_type="ortho")
-    ax.set_axis_off()
-    ax.view_init(elev=elev, azim=azim)
-    ax.computed_zorder = False  # faces below, visible creases on top
-    v3 = pattern.vertices_3d
-
-    e, a = math.radians(elev), math.radians(azim)
-    view = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
-    up = np.array([-math.sin(e) * math.cos(a), -math.sin(e) * math.sin(a), math.cos(e)])
-    left = np.cross(view, up)
-    light = view + 0.6 * up + 0.4 * left
+    right, upward, eye = view_frame(float(azim), float(elev), up)
+    light = eye + 0.6 * upward - 0.4 * right
     light /= np.linalg.norm(light)
 
-    if pattern.faces:
-        normal = pattern.face_normal_3d()
-        normal = np.nan_to_num(normal)
-        shade = 0.35 + 0.65 * np.abs(normal @ light)
-        base = np.array([PATCH_COLOR.get(_kind(p), (0.8, 0.8, 0.8)) for p in pattern.face_patch])
-        colors = np.clip(base * shade[:, None], 0.0, 1.0)
-        facing = normal @ view > 0
-        # back faces first, front faces over them: exact for convex forms, where front faces
-        # never overlap in the picture
-        for sel, z in ((~facing, 0), (facing, 1)):
-            idx = np.flatnonzero(sel)
-            if len(idx):
-                polys = Poly3DCollection(
-                    [v3[np.asarray(pattern.faces[i])] for i in idx],
-                    facecolors=colors[idx],
-                    edgecolors=colors[idx],
-                    linewidths=0.2,
-                    zorder=z,
-                )
-                ax.add_collection3d(polys)
+    triangles, tri_face = triangulate_faces(pattern.vertices_2d, pattern.faces)
+    if len(pattern.face_patch):
+        normal = np.nan_to_num(pattern.face_normal_3d())
+        color_of = {p: PATCH_COLOR.get(_kind(p), (0.8, 0.8, 0.8)) for p in set(pattern.face_patch)}
+        base = np.array([color_of[p] for p in pattern.face_patch], dtype=np.float64)
+        facing = normal @ eye
+        shade = _AMBIENT + _KEY * np.abs(normal @ light) + _HEAD * np.abs(facing)
+        shade = np.where(facing < 0.0, _BACK_SIDE * shade, shade)
+        face_color = np.clip(base * shade[:, None], 0.0, 1.0)
     else:
-        facing = np.zeros(0, dtype=bool)
+        face_color = np.zeros((0, 3))
+    colors = face_color[tri_face]
 
-    ef = pattern.edge_faces
-    if ef is None:
-        visible = np.ones(len(pattern.edges), dtype=bool)
-    else:
-        ef = np.asarray(ef)
-        visible = np.zeros(len(ef), dtype=bool)
-        for side in (0, 1):
-            f = ef[:, side]
-            ok = f >= 0
-            visible[ok] |= facing[f[ok]]
-    lw = max(0.5, width_px / 1200.0)
+    v3 = pattern.vertices_3d
     assign = np.asarray(pattern.edge_assignment)
-    for code, color, width in (
-        ("B", _EDGE_COLOR["CUT"], 0.7 * lw),
-        ("V", _EDGE_COLOR["VALLEY"], lw),
-        ("M", _EDGE_COLOR["MOUNTAIN"], lw),
+    edge_faces = None if pattern.edge_faces is None else np.asarray(pattern.edge_faces)
+    seam = pattern.cut_mask() if len(assign) else np.zeros(0, dtype=bool)
+    lw = max(1.0, width_px / 800.0)
+    lines = []
+    for sel, color, width in (
+        (seam, _SEAM_COLOR, 0.7 * lw),
+        ((assign == "B") & ~seam, _EDGE_COLOR["CUT"], lw),
+        (assign == "V", _EDGE_COLOR["VALLEY"], lw),
+        (assign == "M", _EDGE_COLOR["MOUNTAIN"], lw),
     ):
-        sel = (assign == code) & visible
-        if sel.any():
-            segs = v3[pattern.edges[sel]]
-            lc = Line3DCollection(segs, colors=color, linewidths=width, zorder=3)
-            ax.add_collection3d(lc)
-
-    if len(v3):
-        lo, hi = v3.min(axis=0), v3.max(axis=0)
-    else:
-        lo, hi = np.zeros(3), np.ones(3)
-    span = np.maximum(hi - lo, 1e-3 * max(float((hi - lo).max()), 1e-9))
-    mid = 0.5 * (lo + hi)
-    ax.set_xlim(mid[0] - span[0] / 2, mid[0] + span[0] / 2)
-    ax.set_ylim(mid[1] - span[1] / 2, mid[1] + span[1] / 2)
-    ax.set_zlim(mid[2] - span[2] / 2, mid[2] + span[2] / 2)
-    ax.set_box_aspect(tuple(span), zoom=1.2)
-    # mplot3d's projection (a BLAS dot of finite data) now and then reports a spurious float
-    # overflow; the picture is unaffected
-    with np.errstate(over="ignore"):
-        return _render(fig)
+        faces = None if edge_faces is None else edge_faces[sel]
+        lines.append((v3[pattern.edges[sel]], faces, _rgb(color), width))
+    image = render(
+        v3,
+        triangles,
+        colors,
+        triangle_face=tri_face,
+        lines=lines,
+        width=width_px,
+        height=height_px,
+        azim=float(azim),
+        elev=float(elev),
+        up=up,
+    )
+    return png_bytes(image)

@@ -310,6 +310,58 @@ def _saddle_patch():
     return _scale_mean_edge(v, faces), faces
 
 
+def _shell(cells=(6, 4), opening: float = 140.0, sag: float = 0.1):
+    """An open vault shell (a shelter, as in the paper's fig. 20): a translational surface of
+    planar quads, convex at every interior vertex.
+
+    The arch across is an arc of the unit circle turning ``opening`` degrees, ``a`` quads of equal
+    angle; along the vault, ``b`` rows of quads whose width equals the arch's step, on a
+    parabola that lowers both ends by ``sag`` times the vault's length. A translational
+    surface ``P(i, j) = (x_i, y_j, f_i + g_j)`` has parallelogram quads, so every quad is
+    planar; with both curves concave each interior vertex has a positive angle defect. Scaled
+    to a mean edge length of 1, its lowest point at z = 0.
+
+    Parameters
+    ----------
+    cells : (2,) int
+        ``(a, b)``: quads across the arch (2..24) and along the vault (1..24).
+    opening : float
+        Turn of the arch in degrees, in [30, 170].
+    sag : float
+        Drop of the two ends over the vault's length, in [0, 0.4] (0: a barrel vault, every
+        interior vertex developable).
+
+    Returns
+    -------
+    vertices : ((a + 1) * (b + 1), 3) float64
+        Row ``j`` along the vault holds vertices ``j * (a + 1) .. j * (a + 1) + a``.
+    faces : list of (4,) int64
+        Counter-clockwise seen from above (outside).
+    """
+    a, b = tessellations._cells(cells, low=1, high=24)
+    if a < 2:
+        raise ParameterError(f"cells must have 2..24 quads across the arch, got {a}", name="cells")
+    turn = np.radians(tessellations._in_range(opening, "opening", 30.0, 170.0))
+    drop = tessellations._in_range(sag, "sag", 0.0, 0.4)
+    theta = turn * (np.arange(a + 1) / a - 0.5)
+    length = b * turn / a
+    y = length * (np.arange(b + 1) / b - 0.5)
+    g = -drop * length * (2.0 * y / length) ** 2
+    jj, ii = np.meshgrid(np.arange(b + 1), np.arange(a + 1), indexing="ij")
+    v = np.column_stack(
+        [np.sin(theta)[ii.ravel()], y[jj.ravel()], (np.cos(theta)[ii] + g[jj]).ravel()]
+    )
+    v[:, 2] -= v[:, 2].min()
+    faces = [
+        np.array(
+            [j * (a + 1) + i, j * (a + 1) + i + 1, (j + 1) * (a + 1) + i + 1, (j + 1) * (a + 1) + i]
+        )
+        for j in range(b)
+        for i in range(a)
+    ]
+    return _scale_mean_edge(v, faces), faces
+
+
 # -------------------------------------------------------------------------------- registry
 EXAMPLES: dict[str, Example] = {
     e.name: e
@@ -413,6 +465,16 @@ EXAMPLES: dict[str, Example] = {
             "5 x 5 grid on the saddle z = 0.6 x y, triangles",
             ("non-convex", "saddle", "open", "triangles"),
             _saddle_patch,
+        ),
+        Example(
+            "shell",
+            "open vault shell (a shelter, paper fig. 20): translational surface of planar "
+            "quads, every interior vertex convex. Parameters: cells AxB (A quads across the "
+            "arch x B along, default 6x4), opening = turn of the arch in degrees (30..170, "
+            "default 140), sag = drop of the ends over the length (0..0.4, default 0.1)",
+            ("convex", "open", "quads"),
+            _shell,
+            ("cells", "opening", "sag"),
         ),
         Example(
             "miura",
