@@ -402,3 +402,15 @@ def pattern(request) -> CreasePattern:
 def signed_area(p: np.ndarray) -> float:
     q = np.roll(p, -1, axis=0)
     return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]))
+
+
+def folded_area(pattern) -> float:
+    """The folded polygons' area, by Newell's formula (no triangulation)."""
+    from filletfold.surface.pattern import face_arrays
+
+    flat, start = face_arrays(pattern.faces)
+    p = pattern.vertices_3d[flat]
+    nxt = np.arange(1, len(flat) + 1)
+    nxt[start[1:] - 1] = start[:-1]
+    cross = np.add.reduceat(np.cross(p, p[nxt]), start[:-1], axis=0)
+    return float(0.5 * np.linalg.norm(cross, axis=1).sum())

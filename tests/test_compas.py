@@ -17,7 +17,7 @@ from filletfold.compas import (
 )
 from filletfold.errors import ParameterError
 
-from .export.test_gltf import folded_area
+from .conftest import folded_area
 
 datastructures = pytest.importorskip("compas.datastructures")
 Mesh = datastructures.Mesh

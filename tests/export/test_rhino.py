@@ -21,8 +21,8 @@ from filletfold.export.rhino import (
     require_rhino3dm,
 )
 
+from ..conftest import folded_area
 from .conftest import arc_pattern, edge_length, tab_lengths
-from .test_gltf import folded_area
 
 rhino3dm = pytest.importorskip("rhino3dm")
 

@@ -20,19 +20,9 @@ from filletfold.export.mesh3d import (
     weld_vertices,
 )
 from filletfold.export.png import PATCH_COLOR
-from filletfold.surface.pattern import face_arrays
 
+from ..conftest import folded_area
 from .conftest import arc_pattern
-
-
-def folded_area(pattern) -> float:
-    """The folded polygons' area, by Newell's formula (no triangulation)."""
-    flat, start = face_arrays(pattern.faces)
-    p = pattern.vertices_3d[flat]
-    nxt = np.arange(1, len(flat) + 1)
-    nxt[start[1:] - 1] = start[:-1]
-    cross = np.add.reduceat(np.cross(p, p[nxt]), start[:-1], axis=0)
-    return float(0.5 * np.linalg.norm(cross, axis=1).sum())
 
 
 def triangle_count(pattern, kind: str | None = None) -> int:
