@@ -127,15 +127,21 @@ def layer_lengths(doc) -> dict:
     return out
 
 
-def check_lengths(doc, pattern: CreasePattern, scale: float = 1.0) -> None:
-    lengths = layer_lengths(doc)
+def layer_lengths_of(pattern: CreasePattern) -> dict[str, float]:
+    """The length each cut-file layer should draw: CUT the borders and the tab outlines,
+    MOUNTAIN and VALLEY their creases, TAB the tab hinges (pattern units)."""
     tab_cut, hinge = tab_lengths(pattern.annotations)
-    expected = {
+    return {
         "CUT": edge_length(pattern, "B") + tab_cut,
         "MOUNTAIN": edge_length(pattern, "M"),
         "VALLEY": edge_length(pattern, "V"),
         "TAB": hinge,
     }
+
+
+def check_lengths(doc, pattern: CreasePattern, scale: float = 1.0) -> None:
+    lengths = layer_lengths(doc)
+    expected = layer_lengths_of(pattern)
     for layer, want in expected.items():
         got, splines = lengths.get(layer, (0.0, []))
         assert got == pytest.approx(want * scale, rel=1e-6, abs=1e-9), layer

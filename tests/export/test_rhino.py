@@ -22,7 +22,7 @@ from filletfold.export.rhino import (
 )
 
 from ..conftest import folded_area
-from .conftest import arc_pattern, edge_length, tab_lengths
+from .conftest import arc_pattern, layer_lengths_of
 
 rhino3dm = pytest.importorskip("rhino3dm")
 
@@ -74,13 +74,7 @@ def test_pattern_3dm_layers_units_and_lengths(pattern, units, scale):
     assert [layer.Name for layer in model.Layers] == list(PATTERN_LAYERS)
     assert model.Settings.ModelUnitSystem == getattr(rhino3dm.UnitSystem, RHINO_UNITS[units])
     layers = by_layer(model)
-    tab_cut, hinge = tab_lengths(pattern.annotations)
-    expected = {
-        "CUT": edge_length(pattern, "B") + tab_cut,
-        "MOUNTAIN": edge_length(pattern, "M"),
-        "VALLEY": edge_length(pattern, "V"),
-        "TAB": hinge,
-    }
+    expected = layer_lengths_of(pattern)
     v2 = pattern.vertices_2d * scale
     for layer, want in expected.items():
         curves = [g for g, _ in layers.get(layer, [])]
