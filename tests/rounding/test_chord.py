@@ -100,14 +100,15 @@ def test_a_smaller_fillet_gets_fewer_points():
 
 def test_the_isometry_figures_stay_at_round_off():
     """The certificate's ruling isometry and contraction are the construction's, not the
-    sampling's: with the chord tolerance as with the old arc step, at round-off."""
+    sampling's: with the chord tolerance as with the old arc step, at round-off (1e-11: the
+    torus's contraction is 1.1e-12 with numpy 2.4, the sampling's own mismatch about 1e-5)."""
     old = filletfold.round_mesh("torus", chord_tol=0, arc_step=1.5, tabs=False)
     new = filletfold.round_mesh("torus", arc_step=5, tabs=False)  # the tolerance decides
     assert len(new.pattern.vertices_2d) < len(old.pattern.vertices_2d)
     for d in (old, new):
         assert d.certificate.ok
         for name in ("ruling isometry", "contraction"):
-            assert d.certificate[name].value < 1e-12
+            assert d.certificate[name].value < 1e-11
 
 
 def test_mismatch_converges_as_the_chord_tolerance_shrinks():
