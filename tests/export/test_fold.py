@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
 import json
+import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -13,11 +15,12 @@ from numpy.testing import assert_allclose
 
 from filletfold.errors import ExportError, ParameterError
 from filletfold.export import (
+    cut_files,
     fold_document,
     fold_json,
     pattern_svg,
 )
-from filletfold.surface.pattern import CreasePattern
+from filletfold.surface.pattern import Annotations, CreasePattern, Label
 
 from ..conftest import signed_area, square_pattern, strip_pattern, two_pieces
 
@@ -241,3 +244,135 @@ def test_fold_json_same_pattern_same_bytes():
 def test_fold_json_rejects(doc, match):
     with pytest.raises(ExportError, match=match):
         fold_json(doc)
+
+
+def test_fold_facet_angles_are_written_on_a_nanodegree_grid():
+    """F edges' dihedrals keep 9 decimals (degrees): within 5e-10 of the folded form's, no more
+    digits; M and V angles keep their 12 significant digits."""
+    from filletfold.export.fold import _round, edge_dihedrals
+
+    from ..conftest import design_of
+
+    p = design_of("tetrahedron", samples=6).pattern
+    doc = json.loads(fold_json(fold_document(p)))
+    assign = np.array(doc["edges_assignment"])
+    written = np.array([np.nan if a is None else a for a in doc["edges_foldAngle"]])
+    facet, crease = assign == "F", np.isin(assign, ["M", "V"])
+    exact = edge_dihedrals(p)[facet]
+    assert np.abs(written[facet] - exact).max() <= 0.5e-9 * (1 + 1e-6)
+    nano = written[facet] * 1e9
+    assert np.abs(nano - np.rint(nano)).max() < 1e-3
+    assert (np.abs(exact * 1e9 - np.rint(exact * 1e9)) > 1e-3).any()  # digits were dropped
+    assert written[crease].tolist() == [_round(a) for a in p.edge_fold_angle[crease].tolist()]
+
+
+# ---------------------------------------------------------------- annotations
+
+
+def annotated_square(scale: float, n: int = 40, seed: int = 0) -> CreasePattern:
+    """The diagonal square with ``n`` random glue tabs (each hinge two of its tab's points),
+    ``n`` labels and a sheet, all lengths about ``scale``."""
+    rng = np.random.default_rng(seed)
+    p = square_pattern(90.0)
+    tabs = [scale * rng.normal(size=(4, 2)) for _ in range(n)]
+    labels = [
+        Label(scale * rng.normal(size=2), str(i), float(rng.uniform(-180, 180)), 0.02 * scale, k)
+        for i, k in zip(range(n), itertools.cycle(["tab", "part"]), strict=False)
+    ]
+    p.annotations = Annotations(
+        tabs=tabs,
+        tab_hinges=[t[[3, 2]].copy() for t in tabs],
+        labels=labels,
+        sheets=scale * np.array([[-5.0, -5.0, 5.0, 5.0]]),
+    )
+    return p
+
+
+def grid_step(p: CreasePattern) -> float:
+    """The grid annotation lengths are written on: the 7th significant digit of the largest."""
+    ann = p.annotations
+    lengths = [*ann.tabs, *ann.tab_hinges, *(lb.position for lb in ann.labels), ann.sheets]
+    largest = max(max(np.abs(x).max() for x in lengths), max(lb.height for lb in ann.labels))
+    return 10.0 ** (math.ceil(math.log10(largest)) - 7)
+
+
+@pytest.mark.parametrize("scale", [1e-4, 0.03, 0.7, 1.0, 93.0, 4e4, 3e8])
+def test_annotation_numbers_are_written_on_their_grid(scale):
+    """Tab, hinge, label and sheet lengths to 7 significant digits of the largest (half a grid
+    step), label angles to 1e-4 degree; shared points stay equal; both writers agree."""
+    p = annotated_square(scale)
+    text = fold_json(fold_document(p))
+    assert text == cut_files(p, "fold")["design.fold"] == fold_json(fold_document(p))
+    ann = json.loads(text)["filletfold:annotations"]
+    step = grid_step(p)
+    tol = 0.5 * step * (1 + 1e-9)
+
+    def on_grid(written, exact, step, tol):
+        written, exact = np.asarray(written, dtype=float), np.asarray(exact, dtype=float)
+        assert written.shape == exact.shape
+        assert np.abs(written - exact).max() <= tol
+        k = written / step
+        assert np.abs(k - np.rint(k)).max() <= 1e-6 * max(1.0, np.abs(k).max())
+
+    lab = ann["labels"]
+    on_grid(ann["tabs"], p.annotations.tabs, step, tol)
+    on_grid(ann["tab_hinges"], p.annotations.tab_hinges, step, tol)
+    on_grid(lab["position"], [lb.position for lb in p.annotations.labels], step, tol)
+    on_grid(lab["height"], [lb.height for lb in p.annotations.labels], step, tol)
+    on_grid(ann["sheets"], p.annotations.sheets, step, tol)
+    on_grid(lab["angle"], [lb.angle for lb in p.annotations.labels], 1e-4, 0.5e-4 * (1 + 1e-9))
+    # a hinge is written as the very numbers of its tab's points
+    for tab, hinge in zip(ann["tabs"], ann["tab_hinges"], strict=True):
+        assert hinge == [tab[3], tab[2]]
+    assert lab["text"] == [lb.text for lb in p.annotations.labels]
+    assert lab["kind"] == [lb.kind for lb in p.annotations.labels]
+
+
+def test_annotation_labels_are_parallel_lists_on_a_few_lines():
+    """The labels are one list per field (no key repeated per label), and the file has as many
+    lines with 400 tabs and labels as with 4: arrays are written on one line each."""
+    few, many = annotated_square(1.0, n=4), annotated_square(1.0, n=400)
+    texts = [fold_json(fold_document(p)) for p in (few, many)]
+    assert texts[0].count("\n") == texts[1].count("\n") < 60
+    labels = json.loads(texts[1])["filletfold:annotations"]["labels"]
+    assert list(labels) == ["position", "text", "angle", "height", "kind"]
+    assert all(len(v) == 400 for v in labels.values())
+    assert texts[1].count('"position"') == 1
+
+
+def test_annotation_bytes_are_bounded_by_their_numbers():
+    """At 7 significant digits a number takes at most 10 characters (sign, 7 digits, point,
+    a leading zero): the annotations' text is within that budget plus JSON punctuation, and
+    well under their numbers at 12 digits."""
+    p = annotated_square(93.0, n=500, seed=1)
+    text = fold_json(fold_document(p))
+    start = text.index('"filletfold:annotations"')
+    written = len(text) - start
+    ann = p.annotations
+    points = sum(len(t) for t in ann.tabs) + 2 * len(ann.tab_hinges)
+    n = len(ann.labels)
+    per_point = 2 * 10 + len("[,],")
+    budget = (
+        points * per_point
+        + 3 * (len(ann.tabs) + len(ann.tab_hinges))  # "[", "]", ","
+        + n * per_point  # positions
+        + sum(len(lb.text) + 3 for lb in ann.labels)
+        + n * (10 + 1) * 2  # angles ("-179.9999" is 9), heights
+        + sum(len(lb.kind) + 3 for lb in ann.labels)
+        + 300  # keys, indentation, sheets
+    )
+    assert written <= budget
+    full = json.dumps(
+        {
+            "tabs": [np.asarray(t).tolist() for t in ann.tabs],
+            "labels": [{"position": lb.position.tolist(), "angle": lb.angle} for lb in ann.labels],
+        },
+        separators=(",", ":"),
+    )
+    assert written < 0.75 * len(full)
+
+
+def test_annotated_fold_is_deterministic():
+    a = fold_json(fold_document(annotated_square(93.0, seed=4)))
+    b = fold_json(fold_document(annotated_square(93.0, seed=4)))
+    assert a == b

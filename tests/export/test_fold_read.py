@@ -76,14 +76,32 @@ def assert_same_pattern(a: CreasePattern, b: CreasePattern) -> None:
     assert a.edge_faces.tolist() == b.edge_faces.tolist()
     aa, ba = a.annotations, b.annotations
     assert len(aa.tabs) == len(ba.tabs) and len(aa.labels) == len(ba.labels)
+    # annotation lengths are written to 7 significant digits of the largest, angles to 1e-4
+    tol = annotation_tolerance(aa)
     for s, t in zip(aa.tabs, ba.tabs, strict=True):
-        assert_allclose(s, t, atol=1e-9)
+        assert_allclose(s, t, rtol=0, atol=tol)
     for s, t in zip(aa.tab_hinges, ba.tab_hinges, strict=True):
-        assert_allclose(s, t, atol=1e-9)
+        assert_allclose(s, t, rtol=0, atol=tol)
     for s, t in zip(aa.labels, ba.labels, strict=True):
         assert (s.text, s.kind) == (t.text, t.kind)
-        assert_allclose([*s.position, s.angle, s.height], [*t.position, t.angle, t.height])
-    assert_allclose(np.reshape(aa.sheets, (-1, 4)), np.reshape(ba.sheets, (-1, 4)), atol=1e-9)
+        assert_allclose([*s.position, s.height], [*t.position, t.height], rtol=0, atol=tol)
+        assert abs(s.angle - t.angle) <= 0.5e-4 * (1 + 1e-9)
+    assert_allclose(np.reshape(aa.sheets, (-1, 4)), np.reshape(ba.sheets, (-1, 4)), atol=tol)
+
+
+def annotation_tolerance(ann) -> float:
+    """Half the grid step annotation lengths are written on: the 7th significant digit of the
+    largest |length| (a little more, for the binary round-off of the grid)."""
+    lengths = [
+        *map(np.ravel, ann.tabs),
+        *map(np.ravel, ann.tab_hinges),
+        *(np.ravel([*lb.position, lb.height]) for lb in ann.labels),
+        np.ravel(ann.sheets),
+    ]
+    largest = max((float(np.abs(x).max()) for x in lengths if np.size(x)), default=0.0)
+    if largest == 0:
+        return 0.0
+    return 0.5 * 10.0 ** (np.ceil(np.log10(largest)) - 7) * (1 + 1e-9) + 1e-15 * largest
 
 
 def test_read_fold_round_trip_cube(cube, tmp_path):
@@ -106,6 +124,46 @@ def test_read_fold_round_trip_annotations(annotated, tmp_path):
     for layer in a:
         assert a[layer][0] == pytest.approx(b[layer][0], rel=1e-9)
         assert len(a[layer][1]) == len(b[layer][1])
+
+
+def test_read_fold_reads_labels_written_as_records(tmp_path):
+    """Files written before the labels were parallel lists hold a list of records, one key per
+    line: they read back to the same labels (missing angle, height, kind: the defaults)."""
+    pattern = arc_pattern(annotated=True)
+    doc = json.loads(fold_json(fold_document(pattern)))
+    columns = doc["filletfold:annotations"]["labels"]
+    records = [dict(zip(columns, row, strict=True)) for row in zip(*columns.values(), strict=True)]
+    assert len(records) == len(pattern.annotations.labels) == 2
+    new = read_fold(write_fold(tmp_path, doc, "new.fold"))
+    doc["filletfold:annotations"]["labels"] = records
+    old = read_fold(write_fold(tmp_path, json.dumps(doc, indent=2), "old.fold"))
+    for a, b in zip(old.annotations.labels, new.annotations.labels, strict=True):
+        assert (a.text, a.angle, a.height, a.kind) == (b.text, b.angle, b.height, b.kind)
+        assert a.position.tolist() == b.position.tolist()
+    assert_same_pattern(pattern, old)
+    # the optional fields, in either layout
+    del records[0]["angle"], records[0]["height"], records[0]["kind"]
+    lean = {"position": columns["position"], "text": columns["text"]}
+    for labels in (records, lean):
+        doc["filletfold:annotations"]["labels"] = labels
+        first = read_fold(write_fold(tmp_path, doc, "lean.fold")).annotations.labels[0]
+        assert (first.angle, first.height, first.kind) == (0.0, 0.05, "part")
+
+
+def test_read_fold_tabs_cut_as_written(cube, tmp_path):
+    """Rounded to 7 digits in the file, a tab still meets its hinge: the same cut paths as the
+    design's own, within the file's rounding."""
+    from filletfold.export.paths import tab_cut_paths
+
+    ann = cube.pattern.annotations
+    assert len(ann.tabs) > 0
+    back = read_fold(write_fold(tmp_path, fold_json(fold_document(cube.pattern)))).annotations
+    tol = annotation_tolerance(ann)
+    mine, read = tab_cut_paths(ann), tab_cut_paths(back)
+    assert [closed for _, closed in read] == [closed for _, closed in mine]
+    assert not any(closed for _, closed in read)  # every tab found its hinge
+    for (a, _), (b, _) in zip(mine, read, strict=True):
+        assert_allclose(a, b, rtol=0, atol=tol)
 
 
 def test_read_fold_without_pieces_vertex(tmp_path):
@@ -136,6 +194,22 @@ def _mutated(change):
         (_mutated(lambda d: d.update({"filletfold:annotations": [1]})), "must be an object"),
         (
             _mutated(lambda d: d.update({"filletfold:annotations": {"labels": [{"x": 1}]}})),
+            "annotations is malformed",
+        ),
+        (
+            _mutated(
+                lambda d: d.update(
+                    {"filletfold:annotations": {"labels": {"position": [[0, 0]], "text": []}}}
+                )
+            ),
+            "annotations is malformed",
+        ),
+        (
+            _mutated(
+                lambda d: d.update(
+                    {"filletfold:annotations": {"labels": {"position": [0, 0], "text": ["a"]}}}
+                )
+            ),
             "annotations is malformed",
         ),
     ],

@@ -26,8 +26,13 @@ from .paths import label_positions, point_rows
 from .report import python_scalar
 
 __all__ = [
+    "ANNOTATION_DIGITS",
+    "FOLD_ANGLE_DECIMALS",
+    "FOLD_DIGITS",
     "FOLD_SPEC",
+    "LABEL_ANGLE_DECIMALS",
     "NAMESPACE",
+    "annotation_decimals",
     "annotations_document",
     "edge_dihedrals",
     "face_arrays",
@@ -41,9 +46,20 @@ __all__ = [
 FOLD_SPEC = 1.2
 #: Prefix of filletfold's custom FOLD keys.
 NAMESPACE = "filletfold:"
-#: Edge assignments the exporters understand.
 #: Significant digits kept for floats in :func:`fold_json`.
 FOLD_DIGITS = 12
+#: Decimals of ``edges_foldAngle`` on ``F`` edges (degrees): a 1e-9 degree grid, the 12th
+#: significant digit of an angle over 100 degrees (the folded coordinates' own rounding moves
+#: such a measured dihedral more). M and V angles keep :data:`FOLD_DIGITS`.
+FOLD_ANGLE_DECIMALS = 9
+#: Significant digits of the largest annotation length (tab, hinge, label position and height,
+#: sheet corner): every annotation length is written on that digit's grid
+#: (:func:`annotation_decimals`).
+ANNOTATION_DIGITS = 7
+#: Decimals of a label's angle (degrees): 7 significant digits of 180.
+LABEL_ANGLE_DECIMALS = 4
+#: More decimals than this are not rounded to (``10 ** decimals`` overflows from 309 on).
+_MAX_DECIMALS = 300
 
 
 def file_creator() -> str:
@@ -79,7 +95,8 @@ def fold_document(
         Keys in a fixed order: file metadata, key-frame metadata, ``vertices_coords`` (n, 2),
         ``edges_vertices`` (m, 2), ``edges_assignment`` (m,), ``edges_foldAngle`` (m,) degrees
         (valley positive; ``null`` on borders, the folded form's dihedral on ``F`` edges, see
-        :func:`edge_dihedrals`), ``faces_vertices`` (counter-clockwise),
+        :func:`edge_dihedrals`, rounded to :data:`FOLD_ANGLE_DECIMALS`), ``faces_vertices``
+        (counter-clockwise),
         ``filletfold:faces_patch`` and ``filletfold:faces_piece`` (n_faces,),
         ``filletfold:pieces_vertex`` (n_pieces,),
         ``file_frames`` (the folded form: a child of the key frame with 3D ``vertices_coords``
@@ -212,7 +229,8 @@ def edge_dihedrals(pattern: CreasePattern) -> np.ndarray:
 
 def _fold_angle_data(pattern: CreasePattern, raw: bool) -> list | _Raw:
     """``edges_foldAngle``: M and V edges as the pattern has them, F edges the folded form's
-    dihedral (:func:`edge_dihedrals`), B edges ``null``; a list, or with ``raw`` JSON text."""
+    dihedral (:func:`edge_dihedrals`) rounded to :data:`FOLD_ANGLE_DECIMALS`, B edges ``null``;
+    a list, or with ``raw`` JSON text."""
     angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64).copy()
     assign = np.asarray(pattern.edge_assignment, dtype=str)
     flat = assign == "F"
@@ -223,6 +241,8 @@ def _fold_angle_data(pattern: CreasePattern, raw: bool) -> list | _Raw:
     if not np.isfinite(angle).all():
         bad = int(np.nonzero(~np.isfinite(angle))[0][0])
         raise ExportError(f"pattern edge {bad} has no finite fold angle")
+    # the facets' dihedrals are measured on the folded form, its crease angles are the design's
+    angle[flat] = np.round(angle[flat], FOLD_ANGLE_DECIMALS)
     if not raw:
         items: list = angle.tolist()
         for e in np.nonzero(border)[0].tolist():
@@ -254,6 +274,91 @@ def has_annotations(annotations: Annotations) -> bool:
     )
 
 
+def annotation_decimals(*lengths: np.ndarray) -> int | None:
+    """Decimals of the grid annotation lengths are written on: the unit of the
+    :data:`ANNOTATION_DIGITS`-th significant digit of the largest finite ``|length|``
+    (``ANNOTATION_DIGITS - ceil(log10(largest))``, negative from 1e7 on); None (written as
+    they are, to :data:`FOLD_DIGITS`) when every length is 0 (or there is none) or the grid
+    would take more than 300 decimals (the largest under about 1e-293: ``10 ** decimals``
+    overflows from 309 on).
+
+    Parameters
+    ----------
+    *lengths : array_like of float
+        Every annotation length: tab and hinge points, label positions and heights, sheets.
+
+    Returns
+    -------
+    int or None
+    """
+    largest = 0.0
+    for a in lengths:
+        a = np.abs(np.asarray(a, dtype=np.float64))
+        a = a[np.isfinite(a)]
+        if a.size:
+            largest = max(largest, float(a.max()))
+    if largest == 0.0:
+        return None
+    decimals = ANNOTATION_DIGITS - math.ceil(math.log10(largest))
+    return decimals if decimals <= _MAX_DECIMALS else None
+
+
+def _on_grid(a: np.ndarray, decimals: int | None) -> np.ndarray:
+    """``a`` rounded to ``decimals`` (``np.round``; as is when None), ``-0.0`` made ``0.0``;
+    values that are not finite stay so (for the writer to name them)."""
+    a = np.asarray(a, dtype=np.float64)
+    return (a if decimals is None else np.round(a, decimals)) + 0.0
+
+
+def _annotation_arrays(annotations: Annotations) -> dict:
+    """The annotations' numbers as arrays, rounded as written (see :func:`annotations_document`):
+    ``tab_points`` (k, 2) and ``tab_size`` (n_tabs,), ``hinges`` (n_hinges, 2, 2),
+    ``position`` (n_labels, 2), ``angle`` and ``height`` (n_labels,), ``sheets`` (n_sheets, 4).
+
+    Raises
+    ------
+    TypeError, ValueError
+        When a value is malformed (a hinge that is not 2 points, a label angle that is not a
+        number, ...).
+    """
+    labels = annotations.labels
+    n = len(labels)
+    tab_points, tab_size = point_rows(annotations.tabs)
+    hinge_points, hinge_size = point_rows(annotations.tab_hinges)
+    if (hinge_size != 2).any():  # each hinge is read as reshape(2, 2): its error
+        for h in annotations.tab_hinges:
+            np.asarray(h, dtype=np.float64).reshape(2, 2)
+    position = label_positions(labels)
+    angle = np.fromiter(map(float, map(operator.attrgetter("angle"), labels)), np.float64, n)
+    height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
+    sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
+    decimals = annotation_decimals(tab_points, hinge_points, position, height, sheets)
+    return {
+        "tab_points": _on_grid(tab_points, decimals),
+        "tab_size": tab_size,
+        "hinges": _on_grid(hinge_points, decimals).reshape(-1, 2, 2),
+        "position": _on_grid(position, decimals),
+        "angle": _on_grid(angle, LABEL_ANGLE_DECIMALS),
+        "height": _on_grid(height, decimals),
+        "sheets": _on_grid(sheets, decimals),
+    }
+
+
+def _check_labels(numbers: dict) -> None:
+    """Name the first label number that is not finite (the labels are written a column at a
+    time, so the writer alone would name the column, not the label)."""
+    for name in ("position", "angle", "height"):
+        values = numbers[name].reshape(len(numbers["angle"]), 2 if name == "position" else 1)
+        bad = np.argwhere(~np.isfinite(values))
+        if len(bad):
+            i, j = bad[0].tolist()
+            where = f"{name}[{j}]" if name == "position" else name
+            raise ExportError(
+                f"FOLD value at {NAMESPACE}annotations.labels[{i}].{where} is not finite "
+                f"({values[i, j]})"
+            )
+
+
 def annotations_document(annotations: Annotations) -> dict:
     """The JSON form of a pattern's annotations (the ``filletfold:annotations`` FOLD key).
 
@@ -265,70 +370,71 @@ def annotations_document(annotations: Annotations) -> dict:
     -------
     dict
         ``tabs``: list of tab outlines, each a list of ``[x, y]``; ``tab_hinges``: list of
-        ``[[x, y], [x, y]]``; ``labels``: list of ``{"position": [x, y], "text", "angle"
-        (degrees), "height", "kind"}``; ``sheets``: list of ``[xmin, ymin, xmax, ymax]``. All
-        in pattern coordinates.
+        ``[[x, y], [x, y]]``; ``labels``: the labels as parallel lists (one item per label),
+        ``{"position": [[x, y], ...], "text": [...], "angle": [...] (degrees), "height": [...],
+        "kind": [...]}``; ``sheets``: list of ``[xmin, ymin, xmax, ymax]``. All in pattern
+        coordinates. The lengths (tab, hinge, position, height, sheet) are rounded to the grid of
+        :func:`annotation_decimals` (:data:`ANNOTATION_DIGITS` significant digits of the
+        largest), the angles to :data:`LABEL_ANGLE_DECIMALS` decimals.
+
+    Raises
+    ------
+    ExportError
+        When a label's position, angle or height is not finite (naming the label).
+    TypeError, ValueError
+        When a value is malformed.
     """
+    a = _annotation_arrays(annotations)
+    _check_labels(a)
+    labels = annotations.labels
+    sizes = a["tab_size"]
+    tabs = np.split(a["tab_points"], np.cumsum(sizes)[:-1]) if len(sizes) else []
     return {
-        "tabs": [np.asarray(t, dtype=np.float64).reshape(-1, 2).tolist() for t in annotations.tabs],
-        "tab_hinges": [
-            np.asarray(h, dtype=np.float64).reshape(2, 2).tolist() for h in annotations.tab_hinges
-        ],
-        "labels": [
-            {
-                "position": np.asarray(lb.position, dtype=np.float64).reshape(2).tolist(),
-                "text": str(lb.text),
-                "angle": float(lb.angle),
-                "height": float(lb.height),
-                "kind": str(lb.kind),
-            }
-            for lb in annotations.labels
-        ],
-        "sheets": np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4).tolist(),
+        "tabs": [t.tolist() for t in tabs],
+        "tab_hinges": a["hinges"].tolist(),
+        "labels": {
+            "position": a["position"].tolist(),
+            "text": [str(lb.text) for lb in labels],
+            "angle": a["angle"].tolist(),
+            "height": a["height"].tolist(),
+            "kind": [str(lb.kind) for lb in labels],
+        },
+        "sheets": a["sheets"].tolist(),
     }
 
 
 def _annotations_data(annotations: Annotations) -> dict:
-    """:func:`annotations_document` for :func:`fold_json`, its numbers formatted in bulk: tabs,
-    hinges and sheets as :class:`_Raw` text, labels as a :class:`_RecordList`.
+    """:func:`annotations_document` for :func:`fold_json`, its numbers formatted in bulk as
+    :class:`_Raw` text.
 
-    When a number is not finite (or a value is malformed), the plain document instead, for
-    :func:`_plain` (or this function's checks) to name it.
+    When a number is not finite, the plain document instead, for :func:`_plain` (or
+    :func:`annotations_document` itself) to name it.
     """
+    a = _annotation_arrays(annotations)
+    numbers = ("tab_points", "hinges", "position", "angle", "height", "sheets")
+    if not all(np.isfinite(a[k]).all() for k in numbers):
+        return annotations_document(annotations)
     labels = annotations.labels
-    n = len(labels)
-    try:
-        tab_points, tab_size = point_rows(annotations.tabs)
-        hinge_points, hinge_size = point_rows(annotations.tab_hinges)
-        if (hinge_size != 2).any():  # each hinge is read as reshape(2, 2)
-            for h in annotations.tab_hinges:
-                np.asarray(h, dtype=np.float64).reshape(2, 2)
-        hinge_points = hinge_points.reshape(-1, 2, 2)
-        position = label_positions(labels)
-        angle = np.fromiter(map(float, map(operator.attrgetter("angle"), labels)), np.float64, n)
-        height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
-        sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
-    except (TypeError, ValueError):
-        return annotations_document(annotations)
-    numbers = (tab_points, hinge_points, position, angle, height, sheets)
-    if not all(np.isfinite(a).all() for a in numbers):
-        return annotations_document(annotations)
-    sizes = tab_size.tolist()
+    sizes = a["tab_size"].tolist()
     tab_template = {k: _template((k, 2)) for k in set(sizes)}
+    tabs = "[" + ",".join(map(tab_template.__getitem__, sizes)) + "]"
     return {
-        "tabs": _Raw(_fill("[" + ",".join(map(tab_template.__getitem__, sizes)) + "]", tab_points)),
-        "tab_hinges": _Raw(_float_text(hinge_points)),
-        "labels": _RecordList(
-            {
-                "position": _item_texts(position),
-                "text": [_quote(str(lb.text)) for lb in labels],
-                "angle": _item_texts(angle),
-                "height": _item_texts(height),
-                "kind": [_quote(str(lb.kind)) for lb in labels],
-            }
-        ),
-        "sheets": _Raw(_float_text(sheets)),
+        "tabs": _Raw(_fill(tabs, a["tab_points"])),
+        "tab_hinges": _Raw(_float_text(a["hinges"])),
+        "labels": {
+            "position": _Raw(_float_text(a["position"])),
+            "text": _Raw(_strings_text(str(lb.text) for lb in labels)),
+            "angle": _Raw(_float_text(a["angle"])),
+            "height": _Raw(_float_text(a["height"])),
+            "kind": _Raw(_strings_text(str(lb.kind) for lb in labels)),
+        },
+        "sheets": _Raw(_float_text(a["sheets"])),
     }
+
+
+def _strings_text(items) -> str:
+    """Compact JSON (ASCII) of a list of strings, as ``json.dumps`` writes it."""
+    return "[" + ",".join(map(_quote, items)) + "]"
 
 
 def _round(x: float) -> float:
@@ -361,35 +467,6 @@ class _Raw:
 
     def __init__(self, text: str):
         self.text = text
-
-
-class _RecordList:
-    """A list of dicts with the same keys, each value already compact JSON text, written by
-    :func:`_dump` a column at a time as it writes a list of dicts.
-
-    Parameters
-    ----------
-    columns : dict of str to list of str
-        Key -> (n,) the JSON text of the key's value in every record.
-    """
-
-    __slots__ = ("columns",)
-
-    def __init__(self, columns: dict[str, list[str]]):
-        self.columns = columns
-
-    def text(self, depth: int) -> str:
-        """The list as :func:`_dump` writes it at ``depth``."""
-        n = len(next(iter(self.columns.values()), []))
-        if n == 0:
-            return "[]"
-        pad = "  " * depth
-        fields = ",\n".join(
-            pad + "    " + json.dumps(k).replace("%", "%%") + ": %s" for k in self.columns
-        )
-        record = pad + "  {\n" + fields + "\n" + pad + "  }"
-        values = tuple(itertools.chain.from_iterable(zip(*self.columns.values(), strict=True)))
-        return "[\n" + ",\n".join([record] * n) % values + "\n" + pad + "]"
 
 
 #: Exact types :func:`_plain` passes through unchanged.
@@ -504,7 +581,7 @@ def _plain(obj, where: str):
         obj = obj.tolist()
     elif isinstance(obj, _RaggedInts):
         return _Raw(obj.text())
-    elif isinstance(obj, _Raw | _RecordList):
+    elif isinstance(obj, _Raw):
         return obj
     obj = python_scalar(obj)
     if obj is None or isinstance(obj, bool | str | int):
@@ -548,9 +625,7 @@ def _dump(obj, depth: int, out: list[str]) -> list[str]:
     """Dicts and lists of dicts one entry per line, everything else compact on one line: the
     text's pieces appended to ``out`` (joined once by :func:`fold_json`), which is returned."""
     pad = "  " * depth
-    if isinstance(obj, _RecordList):
-        out.append(obj.text(depth))
-    elif isinstance(obj, dict) and obj:
+    if isinstance(obj, dict) and obj:
         out.append("{\n")
         for k, v in obj.items():
             out += (pad, "  ", json.dumps(k), ": ")
@@ -571,7 +646,8 @@ def fold_json(doc: Mapping) -> str:
     """Serialise a FOLD document deterministically.
 
     Keys keep the document's order (:func:`fold_document` builds them in a fixed order); floats
-    are rounded to 12 significant digits (``-0`` written as ``0.0``); numpy arrays and scalars
+    are rounded to 12 significant digits (``-0`` written as ``0.0``; :func:`fold_document` has
+    rounded its facets' fold angles and annotations further); numpy arrays and scalars
     become JSON arrays and numbers. Each top-level key (and each key of a frame) is on its own
     line, arrays are compact. Output is ASCII and ends with a newline.
 

@@ -5,7 +5,8 @@
 ``edges_assignment`` and ``edges_foldAngle`` (kept as written, not derived again),
 ``filletfold:faces_patch``, ``filletfold:faces_piece``, ``filletfold:pieces_vertex`` and, from the
 folded frame, the 3D ``vertices_coords``. The annotations come from ``filletfold:annotations``
-when the file has that key.
+when the file has that key (its labels as parallel lists, or as the list of records of files
+written before those).
 """
 
 from __future__ import annotations
@@ -184,17 +185,49 @@ def _annotations(data) -> Annotations:
     try:
         tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in data.get("tabs", [])]
         hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in data.get("tab_hinges", [])]
-        labels = [
-            Label(
-                position=np.asarray(lb["position"], dtype=np.float64).reshape(2),
-                text=str(lb["text"]),
-                angle=float(lb.get("angle", 0.0)),
-                height=float(lb.get("height", 0.05)),
-                kind=str(lb.get("kind", "part")),
-            )
-            for lb in data.get("labels", [])
-        ]
+        labels = _labels(data.get("labels", []))
         sheets = np.asarray(data.get("sheets", []), dtype=np.float64).reshape(-1, 4)
     except (TypeError, ValueError, KeyError, AttributeError) as exc:
         raise MeshReadError(f"filletfold:annotations is malformed ({exc!r})") from None
     return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)
+
+
+def _labels(data) -> list[Label]:
+    """The labels of ``filletfold:annotations``: parallel lists ``{"position": [[x, y], ...],
+    "text": [...], "angle": [...], "height": [...], "kind": [...]}`` (``angle``, ``height`` and
+    ``kind`` optional), or, as files written before those, a list of records ``{"position",
+    "text", "angle", "height", "kind"}``."""
+    if isinstance(data, dict):
+        position = np.asarray(data["position"], dtype=np.float64)
+        if position.size == 0:
+            position = position.reshape(0, 2)
+        if position.ndim != 2 or position.shape[1] != 2:
+            raise ValueError(f"labels' positions must be [x, y] points, got shape {position.shape}")
+        n = len(position)
+        text = [str(t) for t in data["text"]]
+        angle = [float(a) for a in data.get("angle", [0.0] * n)]
+        height = [float(h) for h in data.get("height", [0.05] * n)]
+        kind = [str(k) for k in data.get("kind", ["part"] * n)]
+        sizes = {len(text), len(angle), len(height), len(kind)}
+        if sizes != {n}:
+            raise ValueError(f"labels' lists have lengths {sorted(sizes | {n})}, not one length")
+        return [
+            Label(
+                position=position[i].copy(),
+                text=text[i],
+                angle=angle[i],
+                height=height[i],
+                kind=kind[i],
+            )
+            for i in range(n)
+        ]
+    return [
+        Label(
+            position=np.asarray(lb["position"], dtype=np.float64).reshape(2),
+            text=str(lb["text"]),
+            angle=float(lb.get("angle", 0.0)),
+            height=float(lb.get("height", 0.05)),
+            kind=str(lb.get("kind", "part")),
+        )
+        for lb in data
+    ]
