@@ -61,6 +61,7 @@ def test_cut_files_names_and_types():
     files = cut_files(arc_pattern(annotated=True), "all", units="mm", scale=40.0, report={"a": 1})
     assert list(files) == [
         "design.fold",
+        "annotations.json",
         "simulator.fold",
         "report.json",
         "folded.obj",

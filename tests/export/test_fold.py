@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -288,44 +287,54 @@ def annotated_square(scale: float, n: int = 40, seed: int = 0) -> CreasePattern:
     return p
 
 
-def grid_step(p: CreasePattern) -> float:
-    """The grid annotation lengths are written on: the 7th significant digit of the largest."""
-    ann = p.annotations
-    lengths = [*ann.tabs, *ann.tab_hinges, *(lb.position for lb in ann.labels), ann.sheets]
-    largest = max(max(np.abs(x).max() for x in lengths), max(lb.height for lb in ann.labels))
-    return 10.0 ** (math.ceil(math.log10(largest)) - 7)
-
-
 @pytest.mark.parametrize("scale", [1e-4, 0.03, 0.7, 1.0, 93.0, 4e4, 3e8])
-def test_annotation_numbers_are_written_on_their_grid(scale):
-    """Tab, hinge, label and sheet lengths to 7 significant digits of the largest (half a grid
-    step), label angles to 1e-4 degree; shared points stay equal; both writers agree."""
+def test_annotation_numbers_are_written_to_fold_digits(scale):
+    """Tab, hinge, label and sheet numbers as FOLD writes every number (12 significant
+    digits), so a tab's base stays on its piece's border; shared points stay equal; both
+    writers agree, and annotations.json holds what the FOLD key would."""
+    from filletfold.export.fold import _round, annotations_json
+
     p = annotated_square(scale)
     text = fold_json(fold_document(p))
-    assert text == cut_files(p, "fold")["design.fold"] == fold_json(fold_document(p))
+    assert text == fold_json(fold_document(p))
     ann = json.loads(text)["filletfold:annotations"]
-    step = grid_step(p)
-    tol = 0.5 * step * (1 + 1e-9)
 
-    def on_grid(written, exact, step, tol):
-        written, exact = np.asarray(written, dtype=float), np.asarray(exact, dtype=float)
-        assert written.shape == exact.shape
-        assert np.abs(written - exact).max() <= tol
-        k = written / step
-        assert np.abs(k - np.rint(k)).max() <= 1e-6 * max(1.0, np.abs(k).max())
+    def as_written(exact):
+        exact = np.asarray(exact, dtype=float)
+        return np.vectorize(_round)(exact).tolist()
 
     lab = ann["labels"]
-    on_grid(ann["tabs"], p.annotations.tabs, step, tol)
-    on_grid(ann["tab_hinges"], p.annotations.tab_hinges, step, tol)
-    on_grid(lab["position"], [lb.position for lb in p.annotations.labels], step, tol)
-    on_grid(lab["height"], [lb.height for lb in p.annotations.labels], step, tol)
-    on_grid(ann["sheets"], p.annotations.sheets, step, tol)
-    on_grid(lab["angle"], [lb.angle for lb in p.annotations.labels], 1e-4, 0.5e-4 * (1 + 1e-9))
-    # a hinge is written as the very numbers of its tab's points
+    assert ann["tabs"] == [as_written(t) for t in p.annotations.tabs]
+    assert ann["tab_hinges"] == [as_written(h) for h in p.annotations.tab_hinges]
+    assert lab["position"] == [as_written(lb.position) for lb in p.annotations.labels]
+    assert lab["angle"] == [_round(lb.angle) for lb in p.annotations.labels]
+    assert lab["height"] == [_round(lb.height) for lb in p.annotations.labels]
+    assert ann["sheets"] == as_written(p.annotations.sheets)
     for tab, hinge in zip(ann["tabs"], ann["tab_hinges"], strict=True):
-        assert hinge == [tab[3], tab[2]]
+        assert hinge == [tab[3], tab[2]]  # a hinge is written as the very numbers of its tab's
     assert lab["text"] == [lb.text for lb in p.annotations.labels]
     assert lab["kind"] == [lb.kind for lb in p.annotations.labels]
+    side = json.loads(annotations_json(p))
+    assert side.pop("design") == {"vertices": 4, "faces": 2, "pieces": 1}
+    assert side.pop("file_creator").startswith("filletfold")
+    assert side == ann
+
+
+def test_design_fold_leaves_the_annotations_to_their_own_file():
+    """What ``filletfold round`` writes: design.fold without ``filletfold:annotations``,
+    annotations.json beside it with them (empty lists without tabs)."""
+    p = annotated_square(2.0)
+    files = cut_files(p, "fold")
+    assert list(files) == ["design.fold", "annotations.json"]
+    doc = json.loads(files["design.fold"])
+    assert "filletfold:annotations" not in doc
+    assert len(doc["vertices_coords"]) == 4
+    side = json.loads(files["annotations.json"])
+    assert len(side["tabs"]) == len(side["labels"]["text"]) == 40
+    bare = cut_files(square_pattern(90.0), "fold")
+    empty = json.loads(bare["annotations.json"])
+    assert empty["tabs"] == [] and empty["labels"]["text"] == [] and empty["sheets"] == []
+    assert "filletfold:annotations" not in json.loads(bare["design.fold"])
 
 
 def test_annotation_labels_are_parallel_lists_on_a_few_lines():
@@ -338,38 +347,6 @@ def test_annotation_labels_are_parallel_lists_on_a_few_lines():
     assert list(labels) == ["position", "text", "angle", "height", "kind"]
     assert all(len(v) == 400 for v in labels.values())
     assert texts[1].count('"position"') == 1
-
-
-def test_annotation_bytes_are_bounded_by_their_numbers():
-    """At 7 significant digits a number takes at most 10 characters (sign, 7 digits, point,
-    a leading zero): the annotations' text is within that budget plus JSON punctuation, and
-    well under their numbers at 12 digits."""
-    p = annotated_square(93.0, n=500, seed=1)
-    text = fold_json(fold_document(p))
-    start = text.index('"filletfold:annotations"')
-    written = len(text) - start
-    ann = p.annotations
-    points = sum(len(t) for t in ann.tabs) + 2 * len(ann.tab_hinges)
-    n = len(ann.labels)
-    per_point = 2 * 10 + len("[,],")
-    budget = (
-        points * per_point
-        + 3 * (len(ann.tabs) + len(ann.tab_hinges))  # "[", "]", ","
-        + n * per_point  # positions
-        + sum(len(lb.text) + 3 for lb in ann.labels)
-        + n * (10 + 1) * 2  # angles ("-179.9999" is 9), heights
-        + sum(len(lb.kind) + 3 for lb in ann.labels)
-        + 300  # keys, indentation, sheets
-    )
-    assert written <= budget
-    full = json.dumps(
-        {
-            "tabs": [np.asarray(t).tolist() for t in ann.tabs],
-            "labels": [{"position": lb.position.tolist(), "angle": lb.angle} for lb in ann.labels],
-        },
-        separators=(",", ":"),
-    )
-    assert written < 0.75 * len(full)
 
 
 def test_annotated_fold_is_deterministic():

@@ -76,7 +76,7 @@ def assert_same_pattern(a: CreasePattern, b: CreasePattern) -> None:
     assert a.edge_faces.tolist() == b.edge_faces.tolist()
     aa, ba = a.annotations, b.annotations
     assert len(aa.tabs) == len(ba.tabs) and len(aa.labels) == len(ba.labels)
-    # annotation lengths are written to 7 significant digits of the largest, angles to 1e-4
+    # annotation numbers are written to FOLD's 12 significant digits
     tol = annotation_tolerance(aa)
     for s, t in zip(aa.tabs, ba.tabs, strict=True):
         assert_allclose(s, t, rtol=0, atol=tol)
@@ -85,13 +85,13 @@ def assert_same_pattern(a: CreasePattern, b: CreasePattern) -> None:
     for s, t in zip(aa.labels, ba.labels, strict=True):
         assert (s.text, s.kind) == (t.text, t.kind)
         assert_allclose([*s.position, s.height], [*t.position, t.height], rtol=0, atol=tol)
-        assert abs(s.angle - t.angle) <= 0.5e-4 * (1 + 1e-9)
+        assert abs(s.angle - t.angle) <= 1e-11 * max(1.0, abs(s.angle))
     assert_allclose(np.reshape(aa.sheets, (-1, 4)), np.reshape(ba.sheets, (-1, 4)), atol=tol)
 
 
 def annotation_tolerance(ann) -> float:
-    """Half the grid step annotation lengths are written on: the 7th significant digit of the
-    largest |length| (a little more, for the binary round-off of the grid)."""
+    """How far a written annotation length may be from its own: FOLD's 12 significant digits
+    of the largest |length|."""
     lengths = [
         *map(np.ravel, ann.tabs),
         *map(np.ravel, ann.tab_hinges),
@@ -101,7 +101,7 @@ def annotation_tolerance(ann) -> float:
     largest = max((float(np.abs(x).max()) for x in lengths if np.size(x)), default=0.0)
     if largest == 0:
         return 0.0
-    return 0.5 * 10.0 ** (np.ceil(np.log10(largest)) - 7) * (1 + 1e-9) + 1e-15 * largest
+    return 1e-11 * largest
 
 
 def test_read_fold_round_trip_cube(cube, tmp_path):
@@ -151,7 +151,7 @@ def test_read_fold_reads_labels_written_as_records(tmp_path):
 
 
 def test_read_fold_tabs_cut_as_written(cube, tmp_path):
-    """Rounded to 7 digits in the file, a tab still meets its hinge: the same cut paths as the
+    """Read back from the file, a tab still meets its hinge: the same cut paths as the
     design's own, within the file's rounding."""
     from filletfold.export.paths import tab_cut_paths
 
@@ -225,3 +225,48 @@ def test_read_fold_missing_file_and_folder(tmp_path):
         read_fold(tmp_path / "nothing.fold")
     with pytest.raises(MeshReadError, match="is a folder"):
         read_fold(tmp_path)
+
+
+def test_read_fold_takes_the_annotations_from_the_file_beside_it(cube, tmp_path):
+    """``filletfold round`` writes the tabs and labels into annotations.json: read_fold finds
+    them there (the same as in the design), none without the file, and refuses one written
+    for another design, naming it."""
+    from filletfold.export import cut_files
+
+    for name, text in cut_files(cube.pattern, "fold").items():
+        (tmp_path / name).write_text(text)
+    back = read_fold(tmp_path / "design.fold")
+    assert len(back.annotations.tabs) == len(cube.pattern.annotations.tabs) > 0
+    assert_same_pattern(cube.pattern, back)
+    other = tmp_path / "annotations.json"
+    doc = json.loads(other.read_text())
+    doc["design"]["faces"] += 1
+    other.write_text(json.dumps(doc))
+    with pytest.raises(MeshReadError, match=r"annotations\.json: written for another design"):
+        read_fold(tmp_path / "design.fold")
+    other.write_text("[1, 2]")
+    with pytest.raises(MeshReadError, match=r"annotations\.json: not an annotations file"):
+        read_fold(tmp_path / "design.fold")
+    other.unlink()
+    assert len(read_fold(tmp_path / "design.fold").annotations.tabs) == 0
+
+
+def test_cut_files_exported_from_the_files_are_those_of_round(tmp_path):
+    """``filletfold export`` rebuilds pattern.svg byte for byte from design.fold and
+    annotations.json, and pattern.dxf to the file's 12 digits (the DXF keeps every digit of
+    a float): a net with glue tabs on sheets, whose tab bases lie on the pieces' borders
+    (rounded apart, they would change the SVG's scale)."""
+    from filletfold.cli import main
+
+    out = tmp_path / "ico"
+    args = ["round", "icosahedron", "--layout", "net", "--sheet", "A4", "--units", "mm"]
+    assert main([*args, "--scale", "40", "--format", "fold,svg,dxf", "-o", str(out), "-q"]) == 0
+    first = {n: (out / n).read_bytes() for n in ("pattern.svg", "pattern.dxf")}
+    assert main(["export", str(out), "--format", "svg,dxf", "--units", "mm", "--scale", "40"]) == 0
+    assert (out / "pattern.svg").read_bytes() == first["pattern.svg"]
+    a = layer_lengths(read_dxf((out / "pattern.dxf").read_text()))
+    b = layer_lengths(read_dxf(first["pattern.dxf"].decode()))
+    assert a.keys() == b.keys() and "TAB" in a
+    for layer in a:
+        assert a[layer][0] == pytest.approx(b[layer][0], rel=1e-9)
+        assert len(a[layer][1]) == len(b[layer][1])

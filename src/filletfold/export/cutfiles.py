@@ -5,7 +5,8 @@ Formats and their files:
 =============  ===============================  =================================================
 format         files                            content
 =============  ===============================  =================================================
-``fold``       ``design.fold``                  FOLD 1.2: crease pattern + folded form
+``fold``       ``design.fold``,                 FOLD 1.2: crease pattern + folded form; the
+               ``annotations.json``             tabs, labels and sheets beside it
 ``simulator``  ``simulator.fold``               FOLD 1.2 for Origami Simulator: the pattern
                                                 coarsened and triangulated (see
                                                 :mod:`~filletfold.export.simulator`)
@@ -58,7 +59,7 @@ from ..surface.pattern import Annotations, CreasePattern, Label
 from ..surface.validate import validated_faces
 from ..units import check_units, sheet_size_mm
 from .dxf import check_scale, pattern_dxf
-from .fold import _fold_document, fold_json
+from .fold import ANNOTATIONS_FILE, _fold_document, annotations_json, fold_json
 from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
@@ -81,7 +82,7 @@ __all__ = [
 
 #: Files written for each format, in writing order.
 FORMAT_FILES = {
-    "fold": ("design.fold",),
+    "fold": ("design.fold", "annotations.json"),
     "simulator": ("simulator.fold",),
     "json": ("report.json",),
     "obj": ("folded.obj",),
@@ -339,7 +340,9 @@ def cut_files(
     from .report import report_json
 
     def fold():
-        doc = _fold_document(pattern, faces, title=title, description=description, arrays=True)
+        doc = _fold_document(
+            pattern, faces, title=title, description=description, arrays=True, annotations=False
+        )
         return fold_json(doc)
 
     def simulator():
@@ -354,6 +357,7 @@ def cut_files(
             description=description,
             extra={"filletfold:simulator": settings},
             arrays=True,
+            annotations=False,
         )
         return fold_json(doc)
 
@@ -373,7 +377,7 @@ def cut_files(
         return build
 
     builders = {
-        "fold": {"design.fold": fold},
+        "fold": {"design.fold": fold, ANNOTATIONS_FILE: lambda: annotations_json(pattern)},
         "simulator": {"simulator.fold": simulator},
         "json": {"report.json": lambda: report if isinstance(report, str) else report_json(report)},
         "obj": {"folded.obj": lambda: _folded_obj(pattern, faces)},

@@ -26,14 +26,14 @@ from .paths import label_positions, point_rows
 from .report import python_scalar
 
 __all__ = [
-    "ANNOTATION_DIGITS",
+    "ANNOTATIONS_FILE",
     "FOLD_ANGLE_DECIMALS",
     "FOLD_DIGITS",
     "FOLD_SPEC",
-    "LABEL_ANGLE_DECIMALS",
     "NAMESPACE",
-    "annotation_decimals",
     "annotations_document",
+    "annotations_json",
+    "design_counts",
     "edge_dihedrals",
     "face_arrays",
     "file_creator",
@@ -46,20 +46,16 @@ __all__ = [
 FOLD_SPEC = 1.2
 #: Prefix of filletfold's custom FOLD keys.
 NAMESPACE = "filletfold:"
+#: The file beside ``design.fold`` that holds its cut-file annotations (tabs, tab hinges,
+#: labels, sheets): FOLD readers have no use for them, and on a large design of modules they
+#: are a third of the file (see :func:`annotations_json`).
+ANNOTATIONS_FILE = "annotations.json"
 #: Significant digits kept for floats in :func:`fold_json`.
 FOLD_DIGITS = 12
 #: Decimals of ``edges_foldAngle`` on ``F`` edges (degrees): a 1e-9 degree grid, the 12th
 #: significant digit of an angle over 100 degrees (the folded coordinates' own rounding moves
 #: such a measured dihedral more). M and V angles keep :data:`FOLD_DIGITS`.
 FOLD_ANGLE_DECIMALS = 9
-#: Significant digits of the largest annotation length (tab, hinge, label position and height,
-#: sheet corner): every annotation length is written on that digit's grid
-#: (:func:`annotation_decimals`).
-ANNOTATION_DIGITS = 7
-#: Decimals of a label's angle (degrees): 7 significant digits of 180.
-LABEL_ANGLE_DECIMALS = 4
-#: More decimals than this are not rounded to (``10 ** decimals`` overflows from 309 on).
-_MAX_DECIMALS = 300
 
 
 def file_creator() -> str:
@@ -124,10 +120,13 @@ def _fold_document(
     description: str = "",
     extra: Mapping | None = None,
     arrays: bool = False,
+    annotations: bool = True,
 ) -> dict:
     """:func:`fold_document` of a pattern already checked (``faces`` from
     :func:`validated_faces`); with ``arrays`` the numbers stay numpy arrays (and the faces
-    :class:`_RaggedInts`): the same text from :func:`fold_json`, without lists in between."""
+    :class:`_RaggedInts`): the same text from :func:`fold_json`, without lists in between;
+    without ``annotations`` the document has no ``filletfold:annotations`` (the files keep
+    them in :data:`ANNOTATIONS_FILE`)."""
     for name, value in (("title", title), ("description", description)):
         if not isinstance(value, str):
             raise ParameterError(f"{name} must be a string, got {type(value).__name__}", name=name)
@@ -169,7 +168,7 @@ def _fold_document(
             }
         ],
     }
-    if has_annotations(pattern.annotations):
+    if annotations and has_annotations(pattern.annotations):
         doc[NAMESPACE + "annotations"] = (
             _annotations_data(pattern.annotations)
             if arrays
@@ -274,44 +273,8 @@ def has_annotations(annotations: Annotations) -> bool:
     )
 
 
-def annotation_decimals(*lengths: np.ndarray) -> int | None:
-    """Decimals of the grid annotation lengths are written on: the unit of the
-    :data:`ANNOTATION_DIGITS`-th significant digit of the largest finite ``|length|``
-    (``ANNOTATION_DIGITS - ceil(log10(largest))``, negative from 1e7 on); None (written as
-    they are, to :data:`FOLD_DIGITS`) when every length is 0 (or there is none) or the grid
-    would take more than 300 decimals (the largest under about 1e-293: ``10 ** decimals``
-    overflows from 309 on).
-
-    Parameters
-    ----------
-    *lengths : array_like of float
-        Every annotation length: tab and hinge points, label positions and heights, sheets.
-
-    Returns
-    -------
-    int or None
-    """
-    largest = 0.0
-    for a in lengths:
-        a = np.abs(np.asarray(a, dtype=np.float64))
-        a = a[np.isfinite(a)]
-        if a.size:
-            largest = max(largest, float(a.max()))
-    if largest == 0.0:
-        return None
-    decimals = ANNOTATION_DIGITS - math.ceil(math.log10(largest))
-    return decimals if decimals <= _MAX_DECIMALS else None
-
-
-def _on_grid(a: np.ndarray, decimals: int | None) -> np.ndarray:
-    """``a`` rounded to ``decimals`` (``np.round``; as is when None), ``-0.0`` made ``0.0``;
-    values that are not finite stay so (for the writer to name them)."""
-    a = np.asarray(a, dtype=np.float64)
-    return (a if decimals is None else np.round(a, decimals)) + 0.0
-
-
 def _annotation_arrays(annotations: Annotations) -> dict:
-    """The annotations' numbers as arrays, rounded as written (see :func:`annotations_document`):
+    """The annotations' numbers as arrays (see :func:`annotations_document`):
     ``tab_points`` (k, 2) and ``tab_size`` (n_tabs,), ``hinges`` (n_hinges, 2, 2),
     ``position`` (n_labels, 2), ``angle`` and ``height`` (n_labels,), ``sheets`` (n_sheets, 4).
 
@@ -332,15 +295,14 @@ def _annotation_arrays(annotations: Annotations) -> dict:
     angle = np.fromiter(map(float, map(operator.attrgetter("angle"), labels)), np.float64, n)
     height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
     sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
-    decimals = annotation_decimals(tab_points, hinge_points, position, height, sheets)
     return {
-        "tab_points": _on_grid(tab_points, decimals),
+        "tab_points": tab_points,
         "tab_size": tab_size,
-        "hinges": _on_grid(hinge_points, decimals).reshape(-1, 2, 2),
-        "position": _on_grid(position, decimals),
-        "angle": _on_grid(angle, LABEL_ANGLE_DECIMALS),
-        "height": _on_grid(height, decimals),
-        "sheets": _on_grid(sheets, decimals),
+        "hinges": hinge_points.reshape(-1, 2, 2),
+        "position": position,
+        "angle": angle,
+        "height": height,
+        "sheets": sheets,
     }
 
 
@@ -373,9 +335,8 @@ def annotations_document(annotations: Annotations) -> dict:
         ``[[x, y], [x, y]]``; ``labels``: the labels as parallel lists (one item per label),
         ``{"position": [[x, y], ...], "text": [...], "angle": [...] (degrees), "height": [...],
         "kind": [...]}``; ``sheets``: list of ``[xmin, ymin, xmax, ymax]``. All in pattern
-        coordinates. The lengths (tab, hinge, position, height, sheet) are rounded to the grid of
-        :func:`annotation_decimals` (:data:`ANNOTATION_DIGITS` significant digits of the
-        largest), the angles to :data:`LABEL_ANGLE_DECIMALS` decimals.
+        coordinates (written by :func:`fold_json` to :data:`FOLD_DIGITS`, as the pattern's
+        points: a tab's base stays on its piece's border).
 
     Raises
     ------
@@ -429,6 +390,46 @@ def _annotations_data(annotations: Annotations) -> dict:
             "kind": _Raw(_strings_text(str(lb.kind) for lb in labels)),
         },
         "sheets": _Raw(_float_text(a["sheets"])),
+    }
+
+
+def annotations_json(pattern: CreasePattern) -> str:
+    """The text of :data:`ANNOTATIONS_FILE`: the cut-file annotations of the pattern that
+    ``design.fold`` holds, as :func:`annotations_document` gives them, with the counts of
+    the pattern they belong to.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+
+    Returns
+    -------
+    str
+        A JSON object: ``"file_creator"``, ``"design"`` (:func:`design_counts`, which
+        :func:`~filletfold.export.fold_read.read_fold` compares with ``design.fold``), then
+        ``"tabs"``, ``"tab_hinges"``, ``"labels"`` and ``"sheets"`` (empty lists when there
+        are none).
+
+    Raises
+    ------
+    ExportError
+        When an annotation number is not finite.
+    """
+    doc = {
+        "file_creator": file_creator(),
+        "design": design_counts(pattern),
+        **_annotations_data(pattern.annotations),
+    }
+    return fold_json(doc)
+
+
+def design_counts(pattern: CreasePattern) -> dict:
+    """``{"vertices", "faces", "pieces"}`` of a pattern: what ties :data:`ANNOTATIONS_FILE`
+    to its ``design.fold`` (the pieces counted by ``filletfold:pieces_vertex``)."""
+    return {
+        "vertices": len(pattern.vertices_2d),
+        "faces": len(pattern.faces),
+        "pieces": len(pattern.piece_vertex),
     }
 
 

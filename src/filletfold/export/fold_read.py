@@ -4,9 +4,10 @@
 ``design.fold``: the key frame's 2D ``vertices_coords``, ``faces_vertices``, ``edges_vertices``,
 ``edges_assignment`` and ``edges_foldAngle`` (kept as written, not derived again),
 ``filletfold:faces_patch``, ``filletfold:faces_piece``, ``filletfold:pieces_vertex`` and, from the
-folded frame, the 3D ``vertices_coords``. The annotations come from ``filletfold:annotations``
-when the file has that key (its labels as parallel lists, or as the list of records of files
-written before those).
+folded frame, the 3D ``vertices_coords``. The annotations (tabs, labels, sheets) come from
+the ``annotations.json`` beside it (:data:`~filletfold.export.fold.ANNOTATIONS_FILE`), or,
+in files written before that file, from their ``filletfold:annotations`` key (the labels as
+parallel lists, or as a list of records in older files still).
 """
 
 from __future__ import annotations
@@ -20,9 +21,9 @@ import numpy as np
 from ..errors import ExportError, MeshReadError
 from ..surface.pattern import Annotations, CreasePattern, Label
 from ..surface.validate import validate_pattern
-from .fold import NAMESPACE
+from .fold import ANNOTATIONS_FILE, NAMESPACE, design_counts
 
-__all__ = ["pattern_from_fold", "read_fold"]
+__all__ = ["pattern_from_fold", "read_annotations", "read_fold"]
 
 _REQUIRED = (
     "vertices_coords",
@@ -69,9 +70,54 @@ def read_fold(path) -> CreasePattern:
     except json.JSONDecodeError as exc:
         raise MeshReadError(f"{path}: not a FOLD file (invalid JSON: {exc.msg})") from None
     try:
-        return pattern_from_fold(doc)
+        pattern = pattern_from_fold(doc)
     except MeshReadError as exc:
         raise MeshReadError(f"{path}: {exc}") from None
+    if NAMESPACE + "annotations" not in doc:
+        pattern.annotations = read_annotations(path.with_name(ANNOTATIONS_FILE), pattern)
+    return pattern
+
+
+def read_annotations(path, pattern: CreasePattern) -> Annotations:
+    """The annotations in ``path`` (an ``annotations.json``) of ``pattern``, read from the
+    ``design.fold`` beside it; none when there is no such file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    pattern : CreasePattern
+
+    Returns
+    -------
+    Annotations
+
+    Raises
+    ------
+    MeshReadError
+        When the file is unreadable or malformed, or was written for another design (its
+        ``"design"`` counts are not those of ``pattern``).
+    """
+    path = Path(os.fspath(path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return Annotations()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MeshReadError(f"{path}: cannot read: {exc}") from exc
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise MeshReadError(f"{path}: not an annotations file (invalid JSON: {exc.msg})") from None
+    if not isinstance(doc, dict):
+        raise MeshReadError(f"{path}: not an annotations file (not a JSON object)")
+    expected = design_counts(pattern)
+    if doc.get("design") != expected:
+        raise MeshReadError(
+            f"{path}: written for another design ({doc.get('design')!r}; design.fold has "
+            f"{expected['vertices']} vertices, {expected['faces']} faces and "
+            f"{expected['pieces']} pieces)"
+        )
+    return _annotations(doc, str(path))
 
 
 def pattern_from_fold(doc: dict) -> CreasePattern:
@@ -176,19 +222,20 @@ def _edge_faces(edges: np.ndarray, faces: list, n: int) -> np.ndarray:
     return ef
 
 
-def _annotations(data) -> Annotations:
-    """Annotations from the ``filletfold:annotations`` value (``None``: none)."""
+def _annotations(data, where: str = NAMESPACE + "annotations") -> Annotations:
+    """Annotations from the ``filletfold:annotations`` value, or an ``annotations.json``
+    (``where`` names it in the errors; ``None``: none)."""
     if data is None:
         return Annotations()
     if not isinstance(data, dict):
-        raise MeshReadError("filletfold:annotations must be an object")
+        raise MeshReadError(f"{where} must be an object")
     try:
         tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in data.get("tabs", [])]
         hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in data.get("tab_hinges", [])]
         labels = _labels(data.get("labels", []))
         sheets = np.asarray(data.get("sheets", []), dtype=np.float64).reshape(-1, 4)
     except (TypeError, ValueError, KeyError, AttributeError) as exc:
-        raise MeshReadError(f"filletfold:annotations is malformed ({exc!r})") from None
+        raise MeshReadError(f"{where} is malformed ({exc!r})") from None
     return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)
 
 
