@@ -20,7 +20,7 @@ def test_round_writes_the_design(tmp_path, capsys):
     out = tmp_path / "ico"
     assert main(["round", "icosahedron", "-o", str(out), "--radius", "0.15", "--depth", "0.3"]) == 0
     text = capsys.readouterr().out
-    assert "12 ok" in text and "wrote 6 files" in text
+    assert "12 ok" in text and "wrote 7 files" in text
     report = json.loads((out / "report.json").read_text())
     assert report["parameters"]["radius"] == "0.15"
     assert report["status_counts"]["ok"] == 12
@@ -195,6 +195,7 @@ def test_net_on_sheets_with_all_formats(tmp_path, capsys):
     assert "(net)" in text and "glue tabs:" in text and "sheets:" in text
     names = sorted(p.name for p in out.iterdir())
     assert names == [
+        "annotations.json",
         "assembly.txt",
         "design.fold",
         "folded.3dm",

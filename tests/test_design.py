@@ -160,6 +160,7 @@ def test_export_writes_the_four_files(tmp_path):
     d = design_of("cube")
     files = d.export(tmp_path / "out")
     assert sorted(f.name for f in files) == [
+        "annotations.json",
         "assembly.txt",
         "design.fold",
         "folded.obj",

@@ -121,6 +121,7 @@ def test_export_design_all_formats(cube, tmp_path):
     written = export_design(cube, tmp_path / "all", formats="all", units="mm", scale=60.0)
     assert [p.name for p in written] == [
         "design.fold",
+        "annotations.json",
         "simulator.fold",
         "report.json",
         "folded.obj",
@@ -204,7 +205,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 16 files" in capsys.readouterr().out
+    assert "wrote 17 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 
