@@ -456,11 +456,13 @@ def round_mesh(
         Most points per arc, both ends included (>= 3). With ``chord_tol`` and ``arc_step``
         both 0, every arc gets this many.
     arc_step : float
-        Largest turn between two samples of an arc, in degrees (default 1.5; 0: no limit):
+        Largest turn between two samples of an arc, in degrees (default 10; 0: no limit):
         an arc gets at least one point per ``arc_step`` it turns (and at least 2), at most
         ``samples``; the relative 2D - 3D mismatch of a chord grows with the square of its
-        turn, which an absolute ``chord_tol`` alone leaves large on small fillets. A coarser
-        step with ``chord_tol`` gives smaller files at a larger mismatch.
+        turn, which an absolute ``chord_tol`` alone leaves large on small fillets (a fillet
+        of 10 % of the edge gets a point every 5.1 degrees from the default tolerance, one
+        of 1 % every 16 degrees: the step bounds it to 10). A finer step gives larger files
+        at a smaller mismatch.
     chord_tol : float or str
         Largest distance between a chord of an arc and the arc: absolute, or a percentage of
         the mean edge length (default ``"0.01%"``). An arc of radius ``r`` turning by

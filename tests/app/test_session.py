@@ -55,7 +55,8 @@ def test_arc_step_reaches_the_design_and_its_download():
     the shown design's sampling."""
     s = AppSession()
     s.load("geodesic-sphere")  # arcs of about 20 degrees: the step decides their points
-    fine = len(s.design.pattern.faces)
+    s.set_params(arc_step=1.5)
+    fine = len(s.recompute().pattern.faces)
     s.set_params(arc_step=5.0)
     coarse = s.recompute()
     assert coarse.params.arc_step == 5.0 and len(coarse.pattern.faces) < fine
