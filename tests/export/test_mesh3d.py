@@ -11,6 +11,7 @@ import pytest
 import trimesh
 from numpy.testing import assert_allclose
 
+from filletfold.errors import ParameterError
 from filletfold.export.cutfiles import cut_files, parse_formats
 from filletfold.export.mesh3d import (
     folded_glb,
@@ -33,8 +34,33 @@ def triangle_count(pattern, kind: str | None = None) -> int:
     )
 
 
+#: Metres per drawing unit, glTF's length unit being the metre.
+METRES = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254}
+
+
 def load_glb(data: bytes):
     return trimesh.load(io.BytesIO(data), file_type="glb")
+
+
+def load_mesh(data: bytes, file_type: str):
+    return trimesh.load(io.BytesIO(data), file_type=file_type, process=False)
+
+
+def ply_comments(data: bytes) -> list[str]:
+    """The comment lines of a PLY header."""
+    header = data[: data.index(b"end_header")].decode("ascii")
+    return [line[len("comment ") :] for line in header.splitlines() if line.startswith("comment ")]
+
+
+def mesh_bounds(folder) -> dict[str, np.ndarray]:
+    """(2, 3) bounding box of each of folder's folded.glb, folded.ply and folded.stl, in the
+    design's axes (the GLB's y-up turned back: ``(x, y, z) -> (x, -z, y)``)."""
+    out = {}
+    for ext in ("glb", "ply", "stl"):
+        loaded = trimesh.load(folder / f"folded.{ext}", process=False)
+        points = loaded.bounds if ext != "glb" else loaded.bounds[:, [0, 2, 1]] * [1, -1, 1]
+        out[ext] = np.sort(points, axis=0)
+    return out
 
 
 def glb_json(data: bytes) -> dict:
@@ -110,6 +136,68 @@ def test_ply_and_stl_welded(pattern):
         assert (colours == rgb).all(axis=1).sum() == triangle_count(pattern, kind)
 
 
+@pytest.mark.parametrize(
+    ("units", "scale"), [("", 1.0), ("", 3.0), ("mm", 200.0), ("cm", 2.5), ("m", 1.0), ("in", 0.5)]
+)
+def test_files_are_drawn_at_scale_in_units(pattern, units, scale):
+    """PLY and STL coordinates are the design's times ``scale`` (in ``units``, which the PLY
+    names); the GLB's are in metres: times ``scale`` and the unit's length in metres."""
+    lo, hi = pattern.vertices_3d.min(axis=0), pattern.vertices_3d.max(axis=0)
+    to_metres = METRES[units] if units else 1.0
+    scene = load_glb(folded_glb(pattern, units=units, scale=scale))
+    want = np.array([[lo[0], lo[2], -hi[1]], [hi[0], hi[2], -lo[1]]]) * scale * to_metres
+    assert_allclose(scene.bounds, want, rtol=1e-6, atol=1e-6 * np.abs(want).max())
+    ply_data = folded_ply(pattern, units=units, scale=scale)
+    ply = load_mesh(ply_data, "ply")
+    stl = load_mesh(folded_stl(pattern, scale=scale), "stl")
+    for mesh in (ply, stl):
+        assert_allclose(mesh.bounds, np.array([lo, hi]) * scale, rtol=1e-6, atol=1e-6 * scale)
+        assert mesh.area == pytest.approx(folded_area(pattern) * scale**2, rel=1e-6)
+    named = [c for c in ply_comments(ply_data) if c.startswith("units")]
+    assert named == ([f"units {units}"] if units else [])
+    # welding and normals do not depend on the size
+    assert len(ply.vertices) == len(load_mesh(folded_ply(pattern), "ply").vertices)
+    for kind, mesh in scene.geometry.items():
+        normals = load_glb(folded_glb(pattern)).geometry[kind].vertex_normals
+        assert_allclose(mesh.vertex_normals, normals, atol=1e-6)
+
+
+def test_unit_and_scale_errors(cube):
+    with pytest.raises(ParameterError, match="units"):
+        folded_glb(cube.pattern, units="pt")
+    with pytest.raises(ParameterError, match="units"):
+        folded_ply(cube.pattern, units="furlong")
+    for bad in (0.0, -1.0, float("nan"), True):
+        with pytest.raises(ParameterError, match="scale"):
+            folded_stl(cube.pattern, scale=bad)
+
+
+def test_cli_round_and_export_draw_the_mesh_files_at_scale(tmp_path):
+    """``round`` and ``export`` pass ``--units`` and ``--scale`` to the GLB, PLY and STL as to
+    the 3dm files: PLY and STL times K, the GLB in metres (``--units mm --scale 200``: x 0.2)."""
+    from filletfold.cli import main
+
+    plain, scaled = tmp_path / "plain", tmp_path / "scaled"
+    formats = ["--format", "fold,glb,ply,stl"]
+    assert main(["round", "cube", "-q", "-o", str(plain), *formats]) == 0
+    args = ["--units", "mm", "--scale", "200"]
+    assert main(["round", "cube", "-q", "-o", str(scaled), *formats, *args]) == 0
+    base, got = mesh_bounds(plain), mesh_bounds(scaled)
+    for ext, factor in (("glb", 0.2), ("ply", 200.0), ("stl", 200.0)):
+        assert_allclose(got[ext], base[ext] * factor, rtol=1e-6, err_msg=ext)
+    assert "units mm" in ply_comments((scaled / "folded.ply").read_bytes())
+    assert "units" not in " ".join(ply_comments((plain / "folded.ply").read_bytes()))
+    # export from design.fold (12 digits): the same sizes, to single precision
+    assert (
+        main(["export", str(plain), "--format", "glb,ply,stl", "--units", "in", "--scale", "3"])
+        == 0
+    )
+    got = mesh_bounds(plain)
+    for ext, factor in (("glb", 3 * 0.0254), ("ply", 3.0), ("stl", 3.0)):
+        assert_allclose(got[ext], base[ext] * factor, rtol=1e-6, err_msg=ext)
+    assert "units in" in ply_comments((plain / "folded.ply").read_bytes())
+
+
 def test_stl_of_closed_design_is_watertight(cube):
     """Every cube vertex is a cone and nothing is left open: welded, the surface closes."""
     mesh = trimesh.load(io.BytesIO(folded_stl(cube.pattern)), file_type="stl")
@@ -134,3 +222,8 @@ def test_mesh_files_reproducible_and_in_cut_files(cube):
         assert isinstance(data, bytes)
         assert again[name] == data, name
     assert files["folded.glb"] == folded_glb(cube.pattern)
+    sized = cut_files(cube.pattern, "glb,ply,stl", units="mm", scale=200.0)
+    assert sized["folded.glb"] == folded_glb(cube.pattern, units="mm", scale=200.0)
+    assert sized["folded.ply"] == folded_ply(cube.pattern, units="mm", scale=200.0)
+    assert sized["folded.stl"] == folded_stl(cube.pattern, scale=200.0)
+    assert sized["folded.stl"] != files["folded.stl"]

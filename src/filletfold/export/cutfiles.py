@@ -41,7 +41,9 @@ design's own coordinates. A cutter ``preset`` (:mod:`~filletfold.export.presets`
 colours, layers, line widths and dash or perforation of the SVG and DXF.
 
 Both 3dm files are drawn at ``scale`` in ``units`` (the folded form too, so the two overlay at
-one size); GLB, PLY and STL keep the design's own coordinates, as OBJ does.
+one size). PLY and STL are scaled by ``scale`` too (the PLY names ``units`` in a comment), and
+the GLB, whose unit is the metre, by ``scale`` and the unit in metres
+(:func:`~filletfold.export.mesh3d.length_factor`); OBJ keeps the design's own coordinates.
 """
 
 from __future__ import annotations
@@ -284,8 +286,8 @@ def cut_files(
     formats : str or iterable of str
         See :func:`parse_formats` and the module docstring.
     units : str
-        ``""``, ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: the drawing unit of DXF, SVG, PDF and
-        3DM.
+        ``""``, ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: the drawing unit of DXF, SVG, PDF,
+        3DM, PLY and STL (the GLB is in metres).
     scale : float, optional
         Drawing units per pattern unit (default 1; see the module docstring for the PDF).
     page : str
@@ -336,7 +338,7 @@ def cut_files(
         )
     faces = validated_faces(pattern)  # checked once here for fold, obj and svg
 
-    from .mesh3d import _folded_glb, _folded_ply, _folded_stl
+    from .mesh3d import _folded_glb, _folded_ply, _folded_stl, length_factor
     from .report import report_json
 
     def fold():
@@ -395,9 +397,9 @@ def cut_files(
             "preview.png": lambda: preview_png(pattern, azim=azim, elev=elev, up=up),
         },
         "3dm": {"pattern.3dm": rhino("pattern"), "folded.3dm": rhino("folded")},
-        "glb": {"folded.glb": lambda: _folded_glb(pattern)},
-        "ply": {"folded.ply": lambda: _folded_ply(pattern)},
-        "stl": {"folded.stl": lambda: _folded_stl(pattern)},
+        "glb": {"folded.glb": lambda: _folded_glb(pattern, length_factor(units, scale, gltf=True))},
+        "ply": {"folded.ply": lambda: _folded_ply(pattern, units, length_factor(units, scale))},
+        "stl": {"folded.stl": lambda: _folded_stl(pattern, length_factor(units, scale))},
     }
     out = {name: build for fmt in formats for name, build in builders[fmt].items()}
     return out if lazy else {name: build() for name, build in out.items()}

@@ -11,10 +11,19 @@
   (the two sides of a seam become one vertex), one colour per face (its patch kind's).
 * ``folded.stl`` -- binary STL of the same welded triangles (STL has no colour).
 
-PLY and STL keep the design's own axes and coordinates (z up), as ``folded.obj`` does.
+PLY and STL keep the design's own axes (z up), as ``folded.obj`` does.
 Polygons are triangulated in the flat layout, where they are simple and counter-clockwise
 (:func:`~filletfold.app.view.triangulate_faces`); every triangle is front-facing in 3D as its
 polygon is. Same pattern, same bytes.
+
+Size: as in ``folded.3dm``, one pattern unit is ``scale`` drawing units of ``units``
+(:func:`length_factor`). PLY and STL coordinates are the design's times ``scale``, in
+``units``; the PLY names its unit in a header comment (``comment units mm``; none when
+unitless), STL cannot. glTF lengths are metres by its specification, so with a unit the GLB
+holds the true size in metres (the design's times ``scale`` times the unit in metres:
+``--units mm --scale 200`` multiplies by 0.2); unitless, the design's times ``scale``, one
+drawing unit read as one metre. Welding and normals are computed before scaling, so they do
+not depend on it.
 """
 
 from __future__ import annotations
@@ -25,6 +34,8 @@ import numpy as np
 
 from ..surface.pattern import CreasePattern, FaceRows
 from ..surface.validate import validated_faces
+from ..units import MM_PER_UNIT, check_units
+from .dxf import check_scale
 from .obj import vertex_normal_3d
 from .png import PATCH_COLOR
 
@@ -34,6 +45,7 @@ __all__ = [
     "folded_ply",
     "folded_stl",
     "folded_triangles",
+    "length_factor",
     "patch_kind",
     "weld_vertices",
 ]
@@ -46,6 +58,38 @@ _OTHER_COLOR = (0.8, 0.8, 0.8)
 Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 #: Vertices closer than this share of the folded form's size are welded (PLY and STL).
 WELD_RTOL = 1e-9
+#: Millimetres per glTF length unit (the metre, by the glTF 2.0 specification).
+GLTF_MM_PER_UNIT = 1000.0
+
+
+def length_factor(units: str = "", scale: float = 1.0, *, gltf: bool = False) -> float:
+    """What the design's coordinates are multiplied by in a 3D file.
+
+    Parameters
+    ----------
+    units : str
+        The drawing unit: ``""`` (unitless), ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``.
+    scale : float
+        Drawing units per pattern length unit (positive).
+    gltf : bool
+        For glTF, whose unit is the metre: with ``units``, convert the drawing units to metres.
+
+    Returns
+    -------
+    float
+        ``scale``; for glTF with a unit, ``scale * MM_PER_UNIT[units] / 1000`` (``"mm"``,
+        ``200`` -> ``0.2``).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown unit or a scale that is not a positive number.
+    """
+    check_units(units, unitless=True)
+    scale = check_scale(scale)
+    if gltf and units:
+        return scale * (MM_PER_UNIT[units] / GLTF_MM_PER_UNIT)
+    return scale
 
 
 def patch_kind(patch: str) -> str:
@@ -143,30 +187,39 @@ def _rgba(kind: str) -> list[int]:
     return [round(255 * c) for c in rgb] + [255]
 
 
-def folded_glb(pattern: CreasePattern) -> bytes:
+def folded_glb(pattern: CreasePattern, *, units: str = "", scale: float = 1.0) -> bytes:
     """The folded form as a glTF 2.0 binary file (see the module docstring).
 
     Parameters
     ----------
     pattern : CreasePattern
         Checked with :func:`~filletfold.surface.validate.validate_pattern`.
+    units : str
+        The drawing unit: ``""`` (unitless), ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``; with a
+        unit the coordinates are converted to metres, glTF's unit.
+    scale : float
+        Drawing units per pattern length unit.
 
     Returns
     -------
     bytes
-        The GLB; same input, same bytes.
+        The GLB, coordinates the design's times :func:`length_factor` ``(units, scale,
+        gltf=True)``; same input, same bytes.
 
     Raises
     ------
+    ParameterError
+        For an unknown unit or a scale that is not a positive number.
     ExportError
         When the pattern is inconsistent.
     """
+    factor = length_factor(units, scale, gltf=True)
     validated_faces(pattern)
-    return _folded_glb(pattern)
+    return _folded_glb(pattern, factor)
 
 
-def _folded_glb(pattern: CreasePattern) -> bytes:
-    """:func:`folded_glb` of a pattern already checked."""
+def _folded_glb(pattern: CreasePattern, factor: float = 1.0) -> bytes:
+    """:func:`folded_glb` of a pattern already checked, coordinates times ``factor``."""
     import trimesh
     from trimesh.exchange.gltf import export_glb
     from trimesh.visual.material import PBRMaterial
@@ -181,7 +234,7 @@ def _folded_glb(pattern: CreasePattern) -> bytes:
             doubleSided=True,
         )
         mesh = trimesh.Trimesh(
-            vertices=v @ Y_UP.T,
+            vertices=(v * factor) @ Y_UP.T,
             faces=t,
             vertex_normals=normals @ Y_UP.T,
             visual=trimesh.visual.TextureVisuals(material=material),
@@ -191,66 +244,95 @@ def _folded_glb(pattern: CreasePattern) -> bytes:
     return export_glb(scene, include_normals=True)
 
 
-def _welded(pattern: CreasePattern):
-    """The folded surface as one trimesh, vertices welded (:func:`weld_vertices`), one face
-    colour per patch kind."""
+def _welded(pattern: CreasePattern, factor: float = 1.0):
+    """The folded surface as one trimesh, vertices welded (:func:`weld_vertices`) and then
+    multiplied by ``factor``, one face colour per patch kind."""
     import trimesh
 
     tris, face = folded_triangles(pattern)
     v, inverse = weld_vertices(pattern.vertices_3d)
     colours = np.array([_rgba(patch_kind(p)) for p in pattern.face_patch], dtype=np.uint8)
     return trimesh.Trimesh(
-        vertices=v,
+        vertices=v * factor,
         faces=inverse[tris].reshape(-1, 3),
         face_colors=colours[face].reshape(-1, 4),
         process=False,
     )
 
 
-def folded_ply(pattern: CreasePattern) -> bytes:
+def folded_ply(pattern: CreasePattern, *, units: str = "", scale: float = 1.0) -> bytes:
     """The folded form as a binary PLY (welded vertices, a colour per face).
 
     Parameters
     ----------
     pattern : CreasePattern
         Checked with :func:`~filletfold.surface.validate.validate_pattern`.
+    units : str
+        The drawing unit, ``""`` (unitless), ``"mm"``, ``"cm"``, ``"m"`` or ``"in"``: named in
+        a header comment (``comment units mm``) unless unitless.
+    scale : float
+        Drawing units per pattern length unit: the coordinates are the design's times it.
 
     Returns
     -------
     bytes
         Same input, same bytes.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown unit or a scale that is not a positive number.
+    ExportError
+        When the pattern is inconsistent.
     """
+    factor = length_factor(units, scale)
     validated_faces(pattern)
-    return _folded_ply(pattern)
+    return _folded_ply(pattern, units, factor)
 
 
-def _folded_ply(pattern: CreasePattern) -> bytes:
-    """:func:`folded_ply` of a pattern already checked."""
+def _folded_ply(pattern: CreasePattern, units: str = "", factor: float = 1.0) -> bytes:
+    """:func:`folded_ply` of a pattern already checked, coordinates times ``factor``."""
     from trimesh.exchange.ply import export_ply
 
-    return export_ply(_welded(pattern), encoding="binary", include_attributes=False)
+    data = export_ply(_welded(pattern, factor), encoding="binary", include_attributes=False)
+    if not units:
+        return data
+    # a comment may stand anywhere in the header after the format line
+    at = data.index(b"\n", data.index(b"\nformat ") + 1) + 1
+    return data[:at] + f"comment units {units}\n".encode("ascii") + data[at:]
 
 
-def folded_stl(pattern: CreasePattern) -> bytes:
+def folded_stl(pattern: CreasePattern, *, scale: float = 1.0) -> bytes:
     """The folded form as a binary STL (the welded triangles of :func:`folded_ply`).
 
     Parameters
     ----------
     pattern : CreasePattern
         Checked with :func:`~filletfold.surface.validate.validate_pattern`.
+    scale : float
+        Drawing units per pattern length unit: the coordinates are the design's times it (STL
+        has no field for the unit).
 
     Returns
     -------
     bytes
         Same input, same bytes.
+
+    Raises
+    ------
+    ParameterError
+        For a scale that is not a positive number.
+    ExportError
+        When the pattern is inconsistent.
     """
+    factor = length_factor("", scale)
     validated_faces(pattern)
-    return _folded_stl(pattern)
+    return _folded_stl(pattern, factor)
 
 
-def _folded_stl(pattern: CreasePattern) -> bytes:
-    """:func:`folded_stl` of a pattern already checked."""
+def _folded_stl(pattern: CreasePattern, factor: float = 1.0) -> bytes:
+    """:func:`folded_stl` of a pattern already checked, coordinates times ``factor``."""
     from trimesh.exchange.stl import export_stl
 
-    buffer = io.BytesIO(export_stl(_welded(pattern)))
+    buffer = io.BytesIO(export_stl(_welded(pattern, factor)))
     return buffer.getvalue()
