@@ -1,6 +1,7 @@
-"""What the browser app draws (:mod:`filletfold.app.view`): the legend, triangulations that
-cover each counter-clockwise polygon exactly (convex or not), and the scene arrays of a
-design, consistent with its crease pattern."""
+"""What the browser app draws (:mod:`filletfold.app.view`): the legend, the triangulations it
+draws (the library's, :mod:`filletfold.surface.triangulate`) that cover each counter-clockwise
+polygon exactly (convex or not), and the scene arrays of a design, consistent with its crease
+pattern."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
+from filletfold.app import view
 from filletfold.app.view import (
     CREASE_RGB,
     PATCH_RGB,
@@ -23,9 +25,8 @@ from filletfold.app.view import (
     STATUS_RGB,
     legend_markdown,
     scene_arrays,
-    triangulate_faces,
-    triangulate_polygon,
 )
+from filletfold.surface.triangulate import triangulate_faces, triangulate_polygon
 
 from ..conftest import design_of, signed_area
 
@@ -143,6 +144,12 @@ def test_triangulate_faces_covers_each_face(sizes, seed):
         local = np.searchsorted(np.sort(f), mine)
         back = np.argsort(f)
         check_covers(pts[f], back[local])
+
+
+def test_the_app_draws_the_library_triangulation():
+    """The app has no triangulation of its own: it uses the one the writers use."""
+    assert view.triangulate_faces is triangulate_faces
+    assert view.triangulate_polygon is triangulate_polygon
 
 
 def test_triangulate_faces_of_no_faces_and_of_small_ones():

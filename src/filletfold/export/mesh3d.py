@@ -13,8 +13,8 @@
 
 PLY and STL keep the design's own axes (z up), as ``folded.obj`` does.
 Polygons are triangulated in the flat layout, where they are simple and counter-clockwise
-(:func:`~filletfold.app.view.triangulate_faces`); every triangle is front-facing in 3D as its
-polygon is. Same pattern, same bytes.
+(:func:`~filletfold.surface.triangulate.triangulate_faces`); every triangle is front-facing in
+3D as its polygon is. Same pattern, same bytes.
 
 Size: as in ``folded.3dm``, one pattern unit is ``scale`` drawing units of ``units``
 (:func:`length_factor`). PLY and STL coordinates are the design's times ``scale``, in
@@ -33,6 +33,7 @@ import io
 import numpy as np
 
 from ..surface.pattern import CreasePattern, FaceRows
+from ..surface.triangulate import triangulate_faces
 from ..surface.validate import validated_faces
 from ..units import MM_PER_UNIT, check_units
 from .dxf import check_scale
@@ -120,8 +121,6 @@ def folded_triangles(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
     face : (t,) int
         The face each triangle comes from (non-decreasing).
     """
-    from ..app.view import triangulate_faces
-
     return triangulate_faces(pattern.vertices_2d, pattern.faces)
 
 

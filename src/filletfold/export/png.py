@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
+from ..surface.triangulate import triangulate_faces
 from ..surface.validate import validate_pattern
 from .palette import LABEL_COLOR, PATCH_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
@@ -270,7 +271,6 @@ def preview_png(
     ExportError
         When the pattern is inconsistent.
     """
-    from ..app.view import triangulate_faces
     from .render import png_bytes, render, view_frame
 
     width_px = _check_pixels(width_px, "width_px")

@@ -2,5 +2,5 @@
 curved creases of eq. (1) and the straight creases on the faces) as flat pieces with their
 folded positions, built for all vertices at once (:mod:`.module`; the fans of sharp vertices
 :mod:`.sharp`; :mod:`.piece`, :mod:`.faces`, :mod:`.overlap`, :mod:`.centres`), the crease
-pattern they assemble into (:mod:`.assemble`, :mod:`.pattern`) and its validation
-(:mod:`.validate`)."""
+pattern they assemble into (:mod:`.assemble`, :mod:`.pattern`), its validation
+(:mod:`.validate`) and the triangles of its faces (:mod:`.triangulate`)."""
