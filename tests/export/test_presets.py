@@ -115,17 +115,35 @@ def _pattern(linetype) -> list[float]:
     return [t.value for t in tags if t.code in (40, 49)]
 
 
-def test_default_dxf_layers_unchanged():
+def test_default_dxf_layers():
     doc = read_dxf(pattern_dxf(mm_pattern(), units="mm"))
     got = {layer.dxf.name: layer.dxf.color for layer in doc.layers} | {}
     assert {k: got[k] for k in ("CUT", "MOUNTAIN", "VALLEY", "TAB", "LABEL")} == {
         "CUT": 7,
         "MOUNTAIN": 1,
         "VALLEY": 5,
-        "TAB": 3,
+        "TAB": 6,
         "LABEL": 8,
     }
     assert doc.layers.get("TAB").dxf.linetype == "DASHED"
+
+
+def test_default_dxf_layers_show_the_svg_colours():
+    """The default DXF has no true colours, so its layers' ACI colours are what a viewer shows:
+    each line the SVG draws (cut, mountain, valley, tab hinge) has the same colour in both
+    files -- the tab hinge magenta, not ACI 3 ``#00ff00``, which Origami Simulator reads as a
+    cut. ACI 7 is black on a white sheet."""
+    from ezdxf.colors import aci2rgb
+
+    groups, _ = svg_groups(pattern_svg(mm_pattern(), units="mm"))
+    doc = read_dxf(pattern_dxf(mm_pattern(), units="mm"))
+    preset = get_preset()
+    for role, gid in GROUP.items():
+        layer = doc.layers.get(getattr(preset, role).layer)
+        assert layer.rgb is None  # no true colour: the ACI is the colour
+        aci = layer.dxf.color
+        shown = (0, 0, 0) if aci == 7 else tuple(aci2rgb(aci))
+        assert {hex_rgb(el.get("stroke")) for el in groups[gid]} == {shown}, role
 
 
 def check_dashes(paths, length: float, dash: float, gap: float) -> None:

@@ -4,19 +4,19 @@ Layers, colours, line weights and line styles come from a cutter preset
 (:mod:`filletfold.export.presets`). The default, ``origami-simulator``, has these layers and
 colours (ACI):
 
-===========  ======  ==========================================================================
-layer        colour  content
-===========  ======  ==========================================================================
-``CUT``      7       ``B`` edges (piece borders and cuts) and the cut part of each glue-tab
-                     outline (the outline without its hinge)
-``MOUNTAIN`` 1 red   ``M`` edges
-``VALLEY``   5 blue  ``V`` edges
-``TAB``      3 green the tab hinges (the fold between a tab and its piece), linetype ``DASHED``;
-                     the tab outline is *not* repeated here, so a machine that cuts ``CUT`` and
-                     scores ``TAB`` never cuts a line twice
-``LABEL``    8 grey  ``TEXT`` entities of the labels (centred on their anchor, rotated)
-``FLAT``     9       ``F`` edges, only with ``flat_edges=True``
-===========  ======  ==========================================================================
+===========  =========  =======================================================================
+layer        colour     content
+===========  =========  =======================================================================
+``CUT``      7          ``B`` edges (piece borders and cuts) and the cut part of each glue-tab
+                        outline (the outline without its hinge)
+``MOUNTAIN`` 1 red      ``M`` edges
+``VALLEY``   5 blue     ``V`` edges
+``TAB``      6 magenta  the tab hinges (the fold between a tab and its piece), linetype
+                        ``DASHED``; the tab outline is *not* repeated here, so a machine that
+                        cuts ``CUT`` and scores ``TAB`` never cuts a line twice
+``LABEL``    8 grey     ``TEXT`` entities of the labels (centred on their anchor, rotated)
+``FLAT``     9          ``F`` edges, only with ``flat_edges=True``
+===========  =========  =======================================================================
 
 The other presets rename the layers (e.g. ``SCORE_MOUNTAIN``, ``PERF_VALLEY``, ``ENGRAVE``),
 give them true colours besides the ACI, and line weights (:func:`~filletfold.export.presets.
@@ -66,7 +66,7 @@ __all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
 #: ``$INSUNITS`` code of each drawing unit ("" = unitless): of every cut-file unit.
 DXF_INSUNITS = {"": 0, "in": 1, "mm": 4, "cm": 5, "m": 6}
 #: ACI colour of each layer of the default preset, in the order the layers are created.
-LAYER_COLOR = {"CUT": 7, "MOUNTAIN": 1, "VALLEY": 5, "TAB": 3, "LABEL": 8, "FLAT": 9}
+LAYER_COLOR = {pen.layer: pen.aci for pen in get_preset(None).pens().values()}
 #: The preset role of each layer kind of :func:`~filletfold.export.paths.edge_layer_masks`.
 _ROLE = {"CUT": "cut", "MOUNTAIN": "mountain", "VALLEY": "valley", "FLAT": "flat"}
 

@@ -13,8 +13,9 @@ preset                 what it is for
 ``origami-simulator``  the default of ``pattern.svg`` and ``pattern.dxf``: the colours Origami
                        Simulator reads (mountain red, valley blue, cut black, facet yellow, hinge
                        magenta), ``stroke-opacity`` = |fold angle| / 180, facet (``F``)
-                       lines; the DXF keeps its layers ``CUT``/``MOUNTAIN``/``VALLEY``/``TAB``/
-                       ``LABEL`` in ACI 7/1/5/3/8
+                       lines; the DXF has layers ``CUT``/``MOUNTAIN``/``VALLEY``/``TAB``/
+                       ``LABEL`` in ACI 7/1/5/6/8, the SVG's colours (the tab hinge magenta in
+                       both: ACI 3 would be ``#00ff00``, the simulator's cut)
 ``laser``              a generic laser cutter: hairlines (0.01 mm), cut red, mountain score blue,
                        valley score green, tab score magenta, labels black (engrave); DXF layers
                        ``CUT``, ``SCORE_MOUNTAIN``, ``SCORE_VALLEY``, ``SCORE_TAB``, ``ENGRAVE``
@@ -206,7 +207,7 @@ _OS = Preset(
     cut=Pen("#000000", "CUT", 7, 0.3),
     mountain=Pen("#ff0000", "MOUNTAIN", 1, 0.3),
     valley=Pen("#0000ff", "VALLEY", 5, 0.3),
-    tab=Pen("#ff00ff", "TAB", 3, 0.3, dash_share=0.005),
+    tab=Pen("#ff00ff", "TAB", 6, 0.3, dash_share=0.005),
     label=Pen("#404040", "LABEL", 8, 0.3),
     flat=Pen("#ffff00", "FLAT", 9, 0.1),
     flat_edges=True,
