@@ -115,7 +115,8 @@ ScaleOption = Annotated[
     float | None,
     typer.Option(
         "--scale",
-        help="Drawing units per mesh length unit in the DXF, SVG, PDF and 3DM (default 1).",
+        help="Drawing units per mesh length unit in the DXF, SVG, PDF, 3DM, GLB, PLY and STL "
+        "(default 1).",
     ),
 ]
 PresetOption = Annotated[
