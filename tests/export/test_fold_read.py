@@ -244,6 +244,9 @@ def test_read_fold_takes_the_annotations_from_the_file_beside_it(cube, tmp_path)
     other.write_text(json.dumps(doc))
     with pytest.raises(MeshReadError, match=r"annotations\.json: written for another design"):
         read_fold(tmp_path / "design.fold")
+    other.write_text("{ nope")
+    with pytest.raises(MeshReadError, match=r"annotations\.json: not an annotations file \(inv"):
+        read_fold(tmp_path / "design.fold")
     other.write_text("[1, 2]")
     with pytest.raises(MeshReadError, match=r"annotations\.json: not an annotations file"):
         read_fold(tmp_path / "design.fold")

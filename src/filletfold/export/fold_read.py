@@ -57,18 +57,7 @@ def read_fold(path) -> CreasePattern:
         message names the file and the problem.
     """
     path = Path(os.fspath(path))
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise MeshReadError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise MeshReadError(f"{path}: is a folder, not a FOLD file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MeshReadError(f"{path}: cannot read: {exc}") from exc
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise MeshReadError(f"{path}: not a FOLD file (invalid JSON: {exc.msg})") from None
+    doc = _load_json(path, "a FOLD file")
     try:
         pattern = pattern_from_fold(doc)
     except MeshReadError as exc:
@@ -98,16 +87,9 @@ def read_annotations(path, pattern: CreasePattern) -> Annotations:
         ``"design"`` counts are not those of ``pattern``).
     """
     path = Path(os.fspath(path))
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
+    if not path.exists():
         return Annotations()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MeshReadError(f"{path}: cannot read: {exc}") from exc
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise MeshReadError(f"{path}: not an annotations file (invalid JSON: {exc.msg})") from None
+    doc = _load_json(path, "an annotations file")
     if not isinstance(doc, dict):
         raise MeshReadError(f"{path}: not an annotations file (not a JSON object)")
     expected = design_counts(pattern)
@@ -118,6 +100,23 @@ def read_annotations(path, pattern: CreasePattern) -> Annotations:
             f"{expected['pieces']} pieces)"
         )
     return _annotations(doc, str(path))
+
+
+def _load_json(path: Path, what: str):
+    """The parsed JSON text of ``path``; a :class:`MeshReadError` naming the file when it is
+    missing, a folder, unreadable or not JSON (``what`` it should be: ``"a FOLD file"``)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise MeshReadError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise MeshReadError(f"{path}: is a folder, not {what}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MeshReadError(f"{path}: cannot read: {exc}") from exc
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise MeshReadError(f"{path}: not {what} (invalid JSON: {exc.msg})") from None
 
 
 def pattern_from_fold(doc: dict) -> CreasePattern:
