@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from filletfold.vertex.batch import kkt_point, solve_apex_batch
-from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
+from filletfold.vertex.reference import _FixedApexRows, project_slsqp, solve_apex_slsqp
 
 from ..conftest import first_attempts, objective
 
@@ -99,3 +99,23 @@ def test_an_infeasible_problem_names_what_it_cannot_meet():
         assert sol.failing == cons.describe(np.flatnonzero(g < 0))
         assert sol.failing and all(isinstance(text, str) and text for text in sol.failing)
         assert not solve_apex_batch([cons], [target], [starts])[0].ok  # as the batched solver
+
+
+@pytest.mark.parametrize("mesh", ["icosahedron", "dimpled-cube", "octahedron"])
+def test_the_open_development_rows_are_the_constraints_to_the_bit(mesh):
+    """SLSQP's faster functions of an open development give the very values and derivatives
+    of ``cons.values`` and ``cons.jacobian`` (with the feasibility phase's slack column), at
+    points near the target and far from it."""
+    rng = np.random.default_rng(5)
+    problems = [p for p in first_attempts(mesh, 0.3, 0.6) if p[0].v_fixed is not None]
+    assert problems
+    for cons, target, _ in problems:
+        plain, slack = _FixedApexRows(cons), _FixedApexRows(cons, slack=True)
+        for scale in (1e-9, 1e-3, 1.0, 30.0):
+            V = target + scale * cons.scale * rng.normal(size=3)
+            x = np.append(V, scale * cons.scale * rng.normal())
+            g, J = cons.values(V), cons.jacobian(V)
+            assert np.array_equal(plain.values(V), g)
+            assert np.array_equal(plain.jacobian(V), J)
+            assert np.array_equal(slack.values(x), g - x[3])
+            assert np.array_equal(slack.jacobian(x), np.hstack([J, -np.ones((len(g), 1))]))
