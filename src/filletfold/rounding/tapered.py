@@ -33,6 +33,8 @@ place of the constants (:func:`crease_height_ruled`).
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 
 #: Gauss-Legendre nodes for the developed angle of a conical fillet
@@ -109,6 +111,15 @@ def sweep_rate(C: np.ndarray, dC: np.ndarray, S: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(rho2 - along * along, 0.0)) / rho2
 
 
+@cache
+def _gauss_legendre(nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Read-only ``numpy.polynomial.legendre.leggauss(nodes)``, computed once per ``nodes``
+    (1-2 ms each: an eigenvalue problem; the dense validation asks for it thousands of times)."""
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
+
+
 def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES):
     """(m,) float: the developed angle ``theta(s)`` a conical fillet sweeps from ``0`` to ``s``.
 
@@ -121,7 +132,7 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     nodes : int
         Gauss-Legendre nodes on ``[0, s]``.
     """
-    x, w = np.polynomial.legendre.leggauss(nodes)
+    x, w = _gauss_legendre(nodes)
     s = np.asarray(s, dtype=float)
     t = 0.5 * s[:, None] * (x + 1.0)  # (m, nodes)
     C, dC = arc_points(O[:, None], N0[:, None], B[:, None], kappa[:, None], radius[:, None], t)
