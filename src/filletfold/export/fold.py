@@ -72,6 +72,7 @@ def fold_document(
     title: str = "",
     description: str = "",
     extra: Mapping | None = None,
+    annotations: bool = True,
 ) -> dict:
     """The FOLD 1.2 document of a crease pattern.
 
@@ -84,6 +85,10 @@ def fold_document(
     extra : mapping, optional
         More top-level keys, each namespaced ``"filletfold:..."``; values must be JSON data
         (numpy arrays and scalars are accepted by :func:`fold_json`).
+    annotations : bool
+        Whether the document holds the pattern's tabs, labels and sheets (the key
+        ``filletfold:annotations``); ``design.fold`` does not: they go to
+        :data:`ANNOTATIONS_FILE` (:func:`annotations_json`).
 
     Returns
     -------
@@ -96,7 +101,7 @@ def fold_document(
         ``filletfold:faces_patch`` and ``filletfold:faces_piece`` (n_faces,),
         ``filletfold:pieces_vertex`` (n_pieces,),
         ``file_frames`` (the folded form: a child of the key frame with 3D ``vertices_coords``
-        (n, 3)), ``filletfold:annotations`` when the pattern has any (see
+        (n, 3)), ``filletfold:annotations`` when the pattern has any and ``annotations`` (see
         :func:`annotations_document`), then ``extra``.
 
     Raises
@@ -108,7 +113,12 @@ def fold_document(
         clashes with a key of the document.
     """
     return _fold_document(
-        pattern, validated_faces(pattern), title=title, description=description, extra=extra
+        pattern,
+        validated_faces(pattern),
+        title=title,
+        description=description,
+        extra=extra,
+        annotations=annotations,
     )
 
 
@@ -420,7 +430,7 @@ def annotations_json(pattern: CreasePattern) -> str:
         "design": design_counts(pattern),
         **_annotations_data(pattern.annotations),
     }
-    return fold_json(doc)
+    return fold_json(doc, root="annotations")
 
 
 def design_counts(pattern: CreasePattern) -> dict:
@@ -643,7 +653,7 @@ def _dump(obj, depth: int, out: list[str]) -> list[str]:
     return out
 
 
-def fold_json(doc: Mapping) -> str:
+def fold_json(doc: Mapping, *, root: str = "") -> str:
     """Serialise a FOLD document deterministically.
 
     Keys keep the document's order (:func:`fold_document` builds them in a fixed order); floats
@@ -656,6 +666,9 @@ def fold_json(doc: Mapping) -> str:
     ----------
     doc : mapping
         A FOLD document, such as the result of :func:`fold_document`.
+    root : str
+        The name the path of a bad value starts with in the error (``"annotations"`` for
+        :func:`annotations_json`: ``annotations.tabs[1][0]``); none by default.
 
     Returns
     -------
@@ -668,6 +681,6 @@ def fold_json(doc: Mapping) -> str:
     """
     if not isinstance(doc, Mapping):
         raise ExportError(f"a FOLD document must be a mapping, got {type(doc).__name__}")
-    parts = _dump(_plain(doc, ""), 0, [])
+    parts = _dump(_plain(doc, root), 0, [])
     parts.append("\n")
     return "".join(parts)
