@@ -29,7 +29,14 @@ from filletfold.errors import MeshReadError, ParameterError
 from ..conftest import design_of
 
 TETRA_OBJ = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
-ZIP_NAMES = {"design.fold", "report.json", "folded.obj", "pattern.svg", "pattern.dxf"}
+ZIP_NAMES = {
+    "design.fold",
+    "annotations.json",
+    "report.json",
+    "folded.obj",
+    "pattern.svg",
+    "pattern.dxf",
+}
 
 
 @pytest.fixture(scope="module")
@@ -161,12 +168,15 @@ def test_export_zip_holds_the_files_and_they_parse(cube_session):
         names = set(zf.namelist())
         assert ZIP_NAMES <= names
         fold = json.loads(zf.read("design.fold"))
+        annotations = json.loads(zf.read("annotations.json"))
         report = json.loads(zf.read("report.json"))
         obj = zf.read("folded.obj").decode()
         svg = zf.read("pattern.svg").decode()
         dxf = zf.read("pattern.dxf").decode()
     assert "timings" not in report
     assert fold["file_spec"] == 1.2 and len(fold["vertices_coords"]) > 0
+    assert annotations["design"]["vertices"] == len(fold["vertices_coords"])
+    assert len(annotations["tabs"]) > 0  # the download has its glue tabs
     assert report["status_counts"]["ok"] == 8 and report["source"] == "cube"
     assert "\nv " in obj and "\nf " in obj
     assert svg.lstrip().startswith("<") and "<svg" in svg

@@ -431,8 +431,9 @@ class AppSession:
         return files
 
     def export_zip(self) -> bytes:
-        """A zip of ``design.fold``, ``report.json``, ``folded.obj``, ``pattern.svg`` and
-        ``pattern.dxf`` (and ``assembly.txt`` with glue tabs), built in memory.
+        """A zip of ``design.fold``, ``annotations.json``, ``report.json``, ``folded.obj``,
+        ``pattern.svg`` and ``pattern.dxf`` (and ``assembly.txt`` with glue tabs), built in
+        memory.
 
         Every entry is dated :data:`ZIP_DATE` (not the time of the export), so the same
         design gives the same bytes."""
