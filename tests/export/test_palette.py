@@ -46,6 +46,15 @@ def test_pdf_draws_with_the_palette_and_svg_with_its_preset(cube):
     assert f'fill="{preset.label.color}"' in svg
 
 
+def test_pictures_and_rhino_draw_the_default_presets_colours():
+    """PDF, PNG and 3dm use the palette; the SVG and DXF the default preset: one colour per
+    role in all of them (a tab hinge green in one and magenta in another misleads)."""
+    preset = get_preset()
+    assert TAB_HINGE_COLOR == preset.tab.color
+    for a, role in (("M", "mountain"), ("V", "valley"), ("B", "cut")):
+        assert ASSIGNMENT_COLOR[a] == getattr(preset, role).color
+
+
 def test_dxf_classes_are_sorted(cube):
     """ezdxf takes the classes from a set (ordered by the hash seed); the DXF sorts them."""
     text = pattern_dxf(cube.pattern, units="mm")

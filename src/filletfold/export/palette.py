@@ -12,8 +12,9 @@ __all__ = ["ASSIGNMENT_COLOR", "LABEL_COLOR", "PATCH_COLOR", "SHEET_COLOR", "TAB
 
 #: Stroke colour of each edge assignment.
 ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
-#: Tab hinges (the fold between a glue tab and its piece), drawn dashed.
-TAB_HINGE_COLOR = "#00a000"
+#: Tab hinges (the fold between a glue tab and its piece), drawn dashed: magenta, the
+#: default preset's (Origami Simulator's hinge), as in the default SVG and DXF.
+TAB_HINGE_COLOR = "#ff00ff"
 #: Outlines of the sheets of material.
 SHEET_COLOR = "#999999"
 #: Labels (part numbers, seam labels).
