@@ -658,7 +658,7 @@ def fold_json(doc: Mapping, *, root: str = "") -> str:
 
     Keys keep the document's order (:func:`fold_document` builds them in a fixed order); floats
     are rounded to 12 significant digits (``-0`` written as ``0.0``; :func:`fold_document` has
-    rounded its facets' fold angles and annotations further); numpy arrays and scalars
+    rounded its facets' fold angles further); numpy arrays and scalars
     become JSON arrays and numbers. Each top-level key (and each key of a frame) is on its own
     line, arrays are compact. Output is ASCII and ends with a newline.
 
