@@ -141,7 +141,8 @@ def _between(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> bool:
 
 
 def _components(n_faces: int, pairs: np.ndarray) -> np.ndarray:
-    """(n_faces,) component label of each face, faces joined by the (k, 2) ``pairs``."""
+    """(n_faces,) component label of each face (or point), joined by the (k, 2) ``pairs``:
+    the least index in its component."""
     parent = np.arange(n_faces)
 
     def find(x: int) -> int:
@@ -259,18 +260,7 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
     edge_faces = _edge_faces_of(pattern, faces)
     n = len(pattern.vertices_2d)
     v2 = pattern.vertices_2d
-    parent = np.arange(n)
-
-    def find(x: int) -> int:
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    def union(group) -> None:
-        roots = sorted({find(int(v)) for v in group})
-        parent[roots[1:]] = roots[0]
-
+    merged = [np.zeros((0, 2), dtype=np.int64)]  # pairs of points that become one
     bound = math.tan(math.radians(min_angle))
     flat_sides = [
         np.linalg.norm(v2[f] - v2[np.roll(f, -1)], axis=1)
@@ -286,11 +276,10 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
             order = np.argsort(along, kind="stable")
             cut = np.nonzero(np.diff(along[order]) > 0.1 * length)[0] + 1
             for line in np.split(verts[order], cut):
-                union(line)
+                merged.append(np.c_[line[:-1], line[1:]])
         elif length < scale * bound:
-            for pair in rulings:
-                union(pair)
-    rep = np.array([find(i) for i in range(n)])
+            merged.append(np.asarray(rulings, dtype=np.int64).reshape(-1, 2))
+    rep = _components(n, np.concatenate(merged))  # each point's group, named by its least
     if (rep == np.arange(n)).all():
         return pattern
     count = np.bincount(rep, minlength=n)
