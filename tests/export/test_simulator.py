@@ -188,3 +188,31 @@ def test_simulator_file_is_reproducible_and_documented():
 def test_simulator_rejects_bad_settings(kw, name):
     with pytest.raises(ParameterError, match=name):
         simulator_pattern(_design("cube").pattern, **kw)
+
+
+def test_a_fillet_of_one_triangle_has_its_rulings_at_its_tapered_corner():
+    """A conical fillet sampled as one triangle (the blob's sharp vertices have them) has no
+    inner side to find its rulings' meeting point by: they are its two sides at the corner
+    opposite its shortest side. (Least squares over all three sides found no ruling, and the
+    simulator file failed with an IndexError.)"""
+    from filletfold.export.simulator import _edge_faces_of, _ruled_strips, _split_faces
+
+    pattern = design_of("blob").pattern
+    faces = _split_faces(pattern)
+    strips = list(_ruled_strips(pattern, faces, _edge_faces_of(pattern, faces)))
+    single = [
+        s
+        for s in strips
+        if len(s[0]) == 1
+        and len(faces[s[0][0]]) == 3
+        and pattern.face_patch[s[0][0]].startswith("fillet")
+    ]
+    assert single
+    v2 = pattern.vertices_2d
+    for _, verts, _, rulings, is_inner, _, _, _ in single:
+        assert len(verts) == 3 and len(rulings) == 2 and not is_inner.any()
+        corner = np.intersect1d(rulings[0], rulings[1])
+        assert len(corner) == 1
+        far = np.setdiff1d(verts, corner)
+        sides = [np.linalg.norm(v2[r[0]] - v2[r[1]]) for r in rulings]
+        assert np.linalg.norm(v2[far[0]] - v2[far[1]]) <= min(sides)

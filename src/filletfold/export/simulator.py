@@ -203,18 +203,26 @@ def _ruled_strips(pattern: CreasePattern, faces: list[np.ndarray], edge_faces: n
         normal = np.c_[-unit[:, 1], unit[:, 0]]
         verts = np.unique(sides)
         centre = None
-        if kind[members[0]] == "fillet" and pool.sum() >= 2:
+        if kind[members[0]] == "fillet" and side_inner.sum() >= 2:
             # the point the rulings meet: least squares over the inner sides' lines
             n_p = normal[pool]
             m = n_p.T @ n_p
             if np.linalg.cond(m) < 1e8:
                 centre = np.linalg.solve(m, n_p.T @ np.einsum("ij,ij->i", n_p, a[pool]))
+        elif kind[members[0]] == "fillet" and len(members) == 1 and len(verts) == 3:
+            # a fillet of one triangle: its two rulings meet at the corner opposite its
+            # shortest side (the fillet tapers to that corner)
+            short = sides[int(np.argmin(length))]
+            centre = v2[int(np.setdiff1d(verts, short)[0])]
         if centre is not None:
             mid = (a + b) / 2
             reach = np.linalg.norm(mid - centre, axis=1)
             off = np.abs(np.einsum("ij,ij->i", normal, centre - a)) < 1e-3 * np.maximum(
                 reach, 1e-300
             )
+            if not off.any():  # no side runs through it: taken as a strip of parallel rulings
+                centre = None
+        if centre is not None:
             heading = np.arctan2(*(mid - centre).T[::-1])
             ref = heading[off][0]
             turn = np.mod(heading - ref + np.pi, 2 * np.pi) - np.pi
@@ -653,9 +661,9 @@ def simulator_pattern(
     out_faces, out_patch, out_piece = [], [], []
     for root in np.unique(label).tolist():
         group = np.nonzero(label == root)[0]
-        loop = _outline([faces[f] for f in group.tolist()])
-        loop = [v for v in loop if not gone[v]]
         f0 = int(group[0])
+        loop = _outline([faces[f] for f in group.tolist()], pattern.face_patch[f0])
+        loop = [v for v in loop if not gone[v]]
         for tri in _triangulate(loop, v2):
             out_faces.append(tri)
             out_patch.append(pattern.face_patch[f0])
@@ -677,7 +685,7 @@ def simulator_pattern(
     return _clean_slivers(coarse, min_angle)
 
 
-def _outline(faces: list[np.ndarray]) -> list[int]:
+def _outline(faces: list[np.ndarray], patch: str = "") -> list[int]:
     """The boundary loop of a disc made of counter-clockwise faces, counter-clockwise."""
     half = {}
     for f in faces:
@@ -686,7 +694,9 @@ def _outline(faces: list[np.ndarray]) -> list[int]:
             half[(a, b)] = True
     nxt = {a: b for (a, b) in half if (b, a) not in half}
     if not nxt:
-        raise ParameterError("a patch of the pattern has no outline", name="pattern")
+        raise ParameterError(
+            f"simulator.fold: {patch or 'a patch'} of the pattern has no outline", name="pattern"
+        )
     first = min(nxt)
     loop = [first]
     while True:
@@ -695,4 +705,6 @@ def _outline(faces: list[np.ndarray]) -> list[int]:
             return loop
         loop.append(v)
         if len(loop) > len(nxt):
-            raise ParameterError("a patch of the pattern is not a disc", name="pattern")
+            raise ParameterError(
+                f"simulator.fold: {patch or 'a patch'} of the pattern is not a disc", name="pattern"
+            )
