@@ -16,11 +16,17 @@ from scipy.spatial import cKDTree
 import filletfold
 from filletfold.errors import ParameterError
 from filletfold.export import cut_files
-from filletfold.export.simulator import SIM_MIN_ANGLE, simulator_pattern, triangle_min_angles
+from filletfold.export.simulator import (
+    SIM_MAX_STRETCH,
+    SIM_MIN_ANGLE,
+    simulator_pattern,
+    triangle_min_angles,
+)
 
 from ..conftest import design_of
 
 CORPUS = Path(__file__).parent.parent / "data" / "corpus"
+BUNNY = Path(__file__).parent.parent.parent / "examples" / "bunny-lowres.obj"
 #: Origami Simulator's shader reads at most 100 beams (and creases) per vertex.
 MAX_VALENCE = 30
 
@@ -33,10 +39,23 @@ def _design(name: str) -> filletfold.Design:
         return filletfold.round_mesh("miura", material_loss=True)
     if name == "compas-boxes":
         return filletfold.round_mesh(str(CORPUS / "compas-boxes.obj"))
+    if name == "blob default":
+        return filletfold.round_mesh("blob")
+    if name == "bunny-lowres":
+        return filletfold.round_mesh(str(BUNNY))
+    if name == "pyvista-nut":
+        return filletfold.round_mesh(str(CORPUS / "pyvista-nut.ply"))
     return design_of(name)
 
 
 DESIGNS = ["cube", "icosahedron net", "miura material-loss", "compas-boxes"]
+#: Real meshes at the default command's sampling, with what the four above lack: sharp
+#: vertices (conical fillets tapering into them), cones that meet face pieces and the
+#: border where a cylinder was collapsed or an edge left sharp, skinny face pieces. Until
+#: the simulator copy checked every merge, bunny-lowres stopped with "fillet 251 of the
+#: pattern has no outline" and pyvista-nut with "pattern face 624 is clockwise".
+CORPUS_DESIGNS = ["blob default", "bunny-lowres", "pyvista-nut"]
+ALL_DESIGNS = DESIGNS + CORPUS_DESIGNS
 
 
 @functools.cache
@@ -84,7 +103,20 @@ def test_simulator_triangles_have_no_slivers(name):
     assert triangle_min_angles(v3, faces).min() > 0.1  # no folded triangle is degenerate
 
 
-@pytest.mark.parametrize("name", DESIGNS)
+@pytest.mark.parametrize("name", CORPUS_DESIGNS)
+def test_simulator_triangles_of_real_meshes_are_few_slivers(name):
+    """A real mesh's narrow face pieces (a skinny triangle of the bunny, a face nearly
+    covered by its fillets) leave a few triangles under ``SIM_MIN_ANGLE`` that no move of
+    points along the creases removes; none is degenerate (before, the sharp vertices' fans
+    and the borders of collapsed cylinders left 391 on the blob, down to 0.78 degrees)."""
+    v2, v3, _, faces = _arrays(_file(name))
+    assert faces.shape[1] == 3
+    smallest = np.minimum(triangle_min_angles(v2, faces), triangle_min_angles(v3, faces))
+    assert smallest.min() >= 0.25
+    assert np.mean(smallest < SIM_MIN_ANGLE) <= 0.01
+
+
+@pytest.mark.parametrize("name", ALL_DESIGNS)
 def test_simulator_valence_is_bounded(name):
     v2, _, edges, _ = _arrays(_file(name))
     valence = np.bincount(edges.ravel(), minlength=len(v2))
@@ -93,7 +125,7 @@ def test_simulator_valence_is_bounded(name):
     assert len(v2) < len(fine.vertices_2d) / 2  # coarser than design.fold
 
 
-@pytest.mark.parametrize("name", DESIGNS)
+@pytest.mark.parametrize("name", ALL_DESIGNS)
 def test_simulator_fold_angles_are_the_folded_dihedrals(name):
     doc = _file(name)
     _, v3, edges, faces = _arrays(doc)
@@ -111,7 +143,7 @@ def test_simulator_fold_angles_are_the_folded_dihedrals(name):
     assert (np.abs(written[a == "F"]) > 1.0).any()
 
 
-@pytest.mark.parametrize("name", DESIGNS)
+@pytest.mark.parametrize("name", ALL_DESIGNS)
 def test_simulator_sheet_folds_without_stretch(name):
     """Flat and folded edge lengths agree: a coarse cell's chord across a dropped stretch of
     arc is shorter folded than flat by about turn**2 / 24 of its width only."""
@@ -119,11 +151,14 @@ def test_simulator_sheet_folds_without_stretch(name):
     l2 = np.linalg.norm(v2[edges[:, 0]] - v2[edges[:, 1]], axis=1)
     l3 = np.linalg.norm(v3[edges[:, 0]] - v3[edges[:, 1]], axis=1)
     size = np.linalg.norm(np.ptp(v3, axis=0))
-    assert np.abs(l2 - l3).max() <= 2e-3 * size
+    if name in DESIGNS:
+        assert np.abs(l2 - l3).max() <= 2e-3 * size
+    # the written coordinates are rounded: allow their last digit
+    assert (np.abs(l2 - l3) <= SIM_MAX_STRETCH * l2 + 1e-9 * size).all()
     assert np.median(np.abs(l2 - l3) / l2) < 1e-3
 
 
-@pytest.mark.parametrize("name", DESIGNS)
+@pytest.mark.parametrize("name", ALL_DESIGNS)
 def test_simulator_keeps_the_pieces_and_their_topology(name):
     doc = _file(name)
     v2, v3, edges, faces = _arrays(doc)
@@ -154,11 +189,13 @@ def test_simulator_keeps_the_pieces_and_their_topology(name):
     area = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
     assert (area > 0).all()
     # every point is a point of design.fold, or a merge of points closer than 1 % of the size
+    # (the blob at the default sampling has many fillets too narrow for a triangle: 36 % of
+    # its points are such merges, none moved by more than 0.14 % of the size)
     size = np.linalg.norm(np.ptp(fine.vertices_3d, axis=0))
     for mine, theirs in ((v2, fine.vertices_2d), (v3, fine.vertices_3d)):
         gap, _ = cKDTree(theirs).query(mine)
         assert gap.max() <= 1e-2 * size
-        assert np.mean(gap <= 1e-9 * size) >= 0.75
+        assert np.mean(gap <= 1e-9 * size) >= (0.75 if name in DESIGNS else 0.6)
 
 
 def test_simulator_cube_keeps_exact_points():
@@ -216,3 +253,50 @@ def test_a_fillet_of_one_triangle_has_its_rulings_at_its_tapered_corner():
         far = np.setdiff1d(verts, corner)
         sides = [np.linalg.norm(v2[r[0]] - v2[r[1]]) for r in rulings]
         assert np.linalg.norm(v2[far[0]] - v2[far[1]]) <= min(sides)
+
+
+def test_outline_is_none_unless_the_faces_make_a_disc():
+    from filletfold.export.simulator import _outline
+
+    square = [np.array([0, 1, 2]), np.array([0, 2, 3])]
+    assert _outline(square) == [0, 1, 2, 3]
+    # a triangle and the same triangle turned over (what a collapse left on bunny-lowres)
+    assert _outline([np.array([0, 1, 2]), np.array([0, 2, 1])]) is None
+    # two triangles touching at a point: the loop passes it twice
+    assert _outline([np.array([0, 1, 2]), np.array([0, 3, 4])]) is None
+    # an annulus of four quads around a hole: two loops
+    ring = [np.array([i, (i + 1) % 4, 4 + (i + 1) % 4, 4 + i]) for i in range(4)]
+    assert _outline(ring) is None
+
+
+def test_triangles_refuse_what_would_be_broken():
+    from filletfold.export.simulator import _triangles, _triangulate
+
+    v2 = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    v3 = np.c_[v2, np.zeros(4)]
+    assert len(_triangles([0, 1, 2, 3], v2, v3, SIM_MAX_STRETCH)) == 2
+    assert _triangulate([0, 2, 1, 3], v2) is None  # a bow tie is not simple
+    assert _triangles([0, 3, 2, 1], v2, v3) is None  # clockwise
+    folded = v3.copy()
+    folded[2, 2] = 0.5  # folded, a side grows by 12 %
+    assert _triangles([0, 1, 2, 3], v2, folded) is not None
+    assert _triangles([0, 1, 2, 3], v2, folded, SIM_MAX_STRETCH) is None
+    flat = v3.copy()
+    flat[2] = (flat[0] + flat[1]) / 2  # folded onto the line of two others: degenerate
+    assert _triangles([0, 1, 2], v2, flat) is None
+    assert _triangles([0, 1, 2], v2, v3) == [[0, 1, 2]]
+
+
+def test_collapsed_strips_turn_no_face_over():
+    """Collapsing every narrow strip of bunny-lowres at once turned faces over (two faces
+    became one triangle, once each way round); the strips that would do it stay."""
+    from filletfold.export.simulator import _collapse_narrow, _split_faces
+
+    pattern = _design("bunny-lowres").pattern
+    collapsed = _collapse_narrow(pattern, SIM_MIN_ANGLE)
+    assert len(collapsed.faces) < len(pattern.faces)  # strips were collapsed
+    v2 = collapsed.vertices_2d
+    for f in _split_faces(collapsed):
+        assert len(set(f.tolist())) == len(f)
+        x, y = v2[f, 0], v2[f, 1]
+        assert (x * np.roll(y, -1) - np.roll(x, -1) * y).sum() > 0

@@ -14,7 +14,17 @@ positions): it drops whole rulings of the cylinders, so each coarse cylinder cel
 smallest angle largest. Cylinders and cones are ruled, and the strip between two rulings is
 planar, so the coarse faces are still planar; their flat edges across a dropped stretch are
 chords of the developed arc while the folded ones are chords of the 3D arc, shorter by about
-``turn**2 / 24`` of the cell width (2.6 % for 45 degrees).
+``turn**2 / 24`` of the cell width (2.6 % for 45 degrees). Along the creases and borders of
+the cones where no cylinder runs beside them (a collapsed cylinder, an edge left sharp), the
+points are thinned the same way.
+
+Every step is checked where it is made, and what would break is not done: a collapsed strip
+that would turn a face over, make it degenerate or leave it visiting a point twice stays; a
+merged group of faces that is not a disc, or whose triangles would turn over, be degenerate
+(flat or folded) or stretch a side by more than ``SIM_MAX_STRETCH`` of it or
+``SIM_MAX_SHIFT`` of its piece, keeps its points; a sliver move is taken only under the same
+conditions. So a real mesh's pattern (sharp vertices, skinny faces) gives a valid file: only
+where its own faces are too narrow for it are a few triangles left under ``min_angle``.
 """
 
 from __future__ import annotations
@@ -38,6 +48,19 @@ __all__ = [
 SIM_MAX_TURN = 45.0
 #: Smallest corner angle (degrees) a coarse cylinder cell is made wide enough for.
 SIM_MIN_ANGLE = 5.0
+#: Largest relative change of length, flat to folded, of a side the coarse copy makes (a
+#: chord across dropped points): a chord of an arc turning 1.5 ``SIM_MAX_TURN`` is 5.7 %
+#: shorter than the arc, one turning ``SIM_MAX_TURN`` 2.6 %.
+SIM_MAX_STRETCH = 0.05
+#: Largest change of length, flat to folded, of a side the coarse copy makes, as a share of
+#: the flat diameter of its piece: a long chord may not take the whole ``SIM_MAX_STRETCH``
+#: (a cube's 45-degree cylinder cells change by 0.2 % of their module).
+SIM_MAX_SHIFT = 0.005
+#: Most rounds of sliver moves (see ``_clean_slivers``); the corpus's meshes stop after 5.
+SIM_CLEAN_ROUNDS = 40
+#: A triangle with a corner under this angle (degrees), flat or folded, is degenerate: its
+#: folded normal, and the fold angles beside it, are round-off.
+SIM_DEGENERATE = 1e-3
 
 
 def triangle_min_angles(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -49,31 +72,27 @@ def triangle_min_angles(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
     faces : (n_faces, 3) int
     """
     p = np.asarray(points, dtype=np.float64)[np.asarray(faces, dtype=np.int64)]
-    out = np.full(len(p), 180.0)
-    for i in range(3):
-        u = p[:, (i + 1) % 3] - p[:, i]
-        w = p[:, (i + 2) % 3] - p[:, i]
-        if p.shape[2] == 2:
-            cross = np.abs(u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0])
-        else:
-            cross = np.linalg.norm(np.cross(u, w), axis=1)
-        out = np.minimum(out, np.degrees(np.arctan2(cross, np.einsum("ij,ij->i", u, w))))
-    return out
+    u = p[:, [1, 2, 0]] - p  # at each corner, to the next corner and to the one before
+    w = p[:, [2, 0, 1]] - p
+    if p.shape[2] == 2:
+        cross = np.abs(u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0])
+    else:
+        c = u[..., [1, 2, 0]] * w[..., [2, 0, 1]] - u[..., [2, 0, 1]] * w[..., [1, 2, 0]]
+        cross = np.sqrt((c * c).sum(axis=2))
+    corner = np.arctan2(cross, (u * w).sum(axis=2))
+    return np.degrees(corner.min(axis=1)) if len(p) else np.zeros(0)
 
 
-def _triangulate(loop: list[int], p: np.ndarray) -> list[list[int]]:
+def _triangulate(loop: list[int], p: np.ndarray) -> list[list[int]] | None:
     """Counter-clockwise triangles of a simple counter-clockwise flat polygon whose smallest
-    angle is the largest of all its triangulations (dynamic programming over diagonals)."""
+    angle is the largest of all its triangulations (dynamic programming over diagonals; of
+    equal ones, the split at the earliest corner); None when there is none (the polygon is
+    not simple, or not counter-clockwise)."""
     k = len(loop)
     if k == 3:
         return [list(loop)]
     q = p[np.asarray(loop)]
-    ok = np.zeros((k, k), dtype=bool)
-    for i in range(k):
-        ok[i, (i + 1) % k] = ok[(i + 1) % k, i] = True
-        for j in range(i + 2, k):
-            if not (i == 0 and j == k - 1):
-                ok[i, j] = ok[j, i] = _is_diagonal(q, i, j)
+    ok = _diagonals(q)
     best = np.full((k, k), -math.inf)
     split = -np.ones((k, k), dtype=np.int64)
     for i in range(k - 1):
@@ -83,15 +102,17 @@ def _triangulate(loop: list[int], p: np.ndarray) -> list[list[int]]:
             j = i + gap
             if not ok[i, j]:
                 continue
-            for m in range(i + 1, j):
-                if not (ok[i, m] and ok[m, j]):
-                    continue
-                angle = float(triangle_min_angles(q[[i, m, j]], np.array([[0, 1, 2]]))[0])
-                value = min(best[i, m], best[m, j], angle)
-                if value > best[i, j]:
-                    best[i, j], split[i, j] = value, m
-    if split[0, k - 1] < 0:  # no triangulation found (a degenerate outline): a fan
-        return [[loop[0], loop[i], loop[i + 1]] for i in range(1, k - 1)]
+            m = np.arange(i + 1, j)
+            m = m[ok[i, m] & ok[m, j]]
+            if not len(m):
+                continue
+            angle = triangle_min_angles(q, np.c_[np.full(len(m), i), m, np.full(len(m), j)])
+            value = np.minimum(np.minimum(best[i, m], best[m, j]), angle)
+            at = int(np.argmax(value))
+            if value[at] > -math.inf:
+                best[i, j], split[i, j] = value[at], m[at]
+    if split[0, k - 1] < 0:  # no triangulation (the outline is not simple)
+        return None
     tris, stack = [], [(0, k - 1)]
     while stack:
         i, j = stack.pop()
@@ -103,41 +124,46 @@ def _triangulate(loop: list[int], p: np.ndarray) -> list[list[int]]:
     return tris
 
 
-def _is_diagonal(q: np.ndarray, i: int, j: int) -> bool:
-    """Whether the segment between corners ``i`` and ``j`` of the counter-clockwise polygon
-    ``q`` lies inside it (crossing no side, its midpoint inside)."""
-    a, b = q[i], q[j]
+def _diagonals(q: np.ndarray) -> np.ndarray:
+    """(k, k) bool: which pairs of corners of the counter-clockwise polygon ``q`` (k, 2) the
+    triangulation may join: its sides, and the segments inside it (crossing no side, touching
+    none between its ends, their midpoint inside)."""
     k = len(q)
+    ok = np.zeros((k, k), dtype=bool)
+    side = np.arange(k)
+    ok[side, (side + 1) % k] = ok[(side + 1) % k, side] = True
+    i, j = np.triu_indices(k, 2)
+    keep = ~((i == 0) & (j == k - 1))
+    i, j = i[keep], j[keep]
+    if not len(i):
+        return ok
     scale = float(np.abs(q).max()) or 1.0
     eps = 1e-12 * scale * scale
-    for s in range(k):
-        t = (s + 1) % k
-        if len({i, j, s, t}) < 4:
-            continue
-        c, d = q[s], q[t]
-        d1, d2 = _cross(a, b, c), _cross(a, b, d)
-        d3, d4 = _cross(c, d, a), _cross(c, d, b)
-        if (d1 > eps) != (d2 > eps) and (d3 > eps) != (d4 > eps):
-            return False
-        if abs(d1) <= eps and _between(a, b, c):
-            return False
-    mid = (a + b) / 2
-    x, y = q[:, 0], q[:, 1]
-    xn, yn = np.roll(x, -1), np.roll(y, -1)
-    crossing = (y > mid[1]) != (yn > mid[1])
-    xs = x + (mid[1] - y) * (xn - x) / np.where(yn == y, 1.0, yn - y)
-    return bool(np.count_nonzero(crossing & (xs > mid[0])) % 2)
+    a, b = q[i][:, None, :], q[j][:, None, :]  # (P, 1, 2)
+    c, d = q[None, :, :], np.roll(q, -1, axis=0)[None, :, :]  # (1, k, 2)
 
+    def cross(o, u, w):
+        return (u[..., 0] - o[..., 0]) * (w[..., 1] - o[..., 1]) - (u[..., 1] - o[..., 1]) * (
+            w[..., 0] - o[..., 0]
+        )
 
-def _cross(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
-    """The z component of ``(b - a) x (c - a)``."""
-    return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
-
-
-def _between(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> bool:
-    """Whether ``c`` (on the line ``a b``) lies strictly between ``a`` and ``b``."""
-    t = float((c - a) @ (b - a)) / max(float((b - a) @ (b - a)), 1e-300)
-    return 0 < t < 1
+    d1, d2, d3, d4 = cross(a, b, c), cross(a, b, d), cross(c, d, a), cross(c, d, b)
+    ab = b - a
+    t = ((c - a) * ab).sum(axis=2) / np.maximum((ab * ab).sum(axis=2), 1e-300)
+    near = ((d1 > eps) != (d2 > eps)) & ((d3 > eps) != (d4 > eps))
+    near |= (np.abs(d1) <= eps) & (t > 0) & (t < 1)
+    s, e = side[None, :], (side[None, :] + 1) % k
+    apart = (s != i[:, None]) & (s != j[:, None]) & (e != i[:, None]) & (e != j[:, None])
+    inside = ~(near & apart).any(axis=1)
+    # the midpoint inside: an odd number of sides cross the ray to its right
+    mid = (q[i] + q[j]) / 2
+    x, y = q[:, 0][None, :], q[:, 1][None, :]
+    xn, yn = np.roll(q[:, 0], -1)[None, :], np.roll(q[:, 1], -1)[None, :]
+    crossing = (y > mid[:, 1:2]) != (yn > mid[:, 1:2])
+    xs = x + (mid[:, 1:2] - y) * (xn - x) / np.where(yn == y, 1.0, yn - y)
+    inside &= np.count_nonzero(crossing & (xs > mid[:, 0:1]), axis=1) % 2 == 1
+    ok[i, j] = ok[j, i] = inside
+    return ok
 
 
 def _components(n_faces: int, pairs: np.ndarray) -> np.ndarray:
@@ -263,12 +289,17 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
     ``tan(min_angle)`` times the median side of the face polygons becomes a single curve (the
     two ends of each ruling merged). Merged points move to their mean (flat and folded); the
     strip's faces, and the faces left degenerate, are removed.
+
+    A strip is left as it is where collapsing it would turn a face over, make it degenerate
+    (flat or folded) or stretch a side beyond ``SIM_MAX_STRETCH`` or ``SIM_MAX_SHIFT`` when
+    folded, or leave a face that visits a point twice: such strips are found face by face and
+    the rest are collapsed again without them, until no face is broken.
     """
     faces = _split_faces(pattern)
     edge_faces = _edge_faces_of(pattern, faces)
     n = len(pattern.vertices_2d)
     v2 = pattern.vertices_2d
-    merged = [np.zeros((0, 2), dtype=np.int64)]  # pairs of points that become one
+    proposals = []  # per strip: the pairs of points that become one
     bound = math.tan(math.radians(min_angle))
     flat_sides = [
         np.linalg.norm(v2[f] - v2[np.roll(f, -1)], axis=1)
@@ -283,29 +314,27 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
             # cells) becomes one point
             order = np.argsort(along, kind="stable")
             cut = np.nonzero(np.diff(along[order]) > 0.1 * length)[0] + 1
-            for line in np.split(verts[order], cut):
-                merged.append(np.c_[line[:-1], line[1:]])
+            lines = np.split(verts[order], cut)
+            proposals.append(np.concatenate([np.c_[line[:-1], line[1:]] for line in lines]))
         elif length < scale * bound:
-            merged.append(np.asarray(rulings, dtype=np.int64).reshape(-1, 2))
-    rep = _components(n, np.concatenate(merged))  # each point's group, named by its least
-    if (rep == np.arange(n)).all():
+            proposals.append(np.asarray(rulings, dtype=np.int64).reshape(-1, 2))
+    active = np.ones(len(proposals), dtype=bool)
+    verdicts: dict[tuple, bool] = {}  # a merged polygon's place -> broken
+    while True:
+        pairs = [p for p, on in zip(proposals, active, strict=True) if on]
+        rep = _components(n, np.concatenate([np.zeros((0, 2), dtype=np.int64), *pairs]))
+        merged = _merged_faces(pattern, faces, rep, verdicts)
+        if merged[-1] is None:
+            break
+        # the strips that merged a point of a broken face go back
+        broken = np.unique(rep[merged[-1]])
+        hit = np.array([np.isin(rep[p], broken).any() for p in proposals]) & active
+        if not hit.any():  # cannot happen: a broken face has a merged point
+            break
+        active &= ~hit
+    v2, v3, out_faces, out_patch, out_piece, _ = merged
+    if len(out_faces) == len(faces) and (rep == np.arange(n)).all():
         return pattern
-    count = np.bincount(rep, minlength=n)
-    v2 = np.zeros((n, 2))
-    v3 = np.zeros((n, 3))
-    np.add.at(v2, rep, pattern.vertices_2d)
-    np.add.at(v3, rep, pattern.vertices_3d)
-    used = count > 0
-    v2[used] /= count[used, None]
-    v3[used] /= count[used, None]
-    out_faces, out_patch, out_piece = [], [], []
-    for f, face in enumerate(faces):
-        loop = rep[face].tolist()
-        loop = [v for i, v in enumerate(loop) if v != loop[i - 1]]  # cyclic duplicates
-        if len(set(loop)) >= 3 and len(set(loop)) == len(loop):
-            out_faces.append(loop)
-            out_patch.append(pattern.face_patch[f])
-            out_piece.append(int(pattern.face_piece[f]))
     keep = np.unique(np.concatenate([np.asarray(f) for f in out_faces]))
     new_index = -np.ones(n, dtype=np.int64)
     new_index[keep] = np.arange(len(keep))
@@ -318,6 +347,118 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
         pattern.piece_vertex,
         annotations=pattern.annotations,
     )
+
+
+def _merged_faces(pattern: CreasePattern, faces: list[np.ndarray], rep: np.ndarray, verdicts: dict):
+    """The points of ``pattern`` merged into their groups ``rep`` (n,) (each point moved to
+    its group's mean, flat and folded): (flat positions, folded positions, faces, their
+    patches, their pieces, and the points of the faces that broke, or None when none did).
+
+    A face left with fewer than three distinct points is dropped; one that visits a point
+    twice, or whose triangles (see :func:`_triangles`) are turned over, degenerate flat or
+    folded, or stretched beyond ``SIM_MAX_STRETCH`` or ``SIM_MAX_SHIFT``, is broken.
+    ``verdicts`` keeps the verdict on each polygon of more than three points, by its points
+    and their places, for the next call."""
+    n = len(rep)
+    shift = _shift_bound(pattern)
+    count = np.bincount(rep, minlength=n)
+    v2 = np.zeros((n, 2))
+    v3 = np.zeros((n, 3))
+    np.add.at(v2, rep, pattern.vertices_2d)
+    np.add.at(v3, rep, pattern.vertices_3d)
+    used = count > 0
+    v2[used] /= count[used, None]
+    v3[used] /= count[used, None]
+    moved = count[rep] > 1
+    loops: list[list[int] | None] = []  # per face: its loop, None when it is dropped
+    broken = np.zeros(len(faces), dtype=bool)
+    for f, face in enumerate(faces):
+        loop = rep[face].tolist()
+        if moved[face].any():
+            loop = [v for i, v in enumerate(loop) if v != loop[i - 1]]  # cyclic duplicates
+            if len(set(loop)) < 3:
+                loop = None
+            elif len(set(loop)) < len(loop):
+                broken[f] = True
+            elif len(loop) > 3:
+                key = (tuple(loop), v2[loop].tobytes(), v3[loop].tobytes())
+                if key not in verdicts:
+                    tris = _triangles(loop, v2, v3, SIM_MAX_STRETCH, shift[loop[0]])
+                    verdicts[key] = tris is None
+                broken[f] = verdicts[key]
+        loops.append(loop)
+    # the moved triangles, all at once
+    tri = [f for f, loop in enumerate(loops) if loop is not None and len(loop) == 3]
+    tri = np.array([f for f in tri if moved[faces[f]].any()], dtype=np.int64)
+    if len(tri):
+        corners = np.array([loops[f] for f in tri.tolist()], dtype=np.int64)
+        quality = _triangle_quality(v2[corners], v3[corners], SIM_MAX_STRETCH, shift[corners[:, 0]])
+        broken[tri] = quality < SIM_DEGENERATE
+    keep = [f for f, loop in enumerate(loops) if loop is not None and not broken[f]]
+    out_faces = [loops[f] for f in keep]
+    out_patch = [pattern.face_patch[f] for f in keep]
+    out_piece = [int(pattern.face_piece[f]) for f in keep]
+    bad = [faces[f] for f in np.nonzero(broken)[0].tolist()]
+    return v2, v3, out_faces, out_patch, out_piece, np.concatenate(bad) if bad else None
+
+
+def _triangles(
+    loop: list[int],
+    v2: np.ndarray,
+    v3: np.ndarray,
+    max_stretch: float = math.inf,
+    max_shift: float = math.inf,
+) -> list[list[int]] | None:
+    """The triangles of the flat polygon ``loop`` (see :func:`_triangulate`), or None when it
+    has none, or one of them is turned over or degenerate (a corner under ``SIM_DEGENERATE``
+    degrees, flat or folded), or a side of them changes length when folded by more than
+    ``max_stretch`` of its flat length or more than ``max_shift`` (its sides along ``loop``
+    counted too)."""
+    tris = _triangulate(loop, v2)
+    if tris is None:
+        return None
+    t = np.asarray(tris, dtype=np.int64)
+    if _triangle_quality(v2[t], v3[t], max_stretch, max_shift).min() < SIM_DEGENERATE:
+        return None
+    return tris
+
+
+def _shift_bound(pattern: CreasePattern) -> np.ndarray:
+    """(n,) the most a side at each point may change length, flat to folded:
+    ``SIM_MAX_SHIFT`` times the flat diameter (bounding box diagonal) of the point's piece."""
+    n = len(pattern.vertices_2d)
+    flat, start = face_arrays(pattern.faces)
+    piece = np.zeros(n, dtype=np.int64)
+    piece[flat] = np.repeat(np.asarray(pattern.face_piece, dtype=np.int64), np.diff(start))
+    k = int(piece.max()) + 1 if n else 0
+    lo, hi = np.full((k, 2), np.inf), np.full((k, 2), -np.inf)
+    np.minimum.at(lo, piece[flat], pattern.vertices_2d[flat])
+    np.maximum.at(hi, piece[flat], pattern.vertices_2d[flat])
+    return SIM_MAX_SHIFT * np.linalg.norm(hi - lo, axis=1)[piece]
+
+
+def _triangle_quality(
+    p2: np.ndarray, p3: np.ndarray, max_stretch: float, max_shift: float | np.ndarray = math.inf
+) -> np.ndarray:
+    """(k,) the smallest corner angle (degrees), flat or folded, of the triangles with
+    corners ``p2`` (k, 3, 2) flat and ``p3`` (k, 3, 3) folded; -inf where one turns over in
+    the flat layout (or has no area) or one of its sides changes length, flat to folded, by
+    more than ``max_stretch`` of its flat length or by more than ``max_shift`` (a length, or
+    (k,) one per triangle)."""
+    u, w = p2[:, 1] - p2[:, 0], p2[:, 2] - p2[:, 0]
+    corners = np.arange(3 * len(p2)).reshape(-1, 3)
+    quality = np.minimum(
+        triangle_min_angles(p2.reshape(-1, 2), corners),
+        triangle_min_angles(p3.reshape(-1, 3), corners),
+    )
+    bad = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0] <= 0
+    if max_stretch < math.inf:
+        d2, d3 = p2[:, [1, 2, 0]] - p2, p3[:, [1, 2, 0]] - p3
+        l2, l3 = np.sqrt((d2 * d2).sum(axis=2)), np.sqrt((d3 * d3).sum(axis=2))
+        change = np.abs(l2 - l3)
+        bad |= (change > max_stretch * l2).any(axis=1)
+        bad |= change.max(axis=1) > max_shift
+    return np.where(bad, -math.inf, quality)
 
 
 def _dropped_rulings(
@@ -382,29 +523,36 @@ def _strip_turn(
 def _dropped_crease_points(
     pattern: CreasePattern, faces: list[np.ndarray], min_angle: float
 ) -> np.ndarray:
-    """(n,) bool: points to drop on the creases between two cones (where a collapsed cylinder
-    was): along each such crease, the points nearest to equal steps of about
-    ``tan(3 min_angle)`` times the distance to the nearer apex are kept."""
+    """(n,) bool: points to drop along the creases and borders of the cones where no cylinder
+    or fillet runs beside them (a cone meeting another cone, a face piece, or the border
+    where a cylinder was collapsed or an edge left sharp): along each run of such points, the
+    points nearest to equal steps of about ``tan(3 min_angle)`` times the distance to the
+    nearer apex are kept."""
     n = len(pattern.vertices_2d)
     v2 = pattern.vertices_2d
     gone = np.zeros(n, dtype=bool)
     names = pattern.face_patch
-    cone = np.array([p.startswith("cone ") for p in names] or [False])
+    kind = np.array([p.split(" ")[0] for p in names] or [""])
+    cone = kind == "cone"
     corners = np.concatenate(faces) if faces else np.zeros(0, dtype=np.int64)
     face_of = np.repeat(np.arange(len(faces)), [len(f) for f in faces])
-    only_cones = np.ones(n, dtype=bool)
-    only_cones[corners[~cone[face_of]]] = False
-    patches_at: dict[int, set[str]] = {}
+    on_cone = np.zeros(n, dtype=bool)
+    on_cone[corners[cone[face_of]]] = True
+    on_ruled = np.zeros(n, dtype=bool)
+    on_ruled[corners[np.isin(kind, ["cylinder", "fillet"])[face_of]]] = True
+    cones_at: dict[int, set[str]] = {}
     for v, f in zip(corners.tolist(), face_of.tolist(), strict=True):
-        patches_at.setdefault(v, set()).add(names[f])
-    candidate = np.array([only_cones[v] and len(patches_at.get(v, ())) >= 2 for v in range(n)])
+        if cone[f]:
+            cones_at.setdefault(v, set()).add(names[f])
+    feature = np.isin(pattern.edge_assignment, ["M", "V", "B"])
+    pairs = pattern.edges[feature]
+    fdeg = np.bincount(pairs.ravel(), minlength=n)
+    candidate = on_cone & ~on_ruled & (fdeg == 2)
     # the apex of each cone patch: the corner its faces share most
     apex: dict[str, int] = {}
     for name in {names[f] for f in np.nonzero(cone)[0].tolist()}:
         members = [faces[f] for f in range(len(faces)) if names[f] == name]
         apex[name] = int(np.bincount(np.concatenate(members)).argmax())
-    crease = np.isin(pattern.edge_assignment, ["M", "V"])
-    pairs = pattern.edges[crease]
     link = pairs[candidate[pairs].any(axis=1)]
     neighbours: dict[int, list[int]] = {}
     for a, b in link.tolist():
@@ -415,26 +563,17 @@ def _dropped_crease_points(
     for start_v in np.nonzero(candidate)[0].tolist():
         if seen[start_v]:
             continue
-        # walk to one end of the run, then along it
-        run, prev, v = [], -1, start_v
-        while True:  # to an end: a non-candidate or a point seen again (a closed loop)
-            nxt = [w for w in neighbours.get(v, []) if w != prev]
-            if not candidate[v] or not nxt or (run and v == start_v):
-                break
-            run.append(v)
-            prev, v = v, nxt[0]
-            if len(run) > n:
-                break
-        end = v
-        path, prev, v = [end], -1, end
-        while True:
-            nxt = [w for w in neighbours.get(v, []) if w != prev and w not in path[-2:]]
-            if not nxt:
-                break
-            prev, v = v, nxt[0]
-            path.append(v)
-            if not candidate[v] or v == end or len(path) > n:
-                break
+        # the run through start_v: walk along its two feature edges to the ends of the run
+        # (points that are not candidates), or around it back to start_v (a closed run)
+        sides = []
+        for first in neighbours[start_v][:2]:
+            path, prev, v = [start_v], start_v, first
+            while candidate[v] and v != start_v and len(path) <= n:
+                path.append(v)
+                prev, v = v, next(w for w in neighbours[v] if w != prev)
+            sides.append([*path, v])
+        closed = sides[0][-1] == start_v
+        path = sides[0] if closed or len(sides) < 2 else sides[1][::-1] + sides[0][1:]
         inner = [w for w in path if candidate[w]]
         seen[inner] = True
         if len(inner) < 2:
@@ -445,7 +584,7 @@ def _dropped_crease_points(
         total = float(at[-1])
         radius = min(
             float(np.linalg.norm(v2[inner[len(inner) // 2]] - v2[apex[name]]))
-            for name in patches_at[inner[len(inner) // 2]]
+            for name in cones_at[inner[len(inner) // 2]]
         )
         cells = max(1, math.ceil(total / max(radius * tan, 1e-300)))
         keep = {int(np.argmin(np.abs(at - k * total / cells))) for k in range(1, cells)}
@@ -455,19 +594,26 @@ def _dropped_crease_points(
     return gone
 
 
-def _clean_slivers(pattern: CreasePattern, min_angle: float, rounds: int = 8) -> CreasePattern:
-    """``pattern`` (triangles) with its triangles under ``min_angle`` improved where a local
-    move does it: a short side collapsed (its end that is not on a crease or border, or on
-    one through the side, moved onto the other end: every point keeps its exact flat and
-    folded position) or, inside a smooth patch, the longest side flipped. A move is taken
-    when the smallest angle of the triangles it changes grows and none turns over."""
+def _clean_slivers(
+    pattern: CreasePattern, min_angle: float, rounds: int = SIM_CLEAN_ROUNDS
+) -> CreasePattern:
+    """``pattern`` (triangles) with its triangles under ``min_angle`` (flat or folded)
+    improved where a local move does it: a short side collapsed (its end that is not on a
+    crease or border, or any end along a crease or border through the side, moved onto the
+    other end: every point keeps its exact flat and folded position) or, inside a smooth
+    patch, the longest side flipped. A move is taken when the smallest angle of the triangles
+    it changes grows, none turns over and no side of them changes length when folded by more
+    than ``SIM_MAX_STRETCH`` of it or ``SIM_MAX_SHIFT`` of its piece. Each round tries every
+    sliver, worst first, on the pattern as the moves before left it; the creases and borders
+    are derived again between rounds, until a round makes no move or after ``rounds``
+    rounds."""
     v2, v3 = pattern.vertices_2d.copy(), pattern.vertices_3d.copy()
     tri = np.array(list(pattern.faces), dtype=np.int64).reshape(-1, 3)
     patch = list(pattern.face_patch)
     piece = np.asarray(pattern.face_piece).copy()
     for _ in range(rounds):
         current = CreasePattern(v2, v3, tri, patch, piece, pattern.piece_vertex)
-        quality = triangle_min_angles(v2, tri)
+        quality = np.minimum(triangle_min_angles(v2, tri), triangle_min_angles(v3, tri))
         bad = np.nonzero(quality < min_angle)[0]
         if not len(bad):
             break
@@ -476,28 +622,25 @@ def _clean_slivers(pattern: CreasePattern, min_angle: float, rounds: int = 8) ->
         key = current.edges[:, 0] * n + current.edges[:, 1]
         fdeg = np.bincount(current.edges[feature].ravel(), minlength=n)
         is_feature = dict(zip(key.tolist(), feature.tolist(), strict=True))
+        shift = _shift_bound(current)
         alive = np.ones(len(tri), dtype=bool)
-        touched = np.zeros(n, dtype=bool)
-        for t in bad[np.argsort(quality[bad])].tolist():
-            if not alive[t] or touched[tri[t]].any():
+        at: list[set[int]] = [set() for _ in range(n)]  # each point's live faces
+        for f, corners in enumerate(tri.tolist()):
+            for v in corners:
+                at[v].add(f)
+        moves = 0
+        for t in bad[np.argsort(quality[bad], kind="stable")].tolist():
+            if not alive[t]:
                 continue
-            move = _best_move(tri, alive, t, v2, v3, is_feature, fdeg, patch, n, min_angle)
+            move = _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle)
             if move is None:
                 continue
-            changed, new, moved = move
-            if moved is not None:
-                v, p2, p3 = moved
-                v2[v], v3[v] = p2, p3
-            for f, corners in zip(changed, new, strict=True):
-                if corners is None:
-                    alive[f] = False
-                else:
-                    tri[f] = corners
-            touched[np.unique(tri[changed])] = True
-        if alive.all() and not touched.any():
-            break
+            moves += 1
+            _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n)
         tri, patch = tri[alive], [p for p, a in zip(patch, alive, strict=True) if a]
         piece = piece[alive]
+        if not moves:
+            break
     used = np.unique(tri)
     new_index = -np.ones(len(v2), dtype=np.int64)
     new_index[used] = np.arange(len(used))
@@ -512,64 +655,109 @@ def _clean_slivers(pattern: CreasePattern, min_angle: float, rounds: int = 8) ->
     )
 
 
-def _best_move(tri, alive, t, v2, v3, is_feature, fdeg, patch, n, min_angle):
+def _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n) -> None:
+    """Make the move of :func:`_best_move` on the triangles ``tri`` and keep the faces at
+    each point (``at``), the creases and borders (``is_feature``, keyed by the edge's
+    ``lo * n + hi``) and their count at each point (``fdeg``) up to date: an edge that a
+    collapse makes of two is a crease or border when either of them was; a flip's new
+    diagonal lies inside one smooth patch."""
+    changed, new, moved, collapse = move
+    ring = {v for f in changed for v in tri[f].tolist()}
+    if moved is not None:
+        v, p2, p3 = moved
+        v2[v], v3[v] = p2, p3
+    for f, corners in zip(changed, new, strict=True):
+        for v in tri[f].tolist():
+            at[v].discard(f)
+        if corners is None:
+            alive[f] = False
+        else:
+            tri[f] = corners
+            for v in tri[f].tolist():
+                at[v].add(f)
+
+    def edge(a: int, b: int) -> int:
+        return min(a, b) * n + max(a, b)
+
+    if collapse is not None:
+        go, keep = collapse
+        for x in ring - {go, keep}:
+            merged = is_feature.pop(edge(go, x), False) or is_feature.get(edge(keep, x), False)
+            is_feature[edge(keep, x)] = merged
+        is_feature.pop(edge(go, keep), None)
+        fdeg[go] = 0
+        ring.discard(go)
+    else:
+        c = [tri[f].tolist() for f in changed]
+        old = set(c[0]) & set(c[1])  # the new diagonal's ends
+        is_feature[edge(*old)] = False
+        a, b = ring - old
+        is_feature.pop(edge(a, b), None)
+    for v in ring:
+        near = {x for f in at[v] for x in tri[f].tolist()} - {v}
+        fdeg[v] = sum(is_feature.get(edge(v, x), False) for x in near)
+
+
+def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle):
     """The best collapse or flip for the sliver ``t`` (see :func:`_clean_slivers`): the
-    changed faces, their new corners (None: removed) and the point moved (None, or (vertex,
-    flat, folded position)); None when nothing improves.
+    changed faces, their new corners (None: removed), the point moved (None, or (vertex,
+    flat, folded position)) and, for a collapse, the point removed and the one that takes
+    its place (None for a flip); None when nothing improves. ``at`` lists each point's
+    faces.
 
     A side shorter than ``tan(min_angle)`` times the longest, whose ends both lie on creases
     or borders, may also be collapsed to its midpoint (the one move that moves a point)."""
+    n = len(v2)
     corners = tri[t].tolist()
-    around = {v: np.nonzero(alive & (tri == v).any(axis=1))[0] for v in corners}
-    best, best_q = None, float(triangle_min_angles(v2, tri[[t]])[0])
+    around = {v: np.array(sorted(at[v]), dtype=np.int64) for v in corners}
+    best, best_q = None, _move_quality(tri[[t]], v2, v3, None, None)
     sides = [(corners[i], corners[(i + 1) % 3]) for i in range(3)]
     lengths = [float(np.linalg.norm(v2[a] - v2[b])) for a, b in sides]
     short = math.tan(math.radians(min_angle)) * max(lengths)
+    tries = []  # (keep, go, a, b, along a crease or border, side length)
     for (a, b), length in zip(sides, lengths, strict=True):
         edge_feature = is_feature.get(min(a, b) * n + max(a, b), False)
         for keep, go in ((a, b), (b, a), (min(a, b), -1)):
-            moved = None
-            if go == -1:  # both ends on features: the midpoint, for a short side only
-                if not (fdeg[a] and fdeg[b] and length < short):
-                    continue
-                go = max(a, b)
-                moved = (keep, (v2[a] + v2[b]) / 2, (v3[a] + v3[b]) / 2)
-            elif fdeg[go] and not (fdeg[go] == 2 and edge_feature):
+            tries.append((keep, go, a, b, edge_feature, length))
+    for go in corners:  # a corner on a crease or border may slide along it off the sliver
+        if fdeg[go] == 2:
+            ring = {x for f in around[go].tolist() for x in tri[f].tolist()} - set(corners)
+            for keep in sorted(ring):
+                if is_feature.get(min(go, keep) * n + max(go, keep), False):
+                    tries.append((keep, go, keep, go, True, 0.0))
+    for keep, go, a, b, edge_feature, length in tries:
+        moved = None
+        if go == -1:  # both ends on features: the midpoint, for a short side only
+            if not (fdeg[a] and fdeg[b] and length < short):
                 continue
-            faces = around[go]
-            new = []
-            for f in faces.tolist():
-                c = tri[f]
-                new.append(None if keep in c else np.where(c == go, keep, c))
+            go = max(a, b)
+            moved = (keep, (v2[a] + v2[b]) / 2, (v3[a] + v3[b]) / 2)
+        elif fdeg[go] and not edge_feature:
+            continue
+        faces = around[go]
+        new = []
+        for f in faces.tolist():
+            c = tri[f]
+            new.append(None if keep in c else np.where(c == go, keep, c))
+        kept = [c for c in new if c is not None]
+        if not kept:
+            continue
+        keep_faces = np.array(sorted(at[keep]), dtype=np.int64)
+        if moved is not None:  # the faces of keep move too
+            for f in keep_faces.tolist():
+                if f not in faces:
+                    faces = np.append(faces, f)
+                    new.append(tri[f].copy())
             kept = [c for c in new if c is not None]
-            if not kept:
-                continue
-            keep_faces = around[keep]
-            if moved is not None:  # the faces of keep move too
-                for f in keep_faces.tolist():
-                    if f not in faces:
-                        faces = np.append(faces, f)
-                        new.append(tri[f].copy())
-                kept = [c for c in new if c is not None]
-            k = np.array(kept)
-            p = v2[k]
-            if moved is not None:
-                p = np.where((k == keep)[:, :, None], moved[1], p)
-            area = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (
-                p[:, 1, 1] - p[:, 0, 1]
-            ) * (p[:, 2, 0] - p[:, 0, 0])
-            if (area <= 0).any():
-                continue
-            # the link condition: keep and go share exactly the corners of the faces removed
-            ring_go = set(tri[around[go]].ravel().tolist()) - {go}
-            ring_keep = set(tri[keep_faces].ravel().tolist()) - {keep}
-            if len(ring_go & ring_keep) != sum(c is None for c in new):
-                continue
-            q = float(
-                triangle_min_angles(p.reshape(-1, 2), np.arange(3 * len(k)).reshape(-1, 3)).min()
-            )
-            if q > best_q:
-                best, best_q = (faces.tolist(), new, moved), q
+        k = np.array(kept)
+        # the link condition: keep and go share exactly the corners of the faces removed
+        ring_go = set(tri[around[go]].ravel().tolist()) - {go}
+        ring_keep = set(tri[keep_faces].ravel().tolist()) - {keep}
+        if len(ring_go & ring_keep) != sum(c is None for c in new):
+            continue
+        q = _move_quality(k, v2, v3, moved, shift)
+        if q > best_q:
+            best, best_q = (faces.tolist(), new, moved, (go, keep)), q
     # flip the longest side inside one smooth patch
     a, b = sides[int(np.argmax(lengths))]
     if not is_feature.get(min(a, b) * n + max(a, b), True):
@@ -586,16 +774,27 @@ def _best_move(tri, alive, t, v2, v3, is_feature, fdeg, patch, n, min_angle):
             i = corners.index(a)
             if corners[(i + 1) % 3] != b:  # keep the orientation of t
                 new = [np.array([c, d, a]), np.array([c, b, d])]
-            k = np.array(new)
-            p = v2[k]
-            area = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (
-                p[:, 1, 1] - p[:, 0, 1]
-            ) * (p[:, 2, 0] - p[:, 0, 0])
-            if (area > 0).all():
-                q = float(triangle_min_angles(v2, k).min())
-                if q > best_q:
-                    best, best_q = ([t, o], new, None), q
+            q = _move_quality(np.array(new), v2, v3, None, shift)
+            if q > best_q:
+                best, best_q = ([t, o], new, None, None), q
     return best
+
+
+def _move_quality(
+    k: np.ndarray, v2: np.ndarray, v3: np.ndarray, moved: tuple | None, shift: np.ndarray | None
+) -> float:
+    """The smallest corner angle (degrees), flat or folded, of the triangles ``k`` (j, 3)
+    with ``moved`` (None, or (vertex, flat, folded position)) in its new place; -inf when one
+    of them turns over in the flat layout or one of their sides changes length, flat to
+    folded, by more than ``SIM_MAX_STRETCH`` of its flat length or ``shift`` (n,) at its first
+    corner (see :func:`_triangle_quality`; ``shift`` None: length changes are not looked at)."""
+    p2, p3 = v2[k], v3[k]
+    if moved is not None:
+        at = (k == moved[0])[:, :, None]
+        p2, p3 = np.where(at, moved[1], p2), np.where(at, moved[2], p3)
+    if shift is None:
+        return float(_triangle_quality(p2, p3, math.inf).min())
+    return float(_triangle_quality(p2, p3, SIM_MAX_STRETCH, shift[k[:, 0]]).min())
 
 
 def simulator_pattern(
@@ -650,24 +849,7 @@ def simulator_pattern(
     dihedral = np.nan_to_num(edge_dihedrals(pattern))
     gone = _dropped_rulings(pattern, faces, edge_faces, dihedral, droppable, max_turn, min_angle)
     gone |= _dropped_crease_points(pattern, faces, min_angle)
-    # merge the faces of one patch across every edge that touches a dropped vertex
-    patch = np.array(pattern.face_patch or [""])
-    inner = (edge_faces >= 0).all(axis=1)
-    fa, fb = edge_faces[:, 0], edge_faces[:, 1]
-    touch = gone[pattern.edges].any(axis=1)
-    merge = inner & touch & (patch[fa] == patch[fb])
-    label = _components(len(faces), edge_faces[merge])
-    v2 = pattern.vertices_2d
-    out_faces, out_patch, out_piece = [], [], []
-    for root in np.unique(label).tolist():
-        group = np.nonzero(label == root)[0]
-        f0 = int(group[0])
-        loop = _outline([faces[f] for f in group.tolist()], pattern.face_patch[f0])
-        loop = [v for v in loop if not gone[v]]
-        for tri in _triangulate(loop, v2):
-            out_faces.append(tri)
-            out_patch.append(pattern.face_patch[f0])
-            out_piece.append(int(pattern.face_piece[f0]))
+    out_faces, out_patch, out_piece = _merged_patches(pattern, faces, edge_faces, gone)
     order = np.argsort(np.array(out_piece), kind="stable")  # faces by piece, then as built
     keep = np.nonzero(~gone)[0]
     new_index = -np.ones(n, dtype=np.int64)
@@ -685,26 +867,90 @@ def simulator_pattern(
     return _clean_slivers(coarse, min_angle)
 
 
-def _outline(faces: list[np.ndarray], patch: str = "") -> list[int]:
-    """The boundary loop of a disc made of counter-clockwise faces, counter-clockwise."""
-    half = {}
+def _merged_patches(
+    pattern: CreasePattern, faces: list[np.ndarray], edge_faces: np.ndarray, gone: np.ndarray
+) -> tuple[list[list[int]], list[str], list[int]]:
+    """The triangles of ``pattern`` without the points ``gone`` (n,) bool, their patches and
+    pieces; ``gone`` is updated to the points that did go.
+
+    The faces of one patch are merged across every edge that touches a point that goes, and
+    each merged group is triangulated without those points (see :func:`_triangles`). A group
+    that is not a disc, or whose triangles would be turned over, degenerate or stretched
+    beyond ``SIM_MAX_STRETCH`` or ``SIM_MAX_SHIFT``, keeps its points (they stay for the
+    groups beside it too), and the groups are made again, until every group has its
+    triangles.
+
+    Raises
+    ------
+    ParameterError
+        When a face of ``pattern`` itself has no triangles (it is not simple).
+    """
+    patch = np.array(pattern.face_patch or [""])
+    inner = (edge_faces >= 0).all(axis=1)
+    fa, fb = edge_faces[:, 0], edge_faces[:, 1]
+    same = inner & (patch[fa] == patch[fb])
+    v2, v3 = pattern.vertices_2d, pattern.vertices_3d
+    shift = _shift_bound(pattern)
+    made: dict[tuple, list[list[int]] | None] = {}  # (faces, points gone) -> triangles
+    while True:
+        touch = gone[pattern.edges].any(axis=1)
+        label = _components(len(faces), edge_faces[same & touch])
+        order = np.argsort(label, kind="stable")
+        groups = np.split(order, np.nonzero(np.diff(label[order]))[0] + 1)
+        out, back = [], []
+        for group in groups:
+            points = np.unique(np.concatenate([faces[f] for f in group.tolist()]))
+            going = points[gone[points]]
+            key = (tuple(group.tolist()), tuple(going.tolist()))
+            if key not in made:
+                if not len(going):  # one face of the pattern as it is
+                    made[key] = _triangles(faces[group[0]].tolist(), v2, v3) or _triangulate(
+                        faces[group[0]].tolist(), v2
+                    )
+                    if made[key] is None:
+                        raise ParameterError(
+                            f"simulator.fold: {patch[group[0]]} of the pattern has a face "
+                            f"that is not simple (face {int(group[0])})",
+                            name="pattern",
+                        )
+                else:
+                    loop = _outline([faces[f] for f in group.tolist()])
+                    made[key] = loop and _triangles(
+                        [v for v in loop if not gone[v]], v2, v3, SIM_MAX_STRETCH, shift[loop[0]]
+                    )
+            if made[key] is None:
+                back.append(going)
+            else:
+                out.append((int(group[0]), made[key]))
+        if not back:
+            break
+        gone[np.concatenate(back)] = False
+    out_faces, out_patch, out_piece = [], [], []
+    for f0, tris in sorted(out):
+        out_faces += tris
+        out_patch += [pattern.face_patch[f0]] * len(tris)
+        out_piece += [int(pattern.face_piece[f0])] * len(tris)
+    return out_faces, out_patch, out_piece
+
+
+def _outline(faces: list[np.ndarray]) -> list[int] | None:
+    """The boundary loop of a disc made of counter-clockwise faces, counter-clockwise; None
+    when the faces do not make a disc (no boundary, more than one loop, or a loop that
+    passes a point twice)."""
+    half = set()
     for f in faces:
         fl = f.tolist()
-        for a, b in zip(fl, fl[1:] + fl[:1], strict=True):
-            half[(a, b)] = True
-    nxt = {a: b for (a, b) in half if (b, a) not in half}
-    if not nxt:
-        raise ParameterError(
-            f"simulator.fold: {patch or 'a patch'} of the pattern has no outline", name="pattern"
-        )
+        half.update(zip(fl, fl[1:] + fl[:1], strict=True))
+    border = [(a, b) for (a, b) in half if (b, a) not in half]
+    nxt = dict(border)
+    if not nxt or len(nxt) < len(border):
+        return None
     first = min(nxt)
     loop = [first]
     while True:
         v = nxt[loop[-1]]
         if v == first:
-            return loop
+            return loop if len(loop) == len(nxt) else None
         loop.append(v)
         if len(loop) > len(nxt):
-            raise ParameterError(
-                f"simulator.fold: {patch or 'a patch'} of the pattern is not a disc", name="pattern"
-            )
+            return None
