@@ -58,6 +58,9 @@ SIM_MAX_STRETCH = 0.05
 SIM_MAX_SHIFT = 0.005
 #: Most rounds of sliver moves (see ``_clean_slivers``); the corpus's meshes stop after 5.
 SIM_CLEAN_ROUNDS = 40
+#: Pairs of corners times sides that :func:`_diagonals` looks at in one go (a temporary of
+#: 8 MB per array).
+DIAGONAL_CHUNK = 1 << 20
 #: A triangle with a corner under this angle (degrees), flat or folded, is degenerate: its
 #: folded normal, and the fold angles beside it, are round-off.
 SIM_DEGENERATE = 1e-3
@@ -135,8 +138,18 @@ def _diagonals(q: np.ndarray) -> np.ndarray:
     i, j = np.triu_indices(k, 2)
     keep = ~((i == 0) & (j == k - 1))
     i, j = i[keep], j[keep]
-    if not len(i):
-        return ok
+    chunk = max(1, DIAGONAL_CHUNK // k)  # pairs at a time: (chunk, k) temporaries
+    for lo in range(0, len(i), chunk):
+        ii, jj = i[lo : lo + chunk], j[lo : lo + chunk]
+        ok[ii, jj] = ok[jj, ii] = _inside(q, ii, jj)
+    return ok
+
+
+def _inside(q: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """(P,) bool: whether the segments from corners ``i`` (P,) to ``j`` (P,) of the
+    counter-clockwise polygon ``q`` (k, 2) lie inside it (see :func:`_diagonals`)."""
+    k = len(q)
+    side = np.arange(k)
     scale = float(np.abs(q).max()) or 1.0
     eps = 1e-12 * scale * scale
     a, b = q[i][:, None, :], q[j][:, None, :]  # (P, 1, 2)
@@ -161,9 +174,7 @@ def _diagonals(q: np.ndarray) -> np.ndarray:
     xn, yn = np.roll(q[:, 0], -1)[None, :], np.roll(q[:, 1], -1)[None, :]
     crossing = (y > mid[:, 1:2]) != (yn > mid[:, 1:2])
     xs = x + (mid[:, 1:2] - y) * (xn - x) / np.where(yn == y, 1.0, yn - y)
-    inside &= np.count_nonzero(crossing & (xs > mid[:, 0:1]), axis=1) % 2 == 1
-    ok[i, j] = ok[j, i] = inside
-    return ok
+    return inside & (np.count_nonzero(crossing & (xs > mid[:, 0:1]), axis=1) % 2 == 1)
 
 
 def _components(n_faces: int, pairs: np.ndarray) -> np.ndarray:
