@@ -11,7 +11,7 @@ import copy
 import dataclasses
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
@@ -170,6 +170,11 @@ class Parameters:
             "strict": self.strict,
             "sharp": self.sharp,
         }
+
+    def round_mesh_kwargs(self) -> dict:
+        """The keyword arguments of :func:`round_mesh` that give this design again from its
+        cleaned mesh (every field, by the same name)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
 @dataclass

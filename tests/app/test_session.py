@@ -520,3 +520,26 @@ def test_export_zip_is_reproducible(cube_session):
         # not dated by the clock: the same design is the same zip on any day
         assert {info.date_time for info in zf.infolist()} == {(1980, 1, 1, 0, 0, 0)}
         assert {info.external_attr >> 16 for info in zf.infolist()} == {0o644}
+
+
+def test_the_download_keeps_every_parameter_of_the_shown_design():
+    """The download is the shown design again with glue tabs: parameters the app has no
+    slider for (chord tolerance, sharp vertices, vertex fitting) are those of the shown
+    design too, not the defaults."""
+    from filletfold import round_mesh
+
+    s = AppSession()
+    s.load("l-prism")
+    shown = round_mesh(
+        s.mesh, chord_tol=0, arc_step=0, samples=5, sharp="none", fit_vertices=False, tabs=False
+    )
+    shown.source = "l-prism"
+    s.design = shown
+    files = s.export_files()
+    parameters = json.loads(files["report.json"])["parameters"]
+    assert parameters == shown.params.as_dict()
+    assert parameters["chord_tol"] == 0 and parameters["sharp"] == "none"
+    assert not parameters["fit_vertices"]
+    assert json.loads(files["report.json"])["fabrication"]["tabs"] > 0
+    fold = json.loads(files["design.fold"])
+    assert len(fold["vertices_coords"]) >= len(shown.pattern.vertices_2d)

@@ -401,20 +401,7 @@ class AppSession:
             # the shown design was computed without glue tabs: add them (layout stage only)
             p = design.params
             source = design.source
-            design = round_mesh(
-                design.mesh,
-                radius=p.radius,
-                depth=p.depth,
-                samples=p.samples,
-                arc_step=p.arc_step,
-                clamp=p.clamp,
-                material_loss=p.material_loss,
-                max_loss=p.max_loss,
-                layout=p.layout,
-                coplanar_deg=p.coplanar_deg,
-                tabs=True,
-                reuse=design,
-            )
+            design = round_mesh(design.mesh, **p.round_mesh_kwargs(), tabs=True, reuse=design)
             design.source = source
         files = dict(
             cut_files(
