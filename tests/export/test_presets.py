@@ -130,15 +130,16 @@ def test_default_dxf_layers():
 
 def test_default_dxf_layers_show_the_svg_colours():
     """The default DXF has no true colours, so its layers' ACI colours are what a viewer shows:
-    each line the SVG draws (cut, mountain, valley, tab hinge) has the same colour in both
-    files -- the tab hinge magenta, not ACI 3 ``#00ff00``, which Origami Simulator reads as a
-    cut. ACI 7 is black on a white sheet."""
+    each line the SVG draws (cut, mountain, valley, tab hinge, facet) has the same colour in
+    both files -- the tab hinge magenta, not ACI 3 ``#00ff00``, which Origami Simulator reads
+    as a cut, and the facets yellow (ACI 2), not grey. ACI 7 is black on a white sheet."""
     from ezdxf.colors import aci2rgb
 
     groups, _ = svg_groups(pattern_svg(mm_pattern(), units="mm"))
-    doc = read_dxf(pattern_dxf(mm_pattern(), units="mm"))
+    doc = read_dxf(pattern_dxf(mm_pattern(), units="mm", flat_edges=True))
     preset = get_preset()
-    for role, gid in GROUP.items():
+    for role, gid in {**GROUP, "flat": "flat"}.items():
+        assert groups[gid], role
         layer = doc.layers.get(getattr(preset, role).layer)
         assert layer.rgb is None  # no true colour: the ACI is the colour
         aci = layer.dxf.color

@@ -15,7 +15,7 @@ layer        colour     content
                         ``DASHED``; the tab outline is *not* repeated here, so a machine that
                         cuts ``CUT`` and scores ``TAB`` never cuts a line twice
 ``LABEL``    8 grey     ``TEXT`` entities of the labels (centred on their anchor, rotated)
-``FLAT``     9          ``F`` edges, only with ``flat_edges=True``
+``FLAT``     2 yellow   ``F`` edges, only with ``flat_edges=True``
 ===========  =========  =======================================================================
 
 The other presets rename the layers (e.g. ``SCORE_MOUNTAIN``, ``PERF_VALLEY``, ``ENGRAVE``),

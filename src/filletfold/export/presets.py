@@ -209,7 +209,7 @@ _OS = Preset(
     valley=Pen("#0000ff", "VALLEY", 5, 0.3),
     tab=Pen("#ff00ff", "TAB", 6, 0.3, dash_share=0.005),
     label=Pen("#404040", "LABEL", 8, 0.3),
-    flat=Pen("#ffff00", "FLAT", 9, 0.1),
+    flat=Pen("#ffff00", "FLAT", 2, 0.1),
     flat_edges=True,
     angle_opacity=True,
     join_lines=False,
