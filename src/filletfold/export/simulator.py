@@ -331,10 +331,11 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
             proposals.append(np.asarray(rulings, dtype=np.int64).reshape(-1, 2))
     active = np.ones(len(proposals), dtype=bool)
     verdicts: dict[tuple, bool] = {}  # a merged polygon's place -> broken
+    shift = _shift_bound(pattern)
     while True:
         pairs = [p for p, on in zip(proposals, active, strict=True) if on]
         rep = _components(n, np.concatenate([np.zeros((0, 2), dtype=np.int64), *pairs]))
-        merged = _merged_faces(pattern, faces, rep, verdicts)
+        merged = _merged_faces(pattern, faces, rep, shift, verdicts)
         if merged[-1] is None:
             break
         # the strips that merged a point of a broken face go back
@@ -360,18 +361,23 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
     )
 
 
-def _merged_faces(pattern: CreasePattern, faces: list[np.ndarray], rep: np.ndarray, verdicts: dict):
+def _merged_faces(
+    pattern: CreasePattern,
+    faces: list[np.ndarray],
+    rep: np.ndarray,
+    shift: np.ndarray,
+    verdicts: dict,
+):
     """The points of ``pattern`` merged into their groups ``rep`` (n,) (each point moved to
     its group's mean, flat and folded): (flat positions, folded positions, faces, their
     patches, their pieces, and the points of the faces that broke, or None when none did).
 
     A face left with fewer than three distinct points is dropped; one that visits a point
     twice, or whose triangles (see :func:`_triangles`) are turned over, degenerate flat or
-    folded, or stretched beyond ``SIM_MAX_STRETCH`` or ``SIM_MAX_SHIFT``, is broken.
-    ``verdicts`` keeps the verdict on each polygon of more than three points, by its points
-    and their places, for the next call."""
+    folded, or stretched beyond ``SIM_MAX_STRETCH`` or ``shift`` (n,) at its first point (see
+    :func:`_shift_bound`), is broken. ``verdicts`` keeps the verdict on each polygon of more
+    than three points, by its points and their places, for the next call."""
     n = len(rep)
-    shift = _shift_bound(pattern)
     count = np.bincount(rep, minlength=n)
     v2 = np.zeros((n, 2))
     v3 = np.zeros((n, 3))
@@ -383,6 +389,7 @@ def _merged_faces(pattern: CreasePattern, faces: list[np.ndarray], rep: np.ndarr
     moved = count[rep] > 1
     loops: list[list[int] | None] = []  # per face: its loop, None when it is dropped
     broken = np.zeros(len(faces), dtype=bool)
+    moved_tri = []  # the faces that are moved triangles, checked all at once below
     for f, face in enumerate(faces):
         loop = rep[face].tolist()
         if moved[face].any():
@@ -391,18 +398,18 @@ def _merged_faces(pattern: CreasePattern, faces: list[np.ndarray], rep: np.ndarr
                 loop = None
             elif len(set(loop)) < len(loop):
                 broken[f] = True
-            elif len(loop) > 3:
+            elif len(loop) == 3:
+                moved_tri.append(f)
+            else:
                 key = (tuple(loop), v2[loop].tobytes(), v3[loop].tobytes())
                 if key not in verdicts:
                     tris = _triangles(loop, v2, v3, SIM_MAX_STRETCH, shift[loop[0]])
                     verdicts[key] = tris is None
                 broken[f] = verdicts[key]
         loops.append(loop)
-    # the moved triangles, all at once
-    tri = [f for f, loop in enumerate(loops) if loop is not None and len(loop) == 3]
-    tri = np.array([f for f in tri if moved[faces[f]].any()], dtype=np.int64)
-    if len(tri):
-        corners = np.array([loops[f] for f in tri.tolist()], dtype=np.int64)
+    if moved_tri:
+        tri = np.array(moved_tri, dtype=np.int64)
+        corners = np.array([loops[f] for f in moved_tri], dtype=np.int64)
         quality = _triangle_quality(v2[corners], v3[corners], SIM_MAX_STRETCH, shift[corners[:, 0]])
         broken[tri] = quality < SIM_DEGENERATE
     keep = [f for f, loop in enumerate(loops) if loop is not None and not broken[f]]
