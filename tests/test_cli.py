@@ -211,6 +211,7 @@ def test_net_on_sheets_with_all_formats(tmp_path, capsys):
         "preview.png",
         "report.json",
         "simulator.fold",
+        "simulator.svg",
         "timings.json",
     ]
     fab = json.loads((out / "report.json").read_text())["fabrication"]

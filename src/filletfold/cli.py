@@ -91,16 +91,17 @@ def examples():
 
 
 #: Formats ``filletfold export`` can write from a ``design.fold``.
-EXPORT_FORMATS = ("obj", "svg", "dxf", "pdf", "png", "3dm", "glb", "ply", "stl")
+EXPORT_FORMATS = ("simulator", "obj", "svg", "dxf", "pdf", "png", "3dm", "glb", "ply", "stl")
 
 FormatOption = Annotated[
     str | None,
     typer.Option(
         "--format",
         "-f",
-        help="Comma-separated output formats: fold, simulator (simulator.fold, for Origami "
-        "Simulator), json, obj, svg, dxf, pdf, png (pattern.png and preview.png), 3dm "
-        "(pattern.3dm and folded.3dm, needs rhino3dm), glb (or gltf), ply, stl, or all.",
+        help="Comma-separated output formats: fold, simulator (simulator.fold and "
+        "simulator.svg, for Origami Simulator), json, obj, svg, dxf, pdf, png (pattern.png "
+        "and preview.png), 3dm (pattern.3dm and folded.3dm, needs rhino3dm), glb (or gltf), "
+        "ply, stl, or all.",
     ),
 ]
 UnitsOption = Annotated[
@@ -329,9 +330,10 @@ def round_cmd(
     """Round every edge and vertex of MESH; write the design into the output folder.
 
     Writes design.fold (crease pattern + folded form), report.json (with timings.json beside
-    it), folded.obj and pattern.svg, all or nothing; --format all adds pattern.dxf, pattern.pdf,
-    pattern.png and preview.png. Every file but timings.json has the same bytes for the same
-    input and options.
+    it), folded.obj and pattern.svg, all or nothing; --format all adds every other format
+    (simulator.fold and simulator.svg for Origami Simulator, pattern.dxf, pattern.pdf,
+    pattern.png and preview.png, the 3dm, glb, ply and stl files). Every file but
+    timings.json has the same bytes for the same input and options.
     """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -444,8 +446,9 @@ def export_cmd(
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
     Formats: dxf (pattern.dxf), pdf (pattern.pdf, tiled at true scale), svg (pattern.svg), png
-    (pattern.png and preview.png), obj (folded.obj), 3dm (pattern.3dm, folded.3dm), glb, ply,
-    stl (folded.glb, .ply, .stl); all of them with --format all. The files are written into
+    (pattern.png and preview.png), simulator (simulator.fold and simulator.svg, for Origami
+    Simulator), obj (folded.obj), 3dm (pattern.3dm, folded.3dm), glb, ply, stl (folded.glb,
+    .ply, .stl); all of them with --format all. The files are written into
     FOLDER, all or nothing.
     """
     from .export import write_outputs

@@ -63,6 +63,7 @@ def test_cut_files_names_and_types():
         "design.fold",
         "annotations.json",
         "simulator.fold",
+        "simulator.svg",
         "report.json",
         "folded.obj",
         "pattern.svg",
@@ -123,6 +124,7 @@ def test_export_design_all_formats(cube, tmp_path):
         "design.fold",
         "annotations.json",
         "simulator.fold",
+        "simulator.svg",
         "report.json",
         "folded.obj",
         "pattern.svg",
@@ -173,6 +175,22 @@ def test_cli_export_writes_the_cut_files(cube, tmp_path, capsys):
     check_lengths(doc, cube.pattern, scale=50.0)
 
 
+def test_cli_export_writes_the_simulator_files(tmp_path, capsys):
+    """From a design folder, as Origami Simulator needs them: triangles only, the folded
+    form in its frame, and the SVG in the app's colours."""
+    folder = tmp_path / "miura"
+    assert main(["round", "miura", "--material-loss", "-o", str(folder), "-q"]) == 0
+    assert main(["export", str(folder), "--format", "simulator"]) == 0
+    assert "wrote 2 files" in capsys.readouterr().out
+    doc = json.loads((folder / "simulator.fold").read_text())
+    fine = json.loads((folder / "design.fold").read_text())
+    assert {len(f) for f in doc["faces_vertices"]} == {3}
+    assert len(doc["vertices_coords"]) < len(fine["vertices_coords"]) / 2
+    assert len(doc["file_frames"][0]["vertices_coords"]) == len(doc["vertices_coords"])
+    svg = (folder / "simulator.svg").read_text()
+    assert 'stroke="#ff0000"' in svg and 'stroke="#0000ff"' in svg and 'stroke="#ff00ff"' not in svg
+
+
 @pytest.mark.parametrize(
     ("args", "match"),
     [
@@ -205,7 +223,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 17 files" in capsys.readouterr().out
+    assert "wrote 18 files" in capsys.readouterr().out
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 

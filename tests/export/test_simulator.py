@@ -1,11 +1,13 @@
-"""``simulator.fold`` (:mod:`filletfold.export.simulator`): what Origami Simulator needs, read
-back from the written file, on real designs. No browser: the checks are the geometric
-conditions the simulator's solver relies on."""
+"""``simulator.fold`` and ``simulator.svg`` (:mod:`filletfold.export.simulator`): what Origami
+Simulator needs, read back from the written files, on real designs. No browser: the checks are
+the geometric conditions the simulator's solver relies on, and the SVG read as the simulator's
+SVG import reads it."""
 
 from __future__ import annotations
 
 import functools
 import json
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +21,7 @@ from filletfold.export import cut_files
 from filletfold.export.simulator import (
     SIM_MAX_STRETCH,
     SIM_MIN_ANGLE,
+    SIM_SVG_FLAT,
     simulator_pattern,
     triangle_min_angles,
 )
@@ -59,9 +62,13 @@ ALL_DESIGNS = DESIGNS + CORPUS_DESIGNS
 
 
 @functools.cache
+def _texts(name: str) -> dict:
+    return cut_files(_design(name).pattern, "simulator")
+
+
+@functools.cache
 def _file(name: str) -> dict:
-    text = cut_files(_design(name).pattern, "simulator")["simulator.fold"]
-    return json.loads(text)
+    return json.loads(_texts(name)["simulator.fold"])
 
 
 def _arrays(doc: dict):
@@ -209,10 +216,90 @@ def test_simulator_cube_keeps_exact_points():
     assert all(tuple(np.round(np.r_[a, b], 9)) in keys for a, b in zip(v2, v3, strict=True))
 
 
+SVG_NS = "{http://www.w3.org/2000/svg}"
+#: Origami Simulator's SVG import: stroke colour -> assignment (others it does not read).
+OS_STROKES = {"#000000": "B", "#ff0000": "M", "#0000ff": "V", "#ffff00": "F"}
+#: Its default vertex merge tolerance (user units).
+OS_MERGE = 3.0
+
+
+def _svg_lines(text: str):
+    """The ``<line>`` elements outside ``<defs>`` (what the simulator reads): (k, 2, 2) end
+    points, strokes, opacities (NaN where there is none)."""
+    root = ET.fromstring(text)
+    skip = {id(e) for d in root.iter(SVG_NS + "defs") for e in d.iter()}
+    ends, strokes, opacity = [], [], []
+    for ln in root.iter(SVG_NS + "line"):
+        if id(ln) in skip:
+            continue
+        ends.append(
+            [[float(ln.get("x1")), float(ln.get("y1"))], [float(ln.get(k)) for k in ("x2", "y2")]]
+        )
+        strokes.append(ln.get("stroke"))
+        opacity.append(float(ln.get("stroke-opacity", "nan")))
+    for tag in ("path", "polyline", "polygon", "rect", "text"):
+        assert not [e for e in root.iter(SVG_NS + tag) if id(e) not in skip], tag
+    return np.array(ends).reshape(-1, 2, 2), np.array(strokes), np.array(opacity)
+
+
+@pytest.mark.parametrize("name", ALL_DESIGNS)
+def test_simulator_svg_is_the_fold_file_in_the_apps_colours(name):
+    """``simulator.svg`` read as the simulator reads an SVG: its lines are the edges of
+    ``simulator.fold``, no two points within the merge tolerance, borders black, every edge
+    with a target angle red or blue at opacity |angle| / 180 (the bent facets included, which
+    the app would hold flat as yellow lines), the flat facets yellow; no tabs or labels."""
+    doc = _file(name)
+    v2, v3, edges, _ = _arrays(doc)
+    ends, strokes, opacity = _svg_lines(_texts(name)["simulator.svg"])
+    assert set(strokes) <= set(OS_STROKES)
+    # the drawing is the pattern scaled, y flipped (the SVG's y runs down)
+    pts = ends.reshape(-1, 2)
+    k = np.ptp(pts[:, 0]) / np.ptp(v2[:, 0])
+    assert np.ptp(pts[:, 1]) / np.ptp(v2[:, 1]) == pytest.approx(k, rel=1e-6)
+    drawn = np.c_[pts[:, 0] / k, -pts[:, 1] / k]
+    drawn += v2.min(axis=0) - np.array([drawn[:, 0].min(), drawn[:, 1].min()])
+    size = np.linalg.norm(np.ptp(v2, axis=0))
+    # points closer than the drawing's precision are one point folded as well (a real mesh's
+    # piece whose border touches itself at a sharp vertex, as in design.fold): one each
+    rep = np.arange(len(v2))
+    for a, b in sorted(cKDTree(v2).query_pairs(1e-8 * size)):
+        assert np.linalg.norm(v3[a] - v3[b]) <= 1e-9 * size, (a, b)
+        rep[rep == rep[b]] = rep[a]
+    gap, at = cKDTree(v2).query(drawn)
+    assert gap.max() <= 1e-6 * size
+    at = rep[at]
+    ids = np.unique(rep)
+    assert np.array_equal(np.unique(at), ids)  # every point drawn
+    place = np.zeros((len(v2), 2))
+    place[at] = pts
+    for a, b in cKDTree(place[ids]).query_pairs(OS_MERGE):  # the app merges only these
+        assert np.linalg.norm(v3[ids[a]] - v3[ids[b]]) <= 1e-6 * size, (ids[a], ids[b])
+    # one line per edge, in the colour and opacity of its fold angle
+    line_key = np.sort(at.reshape(-1, 2), axis=1) @ [len(v2), 1]
+    edge_key = np.sort(rep[edges], axis=1) @ [len(v2), 1]
+    assert np.array_equal(np.sort(line_key), np.sort(edge_key))
+    keys, counts = np.unique(edge_key, return_counts=True)
+    single = np.isin(edge_key, keys[counts == 1])
+    assert single.mean() > 0.99
+    line_of = dict(zip(line_key.tolist(), range(len(line_key)), strict=False))
+    line = np.array([line_of[x] for x in edge_key[single].tolist()])
+    code = np.array([OS_STROKES[c] for c in strokes])[line]
+    assign = np.array(doc["edges_assignment"])[single]
+    angle = np.array([np.nan if a is None else a for a in doc["edges_foldAngle"]])[single]
+    assert (code[assign == "B"] == "B").all()
+    bent = (assign != "B") & (np.abs(np.nan_to_num(angle)) >= SIM_SVG_FLAT)
+    assert (code[bent & (angle < 0)] == "M").all() and (code[bent & (angle > 0)] == "V").all()
+    assert (code[(assign != "B") & ~bent] == "F").all()
+    assert_allclose(opacity[line][bent], np.abs(angle[bent]) / 180, atol=6e-7)
+    assert (code == "F").sum() < (assign == "F").sum()  # bent facets get their angle
+
+
 def test_simulator_file_is_reproducible_and_documented():
     pattern = _design("cube").pattern
-    a = cut_files(pattern, "simulator")["simulator.fold"]
-    assert a == cut_files(pattern, "simulator")["simulator.fold"]
+    files = cut_files(pattern, "simulator")
+    assert list(files) == ["simulator.fold", "simulator.svg"]
+    assert files == cut_files(pattern, "simulator")
+    a = files["simulator.fold"]
     doc = json.loads(a)
     assert doc["filletfold:simulator"]["min_angle"] == SIM_MIN_ANGLE
     assert doc["frame_classes"] == ["creasePattern"]

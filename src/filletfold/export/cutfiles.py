@@ -7,9 +7,10 @@ format         files                            content
 =============  ===============================  =================================================
 ``fold``       ``design.fold``,                 FOLD 1.2: crease pattern + folded form; the
                ``annotations.json``             tabs, labels and sheets beside it
-``simulator``  ``simulator.fold``               FOLD 1.2 for Origami Simulator: the pattern
-                                                coarsened and triangulated (see
-                                                :mod:`~filletfold.export.simulator`)
+``simulator``  ``simulator.fold``,              FOLD 1.2 for Origami Simulator: the pattern
+               ``simulator.svg``                coarsened and triangulated (see
+                                                :mod:`~filletfold.export.simulator`), and the
+                                                same in the simulator's SVG colours
 ``json``       ``report.json``                  the design report (needs the design, not only
                                                 the pattern)
 ``obj``        ``folded.obj``                   the folded form
@@ -49,6 +50,7 @@ the GLB, whose unit is the metre, by ``scale`` and the unit in metres
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib.util
 import logging
 import sys
@@ -85,7 +87,7 @@ __all__ = [
 #: Files written for each format, in writing order.
 FORMAT_FILES = {
     "fold": ("design.fold", "annotations.json"),
-    "simulator": ("simulator.fold",),
+    "simulator": ("simulator.fold", "simulator.svg"),
     "json": ("report.json",),
     "obj": ("folded.obj",),
     "svg": ("pattern.svg",),
@@ -347,14 +349,19 @@ def cut_files(
         )
         return fold_json(doc)
 
-    def simulator():
-        from .simulator import SIM_MAX_TURN, SIM_MIN_ANGLE, simulator_pattern
+    @functools.cache
+    def coarse():
+        from .simulator import simulator_pattern
 
-        coarse = simulator_pattern(pattern)
+        return simulator_pattern(pattern)
+
+    def simulator():
+        from .simulator import SIM_MAX_TURN, SIM_MIN_ANGLE
+
         settings = {"max_turn": SIM_MAX_TURN, "min_angle": SIM_MIN_ANGLE}
         doc = _fold_document(
-            coarse,
-            validated_faces(coarse),
+            coarse(),
+            validated_faces(coarse()),
             title=title,
             description=description,
             extra={"filletfold:simulator": settings},
@@ -362,6 +369,12 @@ def cut_files(
             annotations=False,
         )
         return fold_json(doc)
+
+    def simulator_svg():
+        from .simulator import simulator_svg_pattern
+
+        drawn = scaled_pattern(simulator_svg_pattern(coarse()), scale)
+        return _pattern_svg(drawn, units=units, preset="origami-simulator")
 
     def pdf():
         pdf_units, pdf_scale = units or "mm", scale
@@ -380,7 +393,7 @@ def cut_files(
 
     builders = {
         "fold": {"design.fold": fold, ANNOTATIONS_FILE: lambda: annotations_json(pattern)},
-        "simulator": {"simulator.fold": simulator},
+        "simulator": {"simulator.fold": simulator, "simulator.svg": simulator_svg},
         "json": {"report.json": lambda: report if isinstance(report, str) else report_json(report)},
         "obj": {"folded.obj": lambda: _folded_obj(pattern, faces)},
         "svg": {

@@ -25,6 +25,12 @@ merged group of faces that is not a disc, or whose triangles would turn over, be
 ``SIM_MAX_SHIFT`` of its piece, keeps its points; a sliver move is taken only under the same
 conditions. So a real mesh's pattern (sharp vertices, skinny faces) gives a valid file: only
 where its own faces are too narrow for it are a few triangles left under ``min_angle``.
+
+:func:`simulator_svg_pattern` gives the same coarse pattern as ``simulator.svg`` draws it for
+the simulator's SVG import, which reads a target angle only from a mountain or valley line's
+opacity and holds every facet (yellow) line flat: the bent ``F`` edges are drawn as mountain
+or valley lines of their folded dihedral, the unbent ones as facets, and, as in
+``simulator.fold``, there are no tabs or labels.
 """
 
 from __future__ import annotations
@@ -40,7 +46,9 @@ from ..surface.pattern import CreasePattern, face_arrays
 __all__ = [
     "SIM_MAX_TURN",
     "SIM_MIN_ANGLE",
+    "SIM_SVG_FLAT",
     "simulator_pattern",
+    "simulator_svg_pattern",
     "triangle_min_angles",
 ]
 
@@ -64,6 +72,9 @@ DIAGONAL_CHUNK = 1 << 20
 #: A triangle with a corner under this angle (degrees), flat or folded, is degenerate: its
 #: folded normal, and the fold angles beside it, are round-off.
 SIM_DEGENERATE = 1e-3
+#: An ``F`` edge whose folded dihedral is under this (degrees) is drawn flat (a facet line) in
+#: ``simulator.svg``: the SVG's opacity, ``|angle| / 180`` to 6 decimals, has no smaller step.
+SIM_SVG_FLAT = 1e-4
 
 
 def triangle_min_angles(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -972,3 +983,42 @@ def _outline(faces: list[np.ndarray]) -> list[int] | None:
         loop.append(v)
         if len(loop) > len(nxt):
             return None
+
+
+def simulator_svg_pattern(coarse: CreasePattern) -> CreasePattern:
+    """``coarse`` (a :func:`simulator_pattern`) as ``simulator.svg`` draws it.
+
+    Origami Simulator's SVG import takes a line's target fold angle only from a mountain or
+    valley stroke (``stroke-opacity`` times 180 degrees) and holds every facet line at 0, so
+    the ``F`` edges that bend in the folded form (inside the cylinders and cones) become
+    mountain or valley edges of their folded dihedral, as ``simulator.fold`` gives them in
+    ``edges_foldAngle``; the simulator treats both the same (a crease of nonzero target angle,
+    at the same stiffness as a facet). Tabs, labels and sheets are left out, as in
+    ``simulator.fold``.
+
+    Parameters
+    ----------
+    coarse : CreasePattern
+        A pattern from :func:`simulator_pattern`.
+
+    Returns
+    -------
+    CreasePattern
+        The same points and faces, with new edge assignments and fold angles and no
+        annotations.
+    """
+    import dataclasses
+
+    from ..surface.pattern import Annotations
+    from .fold import edge_dihedrals
+
+    assign = np.asarray(coarse.edge_assignment, dtype="<U1").copy()
+    angle = np.asarray(coarse.edge_fold_angle, dtype=np.float64).copy()
+    flat = assign == "F"
+    dihedral = np.nan_to_num(edge_dihedrals(coarse))
+    bent = flat & (np.abs(dihedral) >= SIM_SVG_FLAT)
+    assign[bent] = np.where(dihedral[bent] > 0, "V", "M")  # FOLD: valley positive
+    angle[bent] = dihedral[bent]
+    return dataclasses.replace(
+        coarse, edge_assignment=assign, edge_fold_angle=angle, annotations=Annotations()
+    )
