@@ -32,6 +32,8 @@ TETRA_OBJ = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2
 ZIP_NAMES = {
     "design.fold",
     "annotations.json",
+    "simulator.fold",
+    "simulator.svg",
     "report.json",
     "folded.obj",
     "pattern.svg",
@@ -173,6 +175,11 @@ def test_export_zip_holds_the_files_and_they_parse(cube_session):
         obj = zf.read("folded.obj").decode()
         svg = zf.read("pattern.svg").decode()
         dxf = zf.read("pattern.dxf").decode()
+        simulator = json.loads(zf.read("simulator.fold"))
+        simulator_svg = zf.read("simulator.svg").decode()
+    assert {len(f) for f in simulator["faces_vertices"]} == {3}  # triangles for the app
+    assert len(simulator["vertices_coords"]) < len(fold["vertices_coords"])
+    assert 'stroke="#ff0000"' in simulator_svg and 'stroke="#ff00ff"' not in simulator_svg
     assert "timings" not in report
     assert fold["file_spec"] == 1.2 and len(fold["vertices_coords"]) > 0
     assert annotations["design"]["vertices"] == len(fold["vertices_coords"])

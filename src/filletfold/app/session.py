@@ -43,7 +43,7 @@ UPLOAD_LIMIT_BYTES = 50 * 1024 * 1024
 #: Date and time of every entry of the zip (the earliest a zip can hold).
 ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 #: Files in the zip from :meth:`AppSession.export_zip`, besides ``report.json``.
-ZIP_FORMATS = ("fold", "obj", "svg", "dxf")
+ZIP_FORMATS = ("fold", "simulator", "obj", "svg", "dxf")
 #: Parameters :meth:`AppSession.set_params` accepts.
 PARAM_NAMES = ("radius", "depth", "samples", "arc_step", "material_loss", "clamp", "tabs")
 
@@ -418,7 +418,8 @@ class AppSession:
         return files
 
     def export_zip(self) -> bytes:
-        """A zip of ``design.fold``, ``annotations.json``, ``report.json``, ``folded.obj``,
+        """A zip of ``design.fold``, ``annotations.json``, ``simulator.fold``,
+        ``simulator.svg`` (for Origami Simulator), ``report.json``, ``folded.obj``,
         ``pattern.svg`` and ``pattern.dxf`` (and ``assembly.txt`` with glue tabs), built in
         memory.
 
