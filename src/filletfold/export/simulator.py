@@ -47,6 +47,7 @@ __all__ = [
     "SIM_MAX_TURN",
     "SIM_MIN_ANGLE",
     "SIM_SVG_FLAT",
+    "SIM_SVG_WELD",
     "simulator_pattern",
     "simulator_svg_pattern",
     "triangle_min_angles",
@@ -72,9 +73,18 @@ DIAGONAL_CHUNK = 1 << 20
 #: A triangle with a corner under this angle (degrees), flat or folded, is degenerate: its
 #: folded normal, and the fold angles beside it, are round-off.
 SIM_DEGENERATE = 1e-3
+#: Sides made by sliver moves that are looked at one by one before the search tree of the
+#: pattern's sides is made again (see ``_FlatSides``).
+SIDES_REBUILD = 1024
 #: An ``F`` edge whose folded dihedral is under this (degrees) is drawn flat (a facet line) in
 #: ``simulator.svg``: the SVG's opacity, ``|angle| / 180`` to 6 decimals, has no smaller step.
 SIM_SVG_FLAT = 1e-4
+#: Points of ``simulator.svg`` closer than this share of the drawing's size, flat and folded,
+#: are welded into one (see :func:`simulator_svg_pattern`): two points left that close flat
+#: are apart folded, and any two farther apart flat are at least 10 user units apart (the
+#: drawing is 1e6 user units or more wide when such points set its scale), over three times
+#: the simulator's merge tolerance.
+SIM_SVG_WELD = 1e-5
 
 
 def triangle_min_angles(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -658,14 +668,16 @@ def _clean_slivers(
             for v in corners:
                 at[v].add(f)
         moves = 0
+        sides = _FlatSides(tri, v2, current.edges[current.edge_assignment == "B"])
         for t in bad[np.argsort(quality[bad], kind="stable")].tolist():
             if not alive[t]:
                 continue
-            move = _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle)
+            move = _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle, sides)
             if move is None:
                 continue
             moves += 1
             _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n)
+            sides.add(_new_sides(tri, move), tri[alive])
         tri, patch = tri[alive], [p for p, a in zip(patch, alive, strict=True) if a]
         piece = piece[alive]
         if not moves:
@@ -727,7 +739,67 @@ def _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n) -> None:
         fdeg[v] = sum(is_feature.get(edge(v, x), False) for x in near)
 
 
-def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle):
+class _FlatSides:
+    """The sides of a triangulation's flat layout, to look up which sides a new one crosses
+    (a collapse along a border moves the border, which can then cut across a thin notch of
+    its piece): a search tree of the sides as they were when it was last made, and a list
+    of the sides made since, made into the tree again every ``SIDES_REBUILD`` of them."""
+
+    def __init__(self, tri: np.ndarray, v2: np.ndarray, border: np.ndarray):
+        self.v2 = v2
+        self.on_border = np.zeros(len(v2), dtype=bool)
+        self.on_border[np.asarray(border, dtype=np.int64).ravel()] = True
+        self.rebuild(tri)
+
+    def rebuild(self, tri: np.ndarray) -> None:
+        """Start again from the triangles ``tri`` (k, 3)."""
+        import shapely
+
+        n = len(self.v2)
+        ends = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+        key = np.unique(ends[:, 0] * n + ends[:, 1])
+        self.sides = np.stack([key // n, key % n], axis=1)
+        self.tree = shapely.STRtree(shapely.linestrings(self.v2[self.sides]))
+        self.added = np.zeros((0, 2), dtype=np.int64)
+
+    def add(self, sides: np.ndarray, tri: np.ndarray) -> None:
+        """Sides (k, 2) just made; ``tri`` the live triangles, to start again from when the
+        list is long."""
+        self.added = np.concatenate([self.added, np.asarray(sides, dtype=np.int64)])
+        if len(self.added) > SIDES_REBUILD:
+            self.rebuild(tri)
+
+    def crossed(self, new: np.ndarray, gone: int) -> bool:
+        """Whether a side of ``new`` (k, 2) crosses or touches, flat, a side it shares no
+        point with (sides at ``gone``, the point a collapse removes, do not count)."""
+        import shapely
+
+        lines = shapely.linestrings(self.v2[new])
+        i, j = self.tree.query(lines, predicate="intersects")
+        others = [(new[i], self.sides[j])]
+        if len(self.added):  # boxes first, then the segments whose boxes meet
+            p, q = self.v2[new], self.v2[self.added]  # (k, 2, 2), (m, 2, 2)
+            lo, hi, lo2, hi2 = p.min(axis=1), p.max(axis=1), q.min(axis=1), q.max(axis=1)
+            box = (lo[:, None] <= hi2[None]).all(axis=2) & (lo2[None] <= hi[:, None]).all(axis=2)
+            i, j = np.nonzero(box)
+            hit = shapely.intersects(lines[i], shapely.linestrings(q[j]))
+            others.append((new[i[hit]], self.added[j[hit]]))
+        for a, b in others:
+            apart = (a[:, :, None] != b[:, None, :]).all(axis=(1, 2)) & (b != gone).all(axis=1)
+            if apart.any():
+                return True
+        return False
+
+
+def _new_sides(tri: np.ndarray, move) -> np.ndarray:
+    """(k, 2) the sides of the faces a move of :func:`_best_move` changed, as they are now."""
+    changed, new, _, _ = move
+    kept = [f for f, corners in zip(changed, new, strict=True) if corners is not None]
+    t = tri[kept].reshape(-1, 3)
+    return np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+
+
+def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle, flat=None):
     """The best collapse or flip for the sliver ``t`` (see :func:`_clean_slivers`): the
     changed faces, their new corners (None: removed), the point moved (None, or (vertex,
     flat, folded position)) and, for a collapse, the point removed and the one that takes
@@ -735,7 +807,9 @@ def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle):
     faces.
 
     A side shorter than ``tan(min_angle)`` times the longest, whose ends both lie on creases
-    or borders, may also be collapsed to its midpoint (the one move that moves a point)."""
+    or borders, may also be collapsed to its midpoint (the one move that moves a point). With
+    ``flat`` (:class:`_FlatSides`), a collapse whose sides would cross a side of the pattern
+    in the flat layout is not taken."""
     n = len(v2)
     corners = tri[t].tolist()
     around = {v: np.array(sorted(at[v]), dtype=np.int64) for v in corners}
@@ -754,6 +828,7 @@ def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle):
             for keep in sorted(ring):
                 if is_feature.get(min(go, keep) * n + max(go, keep), False):
                     tries.append((keep, go, keep, go, True, 0.0))
+    collapses = []  # (quality, move, its triangles), each better than the sliver
     for keep, go, a, b, edge_feature, length in tries:
         moved = None
         if go == -1:  # both ends on features: the midpoint, for a short side only
@@ -786,7 +861,13 @@ def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle):
             continue
         q = _move_quality(k, v2, v3, moved, shift)
         if q > best_q:
-            best, best_q = (faces.tolist(), new, moved, (go, keep)), q
+            collapses.append((q, (faces.tolist(), new, moved, (go, keep)), k))
+    # the best collapse whose sides cross none of the pattern's
+    for q, move, k in sorted(collapses, key=lambda c: -c[0]):
+        go, keep = move[3]
+        if flat is None or not _crosses(flat, k, keep, go, move[2]):
+            best, best_q = move, q
+            break
     # flip the longest side inside one smooth patch
     a, b = sides[int(np.argmax(lengths))]
     if not is_feature.get(min(a, b) * n + max(a, b), True):
@@ -807,6 +888,26 @@ def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle):
             if q > best_q:
                 best, best_q = ([t, o], new, None, None), q
     return best
+
+
+def _crosses(sides: _FlatSides, k: np.ndarray, keep: int, go: int, moved) -> bool:
+    """Whether a collapse's triangles ``k`` (j, 3) have a side at ``keep`` that crosses a
+    side of the pattern flat (see :class:`_FlatSides`); a moved ``keep`` is looked at in
+    its new place. A point ``go`` inside its piece leaves its ring as it was, which the new
+    triangles, all counter-clockwise, fill: only a collapse of a border point (or a move)
+    can cross."""
+    if moved is None and not sides.on_border[go]:
+        return False
+    e = np.sort(np.concatenate([k[:, [0, 1]], k[:, [1, 2]], k[:, [2, 0]]]), axis=1)
+    e = np.unique(e[(e == keep).any(axis=1)], axis=0)
+    if moved is None:
+        return sides.crossed(e, go)
+    old = sides.v2[keep].copy()
+    sides.v2[keep] = moved[1]
+    try:
+        return sides.crossed(e, go)
+    finally:
+        sides.v2[keep] = old
 
 
 def _move_quality(
@@ -950,16 +1051,47 @@ def _merged_patches(
             if made[key] is None:
                 back.append(going)
             else:
-                out.append((int(group[0]), made[key]))
+                out.append((int(group[0]), made[key], going))
+        if not back:
+            back = [out[k][2] for k in _crossing_groups(v2, out)]
         if not back:
             break
         gone[np.concatenate(back)] = False
     out_faces, out_patch, out_piece = [], [], []
-    for f0, tris in sorted(out):
+    for f0, tris, _ in sorted(out, key=lambda item: item[0]):
         out_faces += tris
         out_patch += [pattern.face_patch[f0]] * len(tris)
         out_piece += [int(pattern.face_piece[f0])] * len(tris)
     return out_faces, out_patch, out_piece
+
+
+def _crossing_groups(v2: np.ndarray, out: list) -> list[int]:
+    """The merged groups of ``out`` (each ``(face, triangles, points gone)``) whose triangles
+    have a side that crosses or touches, in the flat layout, a side it shares no point with:
+    a chord across a thin notch of its piece, which the simulator's SVG import would split
+    (and which overlaps the pattern). Only groups that dropped points are named."""
+    import shapely
+
+    tri = np.array([t for _, tris, _ in out for t in tris], dtype=np.int64).reshape(-1, 3)
+    group = np.repeat(np.arange(len(out)), [len(tris) for _, tris, _ in out])
+    merged = np.array([len(going) > 0 for _, _, going in out], dtype=bool)
+    if not merged.any():
+        return []
+    sides = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    side_group = np.tile(group, 3)
+    edges, first = np.unique(sides, axis=0, return_index=True)
+    lines = shapely.linestrings(v2[edges])
+    mine = np.nonzero(merged[side_group[first]])[0]  # (one group of) each side of a merge
+    a, b = shapely.STRtree(lines).query(lines[mine], predicate="intersects")
+    a = mine[a]
+    apart = (edges[a][:, :, None] != edges[b][:, None, :]).all(axis=(1, 2))
+    bad_sides = np.unique(np.r_[a[apart], b[apart]])
+    if not len(bad_sides):
+        return []
+    n = len(v2)
+    bad = np.isin(sides[:, 0] * n + sides[:, 1], edges[bad_sides] @ [n, 1])  # as triangle sides
+    hit = np.unique(side_group[np.nonzero(bad)[0]])
+    return [int(k) for k in hit if merged[k]]
 
 
 def _outline(faces: list[np.ndarray]) -> list[int] | None:
@@ -996,6 +1128,14 @@ def simulator_svg_pattern(coarse: CreasePattern) -> CreasePattern:
     at the same stiffness as a facet). Tabs, labels and sheets are left out, as in
     ``simulator.fold``.
 
+    An SVG cannot keep apart two points at one place, and the import merges points closer
+    than 3 user units: a real mesh's piece whose border touches itself (the two sides of
+    the notch of a nearly flat sharp vertex, closed when folded) would be merged there
+    without its edges, and the faces the import then traces across the notch blow its solver
+    up. So points within ``SIM_SVG_WELD`` of the drawing's size, flat and folded, are welded
+    here first: the sides they close become one edge, a crease or facet by its folded
+    dihedral, and the faces of the notch that would be degenerate go.
+
     Parameters
     ----------
     coarse : CreasePattern
@@ -1004,21 +1144,57 @@ def simulator_svg_pattern(coarse: CreasePattern) -> CreasePattern:
     Returns
     -------
     CreasePattern
-        The same points and faces, with new edge assignments and fold angles and no
-        annotations.
+        The welded points and faces, with their edge assignments and fold angles as drawn and
+        no annotations.
     """
     import dataclasses
 
     from ..surface.pattern import Annotations
     from .fold import edge_dihedrals
 
-    assign = np.asarray(coarse.edge_assignment, dtype="<U1").copy()
-    angle = np.asarray(coarse.edge_fold_angle, dtype=np.float64).copy()
+    pattern = _welded(coarse, SIM_SVG_WELD)
+    assign = np.asarray(pattern.edge_assignment, dtype="<U1").copy()
+    angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64).copy()
     flat = assign == "F"
-    dihedral = np.nan_to_num(edge_dihedrals(coarse))
+    dihedral = np.nan_to_num(edge_dihedrals(pattern))
     bent = flat & (np.abs(dihedral) >= SIM_SVG_FLAT)
     assign[bent] = np.where(dihedral[bent] > 0, "V", "M")  # FOLD: valley positive
     angle[bent] = dihedral[bent]
     return dataclasses.replace(
-        coarse, edge_assignment=assign, edge_fold_angle=angle, annotations=Annotations()
+        pattern, edge_assignment=assign, edge_fold_angle=angle, annotations=Annotations()
+    )
+
+
+def _welded(pattern: CreasePattern, share: float) -> CreasePattern:
+    """``pattern`` (triangles) with its points closer than ``share`` of the flat extent
+    (larger side) flat and of the folded diameter folded merged into the least-numbered one
+    (edges derived again), and the triangles left with a repeated corner dropped; ``pattern``
+    itself when no points are that close."""
+    from scipy.spatial import cKDTree
+
+    v2, v3 = pattern.vertices_2d, pattern.vertices_3d
+    n = len(v2)
+    if n < 2:
+        return pattern
+    extent = float(np.ptp(v2, axis=0).max())
+    size = float(np.linalg.norm(np.ptp(v3, axis=0)))
+    pairs = cKDTree(v2).query_pairs(share * extent, output_type="ndarray")
+    pairs = pairs[np.linalg.norm(v3[pairs[:, 0]] - v3[pairs[:, 1]], axis=1) <= share * size]
+    if not len(pairs):
+        return pattern
+    rep = _components(n, pairs)
+    keep = np.unique(rep)
+    new_index = -np.ones(n, dtype=np.int64)
+    new_index[keep] = np.arange(len(keep))
+    tri = new_index[rep[np.asarray(_split_faces(pattern), dtype=np.int64).reshape(-1, 3)]]
+    ok = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 2] != tri[:, 0])
+    patches = [p for p, good in zip(pattern.face_patch, ok.tolist(), strict=True) if good]
+    return CreasePattern(
+        v2[keep],
+        v3[keep],
+        tri[ok],
+        patches,
+        np.asarray(pattern.face_piece, dtype=np.int64)[ok],
+        pattern.piece_vertex,
+        annotations=pattern.annotations,
     )
