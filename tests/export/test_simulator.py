@@ -406,3 +406,18 @@ def test_collapsed_strips_turn_no_face_over():
         assert len(set(f.tolist())) == len(f)
         x, y = v2[f, 0], v2[f, 1]
         assert (x * np.roll(y, -1) - np.roll(x, -1) * y).sum() > 0
+
+
+def test_crossing_groups_names_the_merged_group_whose_chord_crosses():
+    """The guard in ``_merged_patches`` (no merge on the corpus needs it): a merged group's
+    triangle whose side cuts across another group's is named; touching at a shared point,
+    or an unmerged group crossing, is not."""
+    from filletfold.export.simulator import _crossing_groups
+
+    v2 = np.array([[0, 0], [4, 0], [2, 3], [2, 1], [5, 2], [5, 4], [4, 1]], dtype=float)
+    merged = (0, [[0, 1, 2]], np.array([9]))
+    crossing = (1, [[3, 4, 5]], np.array([], dtype=np.int64))  # side 3-4 cuts side 1-2
+    assert _crossing_groups(v2, [merged, crossing]) == [0]
+    assert _crossing_groups(v2, [(0, [[0, 1, 2]], np.array([], dtype=np.int64)), crossing]) == []
+    apart = (1, [[1, 4, 5]], np.array([], dtype=np.int64))  # shares point 1 only
+    assert _crossing_groups(v2, [merged, apart]) == []

@@ -739,6 +739,17 @@ def _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n) -> None:
         fdeg[v] = sum(is_feature.get(edge(v, x), False) for x in near)
 
 
+def _triangle_sides(tri: np.ndarray) -> np.ndarray:
+    """(3k, 2) the sides of the triangles ``tri`` (k, 3), each with its lower point first:
+    the first sides of all triangles, then the second, then the third."""
+    return np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+
+
+def _apart(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k,) bool: which pairs of sides ``a`` (k, 2) and ``b`` (k, 2) share no point."""
+    return (a[:, :, None] != b[:, None, :]).all(axis=(1, 2))
+
+
 class _FlatSides:
     """The sides of a triangulation's flat layout, to look up which sides a new one crosses
     (a collapse along a border moves the border, which can then cut across a thin notch of
@@ -756,7 +767,7 @@ class _FlatSides:
         import shapely
 
         n = len(self.v2)
-        ends = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+        ends = _triangle_sides(tri)
         key = np.unique(ends[:, 0] * n + ends[:, 1])
         self.sides = np.stack([key // n, key % n], axis=1)
         self.tree = shapely.STRtree(shapely.linestrings(self.v2[self.sides]))
@@ -769,34 +780,34 @@ class _FlatSides:
         if len(self.added) > SIDES_REBUILD:
             self.rebuild(tri)
 
-    def crossed(self, new: np.ndarray, gone: int) -> bool:
+    def crossed(self, new: np.ndarray, gone: int, moved=None) -> bool:
         """Whether a side of ``new`` (k, 2) crosses or touches, flat, a side it shares no
-        point with (sides at ``gone``, the point a collapse removes, do not count)."""
+        point with (sides at ``gone``, the point a collapse removes, do not count); with
+        ``moved`` (vertex, flat position, folded position), the sides of ``new`` at that
+        vertex are looked at with it in its new place."""
         import shapely
 
-        lines = shapely.linestrings(self.v2[new])
+        p = self.v2[new]  # (k, 2, 2)
+        if moved is not None:
+            p = np.where((new == moved[0])[:, :, None], moved[1], p)
+        lines = shapely.linestrings(p)
         i, j = self.tree.query(lines, predicate="intersects")
         others = [(new[i], self.sides[j])]
         if len(self.added):  # boxes first, then the segments whose boxes meet
-            p, q = self.v2[new], self.v2[self.added]  # (k, 2, 2), (m, 2, 2)
+            q = self.v2[self.added]  # (m, 2, 2)
             lo, hi, lo2, hi2 = p.min(axis=1), p.max(axis=1), q.min(axis=1), q.max(axis=1)
             box = (lo[:, None] <= hi2[None]).all(axis=2) & (lo2[None] <= hi[:, None]).all(axis=2)
             i, j = np.nonzero(box)
             hit = shapely.intersects(lines[i], shapely.linestrings(q[j]))
             others.append((new[i[hit]], self.added[j[hit]]))
-        for a, b in others:
-            apart = (a[:, :, None] != b[:, None, :]).all(axis=(1, 2)) & (b != gone).all(axis=1)
-            if apart.any():
-                return True
-        return False
+        return any((_apart(a, b) & (b != gone).all(axis=1)).any() for a, b in others)
 
 
 def _new_sides(tri: np.ndarray, move) -> np.ndarray:
     """(k, 2) the sides of the faces a move of :func:`_best_move` changed, as they are now."""
     changed, new, _, _ = move
     kept = [f for f, corners in zip(changed, new, strict=True) if corners is not None]
-    t = tri[kept].reshape(-1, 3)
-    return np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    return _triangle_sides(tri[kept].reshape(-1, 3))
 
 
 def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle, flat=None):
@@ -898,16 +909,8 @@ def _crosses(sides: _FlatSides, k: np.ndarray, keep: int, go: int, moved) -> boo
     can cross."""
     if moved is None and not sides.on_border[go]:
         return False
-    e = np.sort(np.concatenate([k[:, [0, 1]], k[:, [1, 2]], k[:, [2, 0]]]), axis=1)
-    e = np.unique(e[(e == keep).any(axis=1)], axis=0)
-    if moved is None:
-        return sides.crossed(e, go)
-    old = sides.v2[keep].copy()
-    sides.v2[keep] = moved[1]
-    try:
-        return sides.crossed(e, go)
-    finally:
-        sides.v2[keep] = old
+    e = _triangle_sides(k)
+    return sides.crossed(np.unique(e[(e == keep).any(axis=1)], axis=0), go, moved)
 
 
 def _move_quality(
@@ -1077,14 +1080,14 @@ def _crossing_groups(v2: np.ndarray, out: list) -> list[int]:
     merged = np.array([len(going) > 0 for _, _, going in out], dtype=bool)
     if not merged.any():
         return []
-    sides = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    sides = _triangle_sides(tri)
     side_group = np.tile(group, 3)
     edges, first = np.unique(sides, axis=0, return_index=True)
     lines = shapely.linestrings(v2[edges])
     mine = np.nonzero(merged[side_group[first]])[0]  # (one group of) each side of a merge
     a, b = shapely.STRtree(lines).query(lines[mine], predicate="intersects")
     a = mine[a]
-    apart = (edges[a][:, :, None] != edges[b][:, None, :]).all(axis=(1, 2))
+    apart = _apart(edges[a], edges[b])
     bad_sides = np.unique(np.r_[a[apart], b[apart]])
     if not len(bad_sides):
         return []
