@@ -31,10 +31,6 @@ from .solve import VertexResult, classify_vertices, solve_apices
 #: named.
 SHARP_KINDS = ("saddle", "infeasible", "boundary")
 
-#: Rounds of :func:`sharpen_vertices` at most (each makes the newly infeasible neighbours of
-#: the last round's sharp vertices sharp).
-MAX_ROUNDS = 8
-
 
 def parse_sharp(spec) -> frozenset:
     """The kinds named by ``spec``: ``"none"``, ``"all"``, or a comma-separated subset of
@@ -180,7 +176,10 @@ def sharpen_vertices(
     if not kinds:
         return rounding, centres, out
     ends = mesh.edges
-    for _ in range(MAX_ROUNDS):
+    # rounds until no vertex of ``kinds`` is left without its corner: each makes the newly
+    # infeasible neighbours of the last round's sharp vertices sharp, and every round adds one
+    # at least, so there are at most n (fandisk, a CAD part with feature lines, takes 22)
+    while True:
         new = np.array(
             [u for u in range(n) if not sharp[u] and sharp_kind(res.status[u]) in kinds],
             dtype=np.int64,
