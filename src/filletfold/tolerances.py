@@ -65,7 +65,7 @@ class Tolerances:
         certificate's smallest edge (1e-7 of the design); arcs are also sampled no finer than
         ``2 * ruling`` of the size.
     fold : float
-        Smallest angle (radians; 0.6 degrees) between a straight crease's cone triangle and
+        Smallest angle (radians; 1.03 degrees) between a straight crease's cone triangle and
         its face: the apex stays above each face's plane by at least ``sin(fold)`` times its
         distance from the crease on that face, so that no straight crease folds by more than
         180 degrees less this angle (an apex in a face's plane folds the cone flat onto it).
@@ -116,7 +116,7 @@ class Tolerances:
     validate: float = 1e-9
     fillet_floor: float = 1e-3
     min_fillet: float = 1e-6
-    fold: float = 0.0105
+    fold: float = 0.018
     ruling: float = 2e-7
     parallel: float = 1e-12
     coincide: float = 1e-14

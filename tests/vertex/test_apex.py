@@ -34,6 +34,23 @@ def _reference_validate(frame, V, v, sigma, n_samples=65, centres=None) -> ApexC
     nonint = sigma * np.einsum("ij,ij->i", d, N)
     l_min = _reference_refined_min(sa, V, l, s, first, vi=vi, dn=dn)
     nonint_min = _reference_refined_min(sa, V, nonint, s, first, sigma=sigma)
+    # the curved crease's fold: across F(s) the cone leaves along V - F and the cylinder along
+    # -R, both made normal to F'(s) = C'(s) + l'(s) R, with l' = num' / (2 dn) and
+    # num' = -2 (v_x - s) + 2 (V - C) . C'; their angle is at least tol.fold
+    r = np.where(sa.radius[side] > 0, sa.radius[side], 1.0)
+    dC = sa.kappa[side, None] * (
+        -np.sin(s / r)[:, None] * sa.N0[side] + np.cos(s / r)[:, None] * sa.B[side]
+    )
+    dnum = -2 * (vi[side, 0] - s) + 2 * np.einsum("ij,ij->i", d, dC)
+    dF = dC + (0.5 * dnum / np.where(valid, dn, 1.0)[side])[:, None] * sa.R[side]
+    u = dF / np.linalg.norm(dF, axis=1)[:, None]
+    cone = d - l[:, None] * sa.R[side]
+    cone -= np.einsum("ij,ij->i", cone, u)[:, None] * u
+    cyl = -sa.R[side] + np.einsum("ij,ij->i", sa.R[side], u)[:, None] * u
+    cyl /= np.linalg.norm(cyl, axis=1)[:, None]
+    crease = np.cos(tol.fold) * nonint - np.sin(tol.fold) * np.einsum("ij,ij->i", cone, cyl)
+    measured = valid[side] & (sa.radius[side] > 0) & ~sa.conical[side]
+    crease = np.minimum.reduceat(np.where(measured, crease, np.inf), first)
     checks = np.stack(
         [
             dn,
@@ -44,14 +61,15 @@ def _reference_validate(frame, V, v, sigma, n_samples=65, centres=None) -> ApexC
                 -np.inf,
             ),
             nonint_min,
+            crease,
         ],
         axis=1,
     )
     slack = [checks.ravel()]
     failing = []
-    strict = np.array([True, False, False, True])
+    strict = np.array([True, False, False, True, True])
     bad = np.where(strict, checks < eps, checks < -eps)
-    names = ("patch", "l_min", "l_max", "nonint")
+    names = ("patch", "l_min", "l_max", "nonint", "crease")
     for i, c in zip(*np.nonzero(bad), strict=True):
         failing.append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
     nf = len(frame.ring.faces)

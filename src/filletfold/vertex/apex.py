@@ -56,6 +56,7 @@ KINDS = {
     "face": "apex on the wrong side of a face",
     "centre": "the straight crease passes the face piece's centre",
     "fold": "straight crease folds flat (apex too near a face's plane, over the face)",
+    "crease": "curved crease folds flat (apex too near the cylinder's tangent plane)",
 }
 
 
@@ -639,16 +640,18 @@ def validate_apices(
             lower = b < best[cone]
             best[cone[lower]], at[cone[lower]] = b[lower], t[lower]
     floor = np.zeros(n) if floors is None else np.asarray(floors, dtype=float).reshape(n)
+    crease = _curved_crease_fold(sa, V, vi, dn, side, s, C, N, l, nonint, valid)
     checks = np.stack(
         [
             dn,
             np.where(valid, l_min - floor[vert], -np.inf),
             np.where(valid, np.minimum(lmax_start - l[first], lmax_end - l[last]), -np.inf),
             nonint_min,
+            np.minimum.reduceat(crease, first),
         ],
         axis=1,
-    )  # (K, 4): patch, l_min, l_max, nonint
-    strict = np.array([True, False, False, True])
+    )  # (K, 5): patch, l_min, l_max, nonint, crease
+    strict = np.array([True, False, False, True, True])
     e_side = eps[vert][:, None]
     bad = np.where(strict, checks < e_side, checks < -e_side)
     # faces: side i of a vertex ends on its face i, side i + 1 starts on it
@@ -682,7 +685,7 @@ def validate_apices(
     np.minimum.at(margin, vert, checks.min(axis=1))
     np.minimum.at(margin, fvert, np.minimum(np.minimum(face_val, centre_val), fold_val))
     failing = [[] for _ in range(n)]
-    names = ("patch", "l_min", "l_max", "nonint")
+    names = ("patch", "l_min", "l_max", "nonint", "crease")
     for i, c in zip(*np.nonzero(bad), strict=True):
         failing[vert[i]].append(f"{KINDS[names[c]]} at edge {sa.edge[i]}")
     face_bad = np.stack([face_val < e_face, centre_val < e_face, fold_val < e_face], axis=1)
@@ -700,6 +703,39 @@ def validate_apices(
         ApexCheck(not fail, float(m), fail, np.array(c, dtype=float).reshape(-1, 2))
         for fail, m, c in zip(failing, margin, cuts, strict=True)
     ]
+
+
+def _curved_crease_fold(sa, V, vi, dn, side, s, C, N, l, nonint, valid) -> np.ndarray:
+    """(m,) slack of the curved crease's fold at every sample (length units, >= 0 valid):
+    the cone meets the cylinder along ``F(s)`` at an interior angle of at least ``tol.fold``,
+    so that no curved crease folds by more than 180 degrees less that angle.
+
+    In the plane across the crease (normal to ``F'(s) = C'(s) + l'(s) R``) the cylinder leaves
+    the crease along ``h``, ``-R`` made normal to ``F'``, and the cone along ``w``, ``V - F``
+    made normal to it; ``w . sigma N`` is the non-intersection value (eq. 2: ``F - C`` is
+    along ``R``, normal to ``N``). With ``alpha`` the angle from ``h`` to ``w``, the slack is
+    ``|w| sin(alpha - fold) = cos(fold) (w . sigma N) - sin(fold) (w . h)``. A conical side
+    (its chart turns with ``s``) is not measured here (``inf``)."""
+    out = np.full(len(s), np.inf)
+    rows = np.flatnonzero(~sa.conical[side] & (sa.radius[side] > 0) & valid[side])
+    if not len(rows):
+        return out
+    i, t = side[rows], s[rows]
+    r, kappa = sa.radius[i], sa.kappa[i]
+    P = np.einsum("ij,ij->i", V[i] - sa.O[i], sa.N0[i])
+    Q = np.einsum("ij,ij->i", V[i] - sa.O[i], sa.B[i])
+    d1, _ = numerator_arc_derivatives(vi[i, 0], t, kappa, r, P, Q)
+    c, sn = np.cos(t / r), np.sin(t / r)
+    dC = kappa[:, None] * (-sn[:, None] * sa.N0[i] + c[:, None] * sa.B[i])
+    R = sa.R[i]
+    dF = dC + (d1 / (2.0 * dn[i]))[:, None] * R
+    u = dF / np.linalg.norm(dF, axis=1)[:, None]
+    w = V[i] - (C[rows] + l[rows, None] * R)
+    w = w - np.einsum("ij,ij->i", w, u)[:, None] * u
+    h = -(R - np.einsum("ij,ij->i", R, u)[:, None] * u)
+    h /= np.linalg.norm(h, axis=1)[:, None]
+    out[rows] = np.cos(tol.fold) * nonint[rows] - np.sin(tol.fold) * np.einsum("ij,ij->i", w, h)
+    return out
 
 
 def _stack(arrays: Sequence[SideArrays]) -> SideArrays:
