@@ -190,6 +190,23 @@ def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
     for k in np.nonzero(crease)[0]:
         fa, fb = p.edge_faces[k]
         u = max(cone_of[fa], cone_of[fb])
+        if cone_of[fa] == cone_of[fb] >= 0:  # inside a cone: the ruling to a sharp edge
+            a, b = p.vertices_3d[p.edges[k]]
+            apex = d.vertices.apex[u]
+            far = b if np.linalg.norm(a - apex) < np.linalg.norm(b - apex) else a
+            assert min(np.linalg.norm(a - apex), np.linalg.norm(b - apex)) < 1e-9
+            on = []
+            for e in np.flatnonzero((m.edges == u).any(axis=1) & ~(rd.radius > 0)):
+                q, r = m.vertices[m.edges[e]]
+                t = np.clip((far - q) @ (r - q) / ((r - q) @ (r - q)), 0, 1)
+                if np.linalg.norm(far - q - t * (r - q)) < 1e-9 * np.ptp(m.vertices):
+                    on.append(e)
+            assert on, f"crease {k} inside cone {u} is not a ruling to an unrounded edge"
+            # a dimple (apex behind, sigma = -1) is a valley along a convex edge
+            assert p.edge_assignment[k] == (
+                "M" if rd.kappa[on[0]] * d.vertices.sigma[u] > 0 else "V"
+            )
+            continue
         if u < 0:  # two face pieces: a sharp edge
             e = edge_of[tuple(sorted((face_of[fa], face_of[fb])))]
             assert rd.sharp[e], "every crease borders a cone or lies on a sharp edge"
@@ -234,7 +251,9 @@ def check_crease_loop_closes_around_every_cone(d):
         faces = [i for i, s in enumerate(p.face_patch) if s == f"cone {u}"]
         if len(set(p.face_piece[faces])) != 1:
             continue  # a module split in several pieces
+        inner = np.isin(p.edge_faces, faces).all(axis=1)  # rulings to sharp edges
         sel = np.isin(p.edge_faces, faces).any(axis=1) & np.isin(p.edge_assignment, ["M", "V"])
+        sel &= ~inner
         deg = np.bincount(p.edges[sel].ravel(), minlength=len(p.vertices_2d))
         ends = np.nonzero(deg == 1)[0]
         assert set(deg[deg > 0]) <= {1, 2} and len(ends) in (0, 2)

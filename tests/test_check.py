@@ -7,6 +7,7 @@ import dataclasses
 import functools
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -40,6 +41,8 @@ CHECKS = [
     "fold-angle match",
     "fold-angle range",
     "smallest fold angle",
+    "facet folds",
+    "edge lengths",
     "no overlap",
     "face orientation",
     "smallest edge",
@@ -403,6 +406,104 @@ def test_check_exits_1_when_the_file_breaks_an_invariant(tmp_path, capsys):
     out = capsys.readouterr().out.splitlines()
     assert [line.split()[0] for line in out if " FAIL " in line] == ["M/V", "fold-angle"]
     assert out[-1].startswith("NOT VALID: 2 check(s) fail")
+
+
+def _fold_arrays(doc):
+    v2 = np.array(doc["vertices_coords"], dtype=float)
+    v3 = np.array(doc["file_frames"][0]["vertices_coords"], dtype=float)
+    return v2, v3, np.array(doc["edges_vertices"]), doc["edges_assignment"]
+
+
+def _cone_facet_edge(doc):
+    """An F edge between two triangles of one cone, the corner of the second triangle off
+    it, and the edge's index (from the FOLD alone)."""
+    _, _, ev, assign = _fold_arrays(doc)
+    faces, patch = doc["faces_vertices"], doc["filletfold:faces_patch"]
+    owner = {}
+    for f, corners in enumerate(faces):
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+            owner.setdefault((min(a, b), max(a, b)), []).append(f)
+    for e, (a, b) in enumerate(ev.tolist()):
+        fs = owner.get((min(a, b), max(a, b)), [])
+        if assign[e] != "F" or len(fs) != 2 or not patch[fs[0]].startswith("cone "):
+            continue
+        if patch[fs[0]] == patch[fs[1]] and len(faces[fs[1]]) == 3:
+            (c,) = set(faces[fs[1]]) - {a, b}
+            if c not in faces[fs[0]]:
+                return e, a, b, c
+    raise AssertionError("no facet edge inside a cone")
+
+
+def _rotate(p, a, b, deg):
+    """``p`` turned by ``deg`` degrees about the line through ``a`` and ``b``."""
+    k = (b - a) / np.linalg.norm(b - a)
+    q = p - a
+    t = math.radians(deg)
+    return a + q * math.cos(t) + np.cross(k, q) * math.sin(t) + k * (k @ q) * (1 - math.cos(t))
+
+
+def test_check_names_a_facet_folded_30_degrees_and_an_edge_stretched_1_percent(tmp_path, capsys):
+    """Two designs broken on purpose, each read from its files alone: a cone's facet turned by
+    30 degrees about its F edge (a moved folded vertex), and one pattern edge 1% longer flat
+    than folded. ``filletfold check`` fails each, naming the edge."""
+    folder = tmp_path / "facet"
+    design_of("icosahedron").export(folder, formats="fold,json")
+    with open(folder / "design.fold") as fh:
+        e, a, b, c = _cone_facet_edge(json.load(fh))
+
+    def fold_facet(doc):
+        v3 = doc["file_frames"][0]["vertices_coords"]
+        p = [np.array(v3[i], dtype=float) for i in (a, b, c)]
+        v3[c] = _rotate(p[2], p[0], p[1], 30.0).tolist()
+
+    _rewrite_fold(folder, fold_facet)
+    cert = check_folder(folder)
+    assert "facet folds" in _failed(cert)
+    assert cert["facet folds"].value > 29.0, cert["facet folds"].line()
+    named = dict(re.findall(r"(\d+) \(([0-9.]+) deg\)", cert["facet folds"].detail))
+    assert 30.0 <= float(named[str(e)]) < 30.0 + 2 * 1.5, cert["facet folds"].line()
+    assert main(["check", str(folder)]) == 1
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("facet folds"))
+    assert " FAIL " in line and (f", {e} (" in line or f"edges {e} (" in line)
+
+    folder = tmp_path / "stretch"
+    design_of("icosahedron").export(folder, formats="fold,json")
+    with open(folder / "design.fold") as fh:
+        v2, _, ev, assign = _fold_arrays(json.load(fh))
+    length = np.linalg.norm(v2[ev[:, 1]] - v2[ev[:, 0]], axis=1)
+    e = int(np.flatnonzero(np.array(assign) == "F")[np.argmax(length[np.array(assign) == "F"])])
+    a, b = ev[e]
+
+    def stretch(doc):
+        p = np.array(doc["vertices_coords"], dtype=float)
+        doc["vertices_coords"][b] = (p[a] + 1.01 * (p[b] - p[a])).tolist()
+
+    _rewrite_fold(folder, stretch)
+    cert = check_folder(folder)
+    assert "edge lengths" in _failed(cert)
+    named = dict(re.findall(r"(\d+) \(([0-9.e-]+)\)", cert["edge lengths"].detail))
+    assert float(named[str(e)]) == pytest.approx(0.01 / 1.01, rel=0.02), cert["edge lengths"].line()
+    assert main(["check", str(folder)]) == 1
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("edge lengths"))
+    assert " FAIL " in line and (f", {e} (" in line or f"edges {e} (" in line)
+
+
+def test_a_crease_inside_a_cone_must_end_on_an_unrounded_edge():
+    """The ruling to an edge left sharp is a crease inside its cone (an icosahedron vertex
+    with one edge unrounded); written as a crease anywhere else in a cone, it fails."""
+    d = design_of("icosahedron", radius=0.1)
+    p = d.pattern
+    inner = np.flatnonzero((p.edge_assignment == "F") & (p.edge_faces >= 0).all(axis=1))
+    fa, fb = p.edge_faces[inner].T
+    patch = np.array(p.face_patch)
+    in_cone = (patch[fa] == patch[fb]) & np.char.startswith(patch[fa].astype(str), "cone ")
+    e = int(inner[in_cone][0])
+    assign, angle = p.edge_assignment.copy(), p.edge_fold_angle.copy()
+    assign[e], angle[e] = "M", -1.0  # a crease the cone does not have
+    cert = _certify(d, dataclasses.replace(p, edge_assignment=assign, edge_fold_angle=angle))
+    assert "facet folds" in _failed(cert)
+    assert cert["facet folds"].worst["pattern_edge"] == e
+    assert "not a ruling to an unrounded edge" in cert["facet folds"].detail
 
 
 def test_check_finds_overlapping_pieces_in_the_file(tmp_path):

@@ -16,6 +16,7 @@ import filletfold
 from filletfold.errors import MeshReadError, ParameterError
 from filletfold.export.outputs import edge_mismatch, relative_mismatch
 from filletfold.rounding.edges import round_edges
+from filletfold.surface.sampling import cone_sample_counts
 from filletfold.vertex.apex import crease_length
 from filletfold.vertex.frame import vertex_frame
 
@@ -110,10 +111,13 @@ def test_mismatch_converges_as_the_arc_step_shrinks(name):
 @pytest.mark.parametrize("step", [0.0, 0.7, 1.5, 5.0, 45.0])
 def test_arc_points_bound_the_turn_between_samples(step):
     """Every arc gets at most ``samples`` points, at least 2, and fewer only when the turn
-    between two samples stays within the arc step; the built modules use those counts."""
+    between two samples stays within the arc step; the built modules use those counts, or
+    more where a cone at the arc's end turns faster than the arc
+    (:func:`~filletfold.surface.sampling.cone_sample_counts`)."""
     d = design_of("blob", arc_step=step)
     rd = d.rounding
     n = rd.arc_points(24, step)
+    cones = cone_sample_counts(d.stages.solved, d.stages.centres, len(n), step)
     arcs = rd.arc_length > 0
     assert (n[~arcs] == 1).all() and (n[arcs] >= 2).all() and (n <= 24).all()
     turn = np.degrees(2 * rd.half_angle[arcs]) / (n[arcs] - 1)
@@ -125,7 +129,8 @@ def test_arc_points_bound_the_turn_between_samples(step):
         # one point less would exceed the step (unless already at the minimum of 2)
         more = fewer & (n[arcs] > 2)
         assert (np.degrees(2 * rd.half_angle[arcs][more]) / (n[arcs][more] - 2) > step).all()
-    assert_allclose(np.asarray(d.stages.samples), n)
+    assert_allclose(np.asarray(d.stages.samples), np.maximum(n, cones))
+    n = np.maximum(n, cones)
     # a cylinder patch of edge e has n[e] - 1 quads on each of its two modules' halves
     quads = {}
     for patch, face in zip(d.pattern.face_patch, d.pattern.faces, strict=True):

@@ -16,13 +16,23 @@ arrays over every pattern vertex, edge and face at once:
 5. ``M/V`` -- every M/V edge folds the way its assignment and fold angle say: the signed angle
    between its two faces' folded normals has the written sign (count of disagreements, limit
    0), and ``fold-angle match``: it is the written angle within ``ANGLE_TOL_DEG``;
-6. ``fold-angle range`` -- no crease folds flat: ``|angle| < MAX_FOLD_DEG``; and ``smallest fold
+6. ``fold-angle range`` -- no crease folds flat: ``|angle| <= MAX_FOLD_DEG`` (179), or the
+   mesh's sharpest dihedral where that is sharper, and ``< 180``; and ``smallest fold
    angle`` -- none is so small it is no crease at all: ``|angle| > MIN_FOLD_DEG``;
 7. ``no overlap`` -- no two faces overlap in 2D by more than ``OVERLAP_TOL`` of the smaller one
    (and every face is a simple polygon); ``face orientation`` -- every face is counter-clockwise
    (positive signed area) in 2D;
 8. ``smallest edge`` -- the shortest pattern edge (the shorter of its flat and folded lengths)
    is at least ``MIN_EDGE`` of the design size;
+
+9. ``facet folds`` -- no edge the pattern marks ``F`` (inside a smooth patch, or a
+   tangent-continuous join) folds by more than the design's facet limit (its arc step,
+   :func:`~filletfold.surface.sampling.facet_limit`) plus what the coordinates' rounding can
+   turn its faces by; and every crease inside one cone is a ruling from the apex to a mesh edge
+   left unrounded (the only place a cone is not smooth);
+10. ``edge lengths`` -- every pattern edge is as long folded as flat, up to what a chord
+   across a bent facet loses: ``(len2D - len3D) / len2D <= 1 - sin(t/2) / (t/2)`` for a
+   facet turning by twice the facet limit ``t`` (:data:`EDGE_TURNS`), plus the rounding;
 
 and, for information, the ``smallest face angle`` in 2D (slivers). The *design size* is the
 bounding-box diagonal of the folded form.
@@ -47,10 +57,12 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
 from .export.fold_read import _edge_faces, read_fold
 from .surface.pattern import CreasePattern, face_arrays
+from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
 
 __all__ = [
@@ -58,6 +70,7 @@ __all__ = [
     "APEX_TOL",
     "CONTRACTION_TOL",
     "CYLINDER_TOL",
+    "EDGE_TURNS",
     "FILE_ROUNDING",
     "LENGTH_QUANTA",
     "MAX_FOLD_DEG",
@@ -89,8 +102,13 @@ GLUE_TOL = 1e-9
 #: Largest difference between a written fold angle and the folded form's (degrees; plus the
 #: file's rounding). A recomputed angle this close to 0 has no sign to disagree with.
 ANGLE_TOL_DEG = 1e-6
-#: Every crease folds by less than this (degrees): 180 would fold the sheet flat onto itself.
-MAX_FOLD_DEG = 179.5
+#: No crease folds beyond this (degrees) unless the mesh has an edge as sharp (the limit is
+#: then the mesh's sharpest dihedral, always below 180, which would fold the sheet flat).
+MAX_FOLD_DEG = 179.0
+#: A facet's side across a bent patch may be shorter folded than flat by what the chord of an
+#: arc turning by this many facet limits loses (a facet turns by at most one limit from each
+#: neighbour, so a side across it by at most two).
+EDGE_TURNS = 2.0
 #: Every crease folds by more than this (degrees): less is no crease at all.
 MIN_FOLD_DEG = 1e-6
 #: Largest area two faces may share in 2D, as a share of the smaller one.
@@ -105,6 +123,8 @@ ROUNDOFF_ULPS = 16
 #: 3D length within ``2 sqrt(3) q`` of its own, so the two differ by this many ``q`` more.
 LENGTH_QUANTA = 2.0 * (math.sqrt(2.0) + math.sqrt(3.0))
 
+#: Failing elements a check names (the worst first).
+FAILING_NAMED = 5
 #: Convex faces of up to this many corners are told apart in numpy (separating axes).
 SAT_CORNERS = 8
 #: Face pairs separated per numpy block.
@@ -353,6 +373,8 @@ class _Data:
         rounded &= np.isfinite(axis).all(axis=1) & np.isfinite(direction).all(axis=1)
         self.axis_point, self.axis_dir, self.radius = axis, direction, r
         self.rounded = rounded
+        # the turn of every interior edge (the half angle; NaN where undefined)
+        self.half_angle = np.where((ef >= 0).all(axis=1), np.abs(gamma), np.nan)
         apex = np.asarray(vertex_apex, dtype=np.float64)
         if apex.shape != (len(self.mv), 3):
             raise ParameterError(
@@ -420,6 +442,7 @@ class _Data:
         self.l2 = np.linalg.norm(self.v2[e[:, 0]] - self.v2[e[:, 1]], axis=1)
         self.l3 = np.linalg.norm(self.v3[e[:, 0]] - self.v3[e[:, 1]], axis=1)
         self._keys = None
+        self._newell = None
 
     def edge_index(self, a: int, b: int) -> int:
         """The pattern edge between vertices ``a`` and ``b`` (-1 when there is none)."""
@@ -446,6 +469,7 @@ def certify(
     *,
     coord_quantum: float = 0.0,
     quantum_source: str = f"coordinates rounded to {FOLD_DIGITS} digits",
+    arc_step: float = DEFAULT_ARC_STEP,
 ) -> Certificate:
     """Measure the invariants of a crease pattern against the mesh it rounds.
 
@@ -470,6 +494,9 @@ def certify(
         ``sqrt(3) q (P_a / A_a + P_b / A_b)`` radians (``P`` perimeter, ``A`` area, in 3D).
     quantum_source : str
         Where ``coord_quantum`` comes from, for the lines of the certificate.
+    arc_step : float
+        The design's arc step (degrees; 0: none), which sets its facet limit
+        (:func:`~filletfold.surface.sampling.facet_limit`): ``facet folds`` and ``edge lengths``.
 
     Returns
     -------
@@ -491,6 +518,8 @@ def certify(
         _on_cylinders(data),
         _on_fillets(data),
         *_fold_angles(data),
+        _facet_folds(data, facet_limit(arc_step)),
+        _edge_lengths(data, facet_limit(arc_step)),
         *_overlap(data),
         _smallest_edge(data),
         _smallest_face_angle(data),
@@ -756,6 +785,138 @@ def _face_newell(g: _Data) -> tuple[np.ndarray, np.ndarray]:
     return newell, np.add.reduceat(side, g.start[:-1])
 
 
+def _folded(g: _Data, which: np.ndarray):
+    """For pattern edges ``which`` (k,): whether each has two faces, its fold angle in the
+    folded form (degrees, FOLD's sign: valley positive; NaN without two faces), and how far
+    that angle may be off: :data:`ANGLE_TOL_DEG` plus what rounding the corners by
+    ``sqrt(3) q`` can turn the two faces' normals by."""
+    ef = g.edge_faces[which]
+    two = (ef >= 0).all(axis=1)
+    if g._newell is None:
+        g._newell = _face_newell(g)
+    newell, perimeter = g._newell
+    norm = np.linalg.norm(newell, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = newell / norm[:, None]
+        fa, fb = np.where(ef >= 0, ef, 0).T
+        na, nb = unit[fa], unit[fb]
+        d = g.v3[g.edges[which, 1]] - g.v3[g.edges[which, 0]]
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
+        cos = np.einsum("ij,ij->i", na, nb)
+        folded = -np.degrees(np.arctan2(sin, cos))  # FOLD's sign: valley positive
+        slack = math.sqrt(3.0) * g.q * (2 * perimeter / norm)  # P / A, A = |newell| / 2
+        allowed = ANGLE_TOL_DEG + np.degrees(slack[fa] + slack[fb])
+    allowed = np.where(np.isfinite(allowed), allowed, np.inf)
+    folded = np.where(two & np.isfinite(folded), folded, np.nan)
+    return two, folded, allowed
+
+
+def _facet_folds(g: _Data, limit_deg: float) -> Check:
+    """``facet folds``: no ``F`` edge folds beyond ``limit_deg``; every crease inside one
+    cone is a ruling from its apex to a mesh edge left unrounded."""
+    name = "facet folds"
+    smooth = np.flatnonzero(g.assign == "F")
+    two, folded, allowed = _folded(g, smooth)
+    smooth, folded, allowed = smooth[two], folded[two], allowed[two]
+    detail = f"largest |fold| (deg) of {len(smooth)} F edges between two faces"
+    if not len(smooth):
+        return Check(name, True, float("nan"), limit_deg, "no F edge between two faces")
+    excess = np.abs(np.where(np.isnan(folded), 180.0, folded))
+    k = _ratio_worst(np.maximum(excess - limit_deg, 0.0), allowed)
+    if excess[k] <= limit_deg:
+        k = int(np.argmax(excess))
+    e = int(smooth[k])
+    fa, fb = g.edge_faces[e]
+    where = g.patch[fa] if g.patch[fa] == g.patch[fb] else f"{g.patch[fa]} | {g.patch[fb]}"
+    n_bad = int(np.count_nonzero(excess > limit_deg + allowed))
+    detail += f": pattern edge {e} ({where}, {excess[k]:.6g} deg)"
+    if n_bad:
+        over = np.flatnonzero(excess > limit_deg + allowed)
+        over = over[np.argsort(-excess[over], kind="stable")][:FAILING_NAMED]
+        named = ", ".join(f"{int(smooth[j])} ({excess[j]:.4g} deg)" for j in over)
+        detail += f"; {n_bad} F edge(s) fold beyond the facet limit: pattern edges {named}"
+    detail += (
+        f"; limit: the arc step {limit_deg:g} deg" if limit_deg < 180 else "; no limit (arc step 0)"
+    )
+    ok = n_bad == 0
+    worst = {"pattern_edge": e, "patch": where}
+    # creases inside one cone: rulings from its apex to an unrounded mesh edge
+    crease = np.flatnonzero(np.isin(g.assign, ("M", "V")))
+    ef = g.edge_faces[crease]
+    inner = (ef >= 0).all(axis=1)
+    crease, ef = crease[inner], ef[inner]
+    fa, fb = ef.T
+    in_cone = (g.kind[fa] == _CONE) & (g.kind[fb] == _CONE) & (g.index[fa] == g.index[fb])
+    crease, u = crease[in_cone], g.index[fa[in_cone]]
+    if len(crease):
+        bad = _not_sharp_rulings(g, crease, u)
+        detail += f"; {len(crease)} crease(s) inside cones"
+        if len(bad):
+            e = int(crease[bad[0]])
+            detail += (
+                f", {len(bad)} not a ruling to an unrounded edge: first pattern edge {e} "
+                f"(cone {int(u[bad[0]])})"
+            )
+            ok, worst = False, {"pattern_edge": e, "patch": f"cone {int(u[bad[0]])}"}
+    return Check(name, ok, float(excess[k]), limit_deg, detail, "<=", worst)
+
+
+def _not_sharp_rulings(g: _Data, crease: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Positions in ``crease`` (k,) (pattern edges inside the cones of mesh vertices ``u``)
+    of those that are not a ruling from the cone's apex to a point of an unrounded mesh edge
+    at ``u`` (within ``GLUE_TOL`` of the design size)."""
+    eps = GLUE_TOL * g.size + 4 * g.q
+    a, b = g.v3[g.edges[crease, 0]], g.v3[g.edges[crease, 1]]
+    apex = g.apex[u]
+    at_a = np.linalg.norm(a - apex, axis=1) <= eps
+    at_b = np.linalg.norm(b - apex, axis=1) <= eps
+    far = np.where(at_a[:, None], b, a)  # the end away from the apex
+    ok = np.zeros(len(crease), dtype=bool)
+    ev = g.edge_vertices
+    sharp = ~g.rounded
+    for j in np.flatnonzero(at_a ^ at_b).tolist():
+        mine = np.flatnonzero(sharp & ((ev[:, 0] == u[j]) | (ev[:, 1] == u[j])))
+        if len(mine):
+            dist = _distance_to_segments(
+                np.repeat(far[j][None], len(mine), axis=0), g.mv[ev[mine, 0]], g.mv[ev[mine, 1]]
+            )
+            ok[j] = bool((dist <= eps).any())
+    return np.flatnonzero(~ok)
+
+
+def _edge_lengths(g: _Data, limit_deg: float) -> Check:
+    """``edge lengths``: every pattern edge as long folded as flat, up to a chord's loss."""
+    name = "edge lengths"
+    if not len(g.edges):
+        return Check(name, True, float("nan"), 0.0, "no pattern edge")
+    bound = chord_mismatch_bound(EDGE_TURNS * limit_deg)
+    short = g.l2 - g.l3
+    allowed = bound * g.l2 + LENGTH_QUANTA * g.q
+    k = _ratio_worst(np.abs(short), allowed)
+    rel = float(abs(short[k]) / g.l2[k]) if g.l2[k] > 0 else float("inf")
+    n_bad = int(np.count_nonzero(np.abs(short) > allowed))
+    e = int(k)
+    fa, fb = g.edge_faces[e]
+    where = " | ".join(dict.fromkeys(g.patch[f] for f in (fa, fb) if f >= 0))
+    detail = (
+        f"|len2D - len3D| / len2D of {len(g.edges)} pattern edges: worst pattern edge {e} "
+        f"({g.assign[e]}, {where}; 2D {g.l2[e]:.6g}, 3D {g.l3[e]:.6g})"
+    )
+    if n_bad:
+        over = np.flatnonzero(np.abs(short) > allowed)
+        ratio = np.abs(short[over]) / np.where(g.l2[over] > 0, g.l2[over], 1.0)
+        order = np.argsort(-ratio, kind="stable")[:FAILING_NAMED]
+        named = ", ".join(f"{int(over[j])} ({ratio[j]:.4g})" for j in order)
+        detail += f"; {n_bad} edge(s) differ by more: pattern edges {named}"
+    detail += _quantum_note(
+        g.q, f"the chord of {EDGE_TURNS:g} x {limit_deg:g} deg: {bound:.3g}", g.q_source
+    )
+    limit = float(allowed[k] / g.l2[k]) if g.l2[k] > 0 else bound
+    worst = {"pattern_edge": e, "patch": where}
+    return Check(name, n_bad == 0, rel, limit, detail, "<=", worst)
+
+
 def _fold_angles(g: _Data) -> list[Check]:
     """``M/V``, ``fold-angle match``, ``fold-angle range`` and ``smallest fold angle``."""
     crease = np.flatnonzero(np.isin(g.assign, ("M", "V")))
@@ -765,29 +926,12 @@ def _fold_angles(g: _Data) -> list[Check]:
         return [
             Check(names[0], True, 0.0, 0.0, why),
             Check(names[1], True, float("nan"), ANGLE_TOL_DEG, why),
-            Check(names[2], True, float("nan"), MAX_FOLD_DEG, why, "<"),
+            Check(names[2], True, float("nan"), MAX_FOLD_DEG, why),
             Check(names[3], True, float("nan"), MIN_FOLD_DEG, why, ">"),
         ]
     m = g.assign[crease] == "M"
     written = g.angle[crease]
-    ef = g.edge_faces[crease]
-    two = (ef >= 0).all(axis=1)
-    newell, perimeter = _face_newell(g)
-    norm = np.linalg.norm(newell, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = newell / norm[:, None]
-        fa, fb = np.where(ef >= 0, ef, 0).T
-        na, nb = unit[fa], unit[fb]
-        d = g.v3[g.edges[crease, 1]] - g.v3[g.edges[crease, 0]]
-        d /= np.linalg.norm(d, axis=1)[:, None]
-        sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
-        cos = np.einsum("ij,ij->i", na, nb)
-        folded = -np.degrees(np.arctan2(sin, cos))  # FOLD's sign: valley positive
-        # what rounding the corners by sqrt(3) q can turn the two normals by
-        slack = math.sqrt(3.0) * g.q * (2 * perimeter / norm)  # P / A, A = |newell| / 2
-        allowed = ANGLE_TOL_DEG + np.degrees(slack[fa] + slack[fb])
-    allowed = np.where(np.isfinite(allowed), allowed, np.inf)
-    folded = np.where(two & np.isfinite(folded), folded, np.nan)
+    two, folded, allowed = _folded(g, crease)
     # M/V: the written angle has the assignment's sign, and so has the folded form's
     bad_written = np.where(m, written >= 0, written <= 0)
     with np.errstate(invalid="ignore"):
@@ -825,16 +969,19 @@ def _fold_angles(g: _Data) -> list[Check]:
         "<=",
         {"pattern_edge": e},
     )
-    # fold-angle range: no crease folds flat
+    # fold-angle range: no crease folds flat, nor beyond the limit unless the mesh does
     magnitude = np.abs(written)
     k = int(np.argmax(magnitude))
     e = int(crease[k])
+    sharpest = float(np.degrees(2.0 * np.nanmax(g.half_angle, initial=0.0)))
+    limit = max(MAX_FOLD_DEG, sharpest)
     detail = f"largest |fold angle| (deg): pattern edge {e} ({g.assign[e]}, {written[k]:.6g})"
-    n_flat = int(np.count_nonzero(magnitude >= MAX_FOLD_DEG))
+    n_flat = int(np.count_nonzero((magnitude > limit) | (magnitude >= 180.0)))
     if n_flat:
-        detail += f"; {n_flat} crease(s) fold flat"
+        detail += f"; {n_flat} crease(s) fold beyond the limit"
+    detail += f"; limit {MAX_FOLD_DEG:g}, or the mesh's sharpest dihedral ({sharpest:.6g})"
     span = Check(
-        names[2], n_flat == 0, float(magnitude[k]), MAX_FOLD_DEG, detail, "<", {"pattern_edge": e}
+        names[2], n_flat == 0, float(magnitude[k]), limit, detail, "<=", {"pattern_edge": e}
     )
     # smallest fold angle: every crease folds
     k = int(np.argmin(magnitude))
@@ -1105,6 +1252,7 @@ def certify_design(design) -> Certificate:
         design.vertices.apex,
         coord_quantum=memory_quantum(design.pattern),
         quantum_source=f"round-off: {ROUNDOFF_ULPS} ulp of the largest coordinate",
+        arc_step=float(design.params.arc_step),
     )
 
 
@@ -1159,17 +1307,24 @@ def check_folder(path) -> Certificate:
         if not f.is_file():
             raise MeshReadError(f"{f}: no such file (write the design with 'filletfold round')")
     pattern = read_fold(fold)
-    mesh_vertices, mesh_faces, edges, apex = _read_report(report)
+    mesh_vertices, mesh_faces, edges, apex, arc_step = _read_report(report)
     try:
         return certify(
-            pattern, mesh_vertices, mesh_faces, edges, apex, coord_quantum=file_quantum(pattern)
+            pattern,
+            mesh_vertices,
+            mesh_faces,
+            edges,
+            apex,
+            coord_quantum=file_quantum(pattern),
+            arc_step=arc_step,
         )
     except ParameterError as exc:
         raise MeshReadError(f"{fold} does not match {report.name}: {exc}") from None
 
 
 def _read_report(path: Path):
-    """(mesh vertices, mesh faces, edges dict, vertex apices) of a ``report.json``."""
+    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step) of a ``report.json``
+    (the arc step its parameters name, else the default)."""
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as exc:
@@ -1193,6 +1348,7 @@ def _read_report(path: Path):
             [[np.nan] * 3 if v["apex"] is None else v["apex"] for v in doc["vertices"]],
             dtype=np.float64,
         ).reshape(-1, 3)
+        arc_step = float((doc.get("parameters") or {}).get("arc_step", DEFAULT_ARC_STEP))
     except KeyError as exc:
         raise MeshReadError(f"{path}: not a filletfold report (no key {exc})") from None
     except (TypeError, ValueError, AttributeError) as exc:
@@ -1203,7 +1359,9 @@ def _read_report(path: Path):
         )
     kappa = np.where((radius > 0) & (ef >= 0).all(axis=1), kappa, 0.0)  # flat edges: no cylinder
     edges = {"vertices": ev, "faces": ef, "radius": radius, "half_angle": gamma, "kappa": kappa}
-    return vertices, faces, edges, apex
+    if not (math.isfinite(arc_step) and 0 <= arc_step <= 180):
+        raise MeshReadError(f"{path}: arc_step {arc_step} is not in [0, 180] degrees")
+    return vertices, faces, edges, apex, arc_step
 
 
 def _number(x) -> float:

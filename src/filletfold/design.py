@@ -47,6 +47,7 @@ from .surface.assemble import locate_apices
 from .surface.centres import face_piece_centres
 from .surface.module import build_modules
 from .surface.pattern import CreasePattern
+from .surface.sampling import cone_sample_counts
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
@@ -672,6 +673,8 @@ def round_mesh(
         chord_tol=chord,
         radius_scale=np.where(conical_sides(frames, pm.n_edges), 2.0, 1.0),
     )
+    # a cone's normal may turn faster than its arc: more points where it does
+    points = np.maximum(points, cone_sample_counts(solved, centres, pm.n_edges, float(arc_step)))
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]
@@ -725,6 +728,13 @@ def round_mesh(
         timings=timings,
     )
     locate_apices(pattern, res)
+    pattern.crease_sharp_rulings(  # a cone is creased along its rulings to sharp edges
+        res.apex,
+        pm.vertices,
+        pm.edges,
+        ~(rounding.radius > 0),
+        tol.closure * size,  # the apex and the edges' points, to round-off of the size
+    )
     timings["surface"] = time.perf_counter() - t
     mesh_out, rounding_out, res_out, pieces = pm, rounding, res, pieces
     if shift is not None:  # back where the mesh was (the stages stay about the centre)

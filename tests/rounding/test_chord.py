@@ -6,12 +6,14 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from numpy.testing import assert_array_equal
 
 import filletfold
 from filletfold.design import resolve_chord_tol
 from filletfold.errors import ParameterError
 from filletfold.export.outputs import edge_mismatch, relative_mismatch
 from filletfold.rounding.edges import chord_counts
+from filletfold.surface.sampling import cone_sample_counts
 
 
 def chord_error(turn, radius, n):
@@ -128,7 +130,13 @@ def test_mismatch_converges_as_the_chord_tolerance_shrinks():
 
 
 def test_samples_cap_the_points_and_zero_turns_the_tolerance_off():
+    """``samples`` caps what the chord tolerance and the arc step ask for; an arc at whose
+    ends a cone turns faster than the step gets the points its cones need instead."""
     d = filletfold.round_mesh("cube", chord_tol="1e-9", samples=7, tabs=False)
+    cones = cone_sample_counts(d.stages.solved, d.stages.centres, d.mesh.n_edges, 10.0)
+    assert (cones > 7).all()  # the cube's cones turn faster than its arcs
+    assert_array_equal(d.stages.samples, np.maximum(7, cones))
+    d = filletfold.round_mesh("cube", chord_tol="1e-9", samples=7, arc_step=0, tabs=False)
     assert set(d.stages.samples.tolist()) == {7}
     d = filletfold.round_mesh("cube", chord_tol=0, arc_step=0, samples=5, tabs=False)
     assert set(d.stages.samples.tolist()) == {5}

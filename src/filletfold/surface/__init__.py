@@ -1,6 +1,7 @@
 """Stages 4 and 5, the surface: each vertex's module (cone, half-cylinders, face shares; the
 curved creases of eq. (1) and the straight creases on the faces) as flat pieces with their
 folded positions, built for all vertices at once (:mod:`.module`; the fans of sharp vertices
-:mod:`.sharp`; :mod:`.piece`, :mod:`.faces`, :mod:`.overlap`, :mod:`.centres`), the crease
+:mod:`.sharp`; :mod:`.piece`, :mod:`.faces`, :mod:`.overlap`, :mod:`.centres`), sampled so
+that no cone's facets fold by more than the arc step (:mod:`.sampling`), the crease
 pattern they assemble into (:mod:`.assemble`, :mod:`.pattern`), its validation
 (:mod:`.validate`) and the triangles of its faces (:mod:`.triangulate`)."""

@@ -242,6 +242,73 @@ class CreasePattern:
             n[lo:hi] = np.add.reduceat(np.cross(q, q_next), first, axis=0)
         return n / np.linalg.norm(n, axis=1)[:, None]
 
+    def crease_sharp_rulings(
+        self, vertex_apex, mesh_vertices, mesh_edges, unrounded, eps: float
+    ) -> int:
+        """Make every ``F`` edge inside one cone that is the ruling from its apex to a mesh
+        edge left unrounded a crease (M or V, with its fold angle), in place; returns how many.
+
+        A cone whose vertex has an edge left sharp is not smooth along the ruling that ends on
+        that edge: the cone's triangles on its two sides meet there at the edge's dihedral, a
+        crease the sheet must be scored for. A ruling that folds by no more than
+        ``tol.coplanar_deg`` stays ``F``.
+
+        Parameters
+        ----------
+        vertex_apex : (n_vertices, 3) float
+            The cone apex of every mesh vertex (NaN without one).
+        mesh_vertices : (n_vertices, 3) float
+        mesh_edges : (n_edges, 2) int
+        unrounded : (n_edges,) bool
+            The mesh edges without a cylinder or fillet.
+        eps : float
+            Distance within which a point is the apex, or on an edge.
+        """
+        ef = self.edge_faces
+        patch = np.asarray(self.face_patch, dtype=str)
+        cand = np.flatnonzero((self.edge_assignment == "F") & (ef >= 0).all(axis=1))
+        fa, fb = ef[cand, 0], ef[cand, 1]
+        keep = (patch[fa] == patch[fb]) & np.char.startswith(patch[fa], "cone ")
+        cand, fa, fb = cand[keep], fa[keep], fb[keep]
+        sharp = np.flatnonzero(np.asarray(unrounded, dtype=bool))
+        if not len(cand) or not len(sharp):
+            return 0
+        u = np.array([int(p[5:]) for p in patch[fa]], dtype=np.int64)
+        apex = np.asarray(vertex_apex, dtype=float)[u]
+        a, b = self.vertices_3d[self.edges[cand, 0]], self.vertices_3d[self.edges[cand, 1]]
+        at_a = np.linalg.norm(a - apex, axis=1) <= eps
+        at_b = np.linalg.norm(b - apex, axis=1) <= eps
+        far = np.where(at_a[:, None], b, a)
+        ruling = at_a ^ at_b
+        order = np.argsort(u, kind="stable")
+        mv = np.asarray(mesh_vertices, dtype=float)
+        on = np.zeros(len(cand), dtype=bool)
+        for e in sharp.tolist():
+            p, q = mv[mesh_edges[e, 0]], mv[mesh_edges[e, 1]]
+            for end in mesh_edges[e].tolist():
+                lo, hi = np.searchsorted(u[order], [end, end + 1])
+                j = order[lo:hi]
+                j = j[ruling[j] & ~on[j]]
+                if len(j):
+                    d = q - p
+                    t = np.clip((far[j] - p) @ d / (d @ d), 0.0, 1.0)
+                    on[j] |= np.linalg.norm(far[j] - p - t[:, None] * d, axis=1) <= eps
+        k = np.flatnonzero(on)
+        if not len(k):
+            return 0
+        normals = self.face_normal_3d()
+        na, nb = normals[fa[k]], normals[fb[k]]
+        d = self.vertices_3d[self.edges[cand[k], 1]] - self.vertices_3d[self.edges[cand[k], 0]]
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        theta = np.degrees(
+            np.arctan2(np.einsum("ij,ij->i", np.cross(na, nb), d), np.einsum("ij,ij->i", na, nb))
+        )
+        fold = np.abs(theta) > tol.coplanar_deg
+        e = cand[k[fold]]
+        self.edge_assignment[e] = np.where(theta[fold] > 0, "M", "V")
+        self.edge_fold_angle[e] = -theta[fold]
+        return len(e)
+
     def _halfedges(self):
         """(from (h,), to (h,), face_start (n_faces + 1,), next (h,)) of the faces'
         half-edges; ``next`` is the following half-edge of the same face."""

@@ -1,0 +1,102 @@
+"""How many points each arc needs so that no two neighbouring facets of a cone fold by more
+than the arc step.
+
+The arc step bounds the turn of an arc between two samples: the turn of a cylinder's normal
+too, since a cylinder's normal turns with its arc. A cone's normal does not: between the
+rulings to ``F(s)`` and ``F(s + ds)`` it turns by the angle between the planes
+``(V, F(s), F(s + ds))``, which on a narrow cone, or one whose crease runs nearly along its
+rulings, is several times the arc's turn. Sampled by the arc alone, the cone's triangle fan
+then folds between neighbouring triangles by far more than the step, on an edge the pattern
+marks ``F`` (not a crease).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: Points per arc at which a cone's normal is measured (both ends included).
+DENSE = 97
+#: Most points any arc gets to bound its cones' facet folds (``--samples`` bounds the rest).
+MAX_CONE_SAMPLES = 256
+#: The share of the step the fastest turn is sampled at: a facet's fold is the turn between
+#: two facets' mean normals, which the fastest dense turn slightly underestimates.
+SAFETY = 0.8
+#: Vertices measured at once (bounds the dense points held).
+BATCH = 256
+
+
+def cone_sample_counts(solved: list, centres, n_edges: int, step_deg: float) -> np.ndarray:
+    """(n_edges,) int: the fewest evenly spaced points on each arc (ends included) at which
+    neighbouring triangles of the cones at both its ends fold by at most ``step_deg``.
+
+    Each cone's crease ``F(s)`` (eq. (1)) is evaluated at :data:`DENSE` points per arc; the
+    normal of the triangle ``(V, F(s_k), F(s_k+1))`` turns by ``theta_k`` from one dense
+    interval to the next, so the fastest turn per unit arc is ``max theta_k / ds``, and the arc
+    needs ``ceil(max theta_k / ds * a / (SAFETY step)) + 1`` points. At most
+    :data:`MAX_CONE_SAMPLES`; 1 on an edge without an arc or without a cone at either end.
+
+    Parameters
+    ----------
+    solved : list of (VertexFrame, apex or None, developed apex or None)
+        Per vertex, as the apex stage gives them.
+    centres : (n_faces, 3) float
+        Face-piece centres.
+    n_edges : int
+    step_deg : float
+        The arc step (degrees); 0 for no bound (every count is then 1).
+
+    Returns
+    -------
+    (n_edges,) int
+    """
+    from .module import _Chunk  # the module builder: only where a design is made
+
+    need = np.ones(n_edges, dtype=np.int64)
+    if step_deg <= 0:
+        return need
+    cones = [x for x in solved if x[1] is not None and not x[0].sharp]
+    for lo in range(0, len(cones), BATCH):
+        part = cones[lo : lo + BATCH]
+        chunk = _Chunk.of(
+            [x[0] for x in part], centres, DENSE, [x[1] for x in part], [x[2] for x in part]
+        )
+        sa = chunk.sides
+        arc = np.where(chunk.rounded, sa.arc, 0.0)
+        sides = np.flatnonzero(arc > 0)
+        if not len(sides):
+            continue
+        side = np.repeat(sides, DENSE)
+        s = (np.linspace(0.0, 1.0, DENSE)[None] * arc[sides, None]).ravel()
+        _, _, F = chunk.curves(side, s)
+        F = F.reshape(len(sides), DENSE, 3)
+        V = chunk.apex[chunk.side_vertex[sides]]
+        n = np.cross(F[:, :-1] - V[:, None], np.diff(F, axis=1))
+        length = np.linalg.norm(n, axis=2, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            n = n / length
+            cos = np.einsum("ijk,ijk->ij", n[:, 1:], n[:, :-1])
+            sin = np.linalg.norm(np.cross(n[:, 1:], n[:, :-1]), axis=2)
+        turn = np.degrees(np.arctan2(sin, cos))  # NaN where a triangle has no area
+        fastest = np.nanmax(np.where(np.isfinite(turn), turn, 0.0), axis=1)
+        count = np.ceil(fastest * (DENSE - 1) / (SAFETY * step_deg)) + 1
+        count = np.minimum(count, MAX_CONE_SAMPLES).astype(np.int64)
+        np.maximum.at(need, sa.edge[sides], count)
+    return need
+
+
+def facet_limit(step_deg: float) -> float:
+    """The largest fold between two neighbouring facets of one patch (degrees): the arc step;
+    180 (no limit) where the step is 0 (the chord tolerance, or the samples, alone decide)."""
+    return float(step_deg) if step_deg > 0 else 180.0
+
+
+def chord_mismatch_bound(step_deg: float) -> float:
+    """The largest relative difference between an arc turning by ``step_deg`` degrees and its
+    chord, ``1 - sin(t / 2) / (t / 2)``: how much shorter a facet's side across a bent patch is
+    folded than flat (0 for no step: then no bound, ``inf``)."""
+    if step_deg <= 0:
+        return math.inf
+    h = 0.5 * math.radians(min(step_deg, 180.0))
+    return 1.0 - math.sin(h) / h
