@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -167,6 +169,21 @@ def boundary_loops(mesh: PolyMesh) -> int:
     graph = coo_matrix((np.ones(len(b)), (b[:, 0], b[:, 1])), shape=(mesh.n_vertices,) * 2)
     _, label = connected_components(graph, directed=False)
     return len(np.unique(label[b[:, 0]]))
+
+
+def assert_manifold_oriented(mesh):
+    """Every edge of ``mesh`` (a PolyMesh, or a list of faces) is used at most twice, in
+    opposite directions, and every vertex has one fan of faces."""
+    faces = mesh.faces if isinstance(mesh, PolyMesh) else mesh
+    directed = [(int(a), int(b)) for f in faces for a, b in zip(f, np.roll(f, -1), strict=True)]
+    assert len(set(directed)) == len(directed), "an edge is used twice in one direction"
+    undirected = {}
+    for a, b in directed:
+        undirected[min(a, b), max(a, b)] = undirected.get((min(a, b), max(a, b)), 0) + 1
+    assert max(undirected.values()) <= 2, "an edge is used by three faces or more"
+    if isinstance(mesh, PolyMesh):
+        for u in range(mesh.n_vertices):
+            mesh.vertex_ring(u)  # one fan: raises otherwise
 
 
 def assert_convex_planar(mesh: PolyMesh):
@@ -612,16 +629,52 @@ def test_repaired_mesh_is_manifold_oriented_planar_convex(seed, kind):
     assert signed_volume(mesh) > 0
 
 
-def test_faces_back_to_back_are_refused_naming_the_edge():
+def two_objects():
     """A tetrahedron lying in a corner of a cube (trimesh's two_objects.obj): once their
-    shared vertices are welded, faces meet back to back; no repair can fold that."""
+    shared vertices are welded, faces meet back to back."""
     v, faces = cube()
     t = np.array([[-0.5, -0.5, -0.5], [0.5, -0.5, -0.5], [-0.5, 0.5, -0.5], [-0.5, -0.5, 0.5]])
     tri = [[0, 2, 1], [0, 3, 2], [1, 3, 0], [1, 2, 3]]
     tris = [f[[0, 1, 2]] for f in faces] + [f[[0, 2, 3]] for f in faces]
-    with pytest.raises(MeshError, match=r"lie back to back along edge") as info:
-        clean_mesh(np.vstack([v, t]), tris + [np.array(x) + 8 for x in tri])
-    assert info.value.edge is not None
+    return np.vstack([v, t]), tris + [np.array(x) + 8 for x in tri]
+
+
+def test_faces_back_to_back_are_cut_open_naming_the_edge():
+    """The surface doubles back on itself along the cube's edges at the corner: each such
+    edge is cut open (reported with its two faces), leaving a manifold oriented surface; with
+    ``strict`` the first is refused, naming it."""
+    mesh, log = clean_mesh(*two_objects())
+    cuts = [r for r in log.repairs if "back to back" in r.why]
+    assert cuts and all(r.what == "cut-edge" for r in cuts)
+    assert all(re.fullmatch(r"edge \(\d+, \d+\)", r.where) for r in cuts)
+    assert re.match(r"faces \d+ and \d+ lie back to back along it", cuts[0].why)
+    assert_manifold_oriented(mesh)
+    normal = mesh.face_normal  # no two faces back to back any more
+    ef = mesh.edge_faces[(mesh.edge_faces >= 0).all(axis=1)]
+    assert (np.einsum("ij,ij->i", normal[ef[:, 0]], normal[ef[:, 1]]) > -0.999).all()
+    with pytest.raises(MeshError, match=r"non-manifold edge"):
+        clean_mesh(*two_objects(), strict=True)  # its first defect
+
+
+def folded_sheet():
+    """A strip of three triangles whose last one is folded flat back over the middle one
+    along edge (2, 3): the two meet back to back there."""
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [0.45, 0.7, 0]], dtype=float)
+    return v, [[0, 1, 2], [1, 3, 2], [2, 3, 4]]
+
+
+def test_a_sheet_folded_flat_is_cut_along_the_fold_or_refused_with_strict():
+    mesh, log = clean_mesh(*folded_sheet(), merge_coplanar=False)
+    assert log.repairs[0].what == "cut-edge"
+    assert log.repairs[0].where == "edge (2, 3)"
+    assert log.repairs[0].why.startswith("faces 1 and 2 lie back to back along it")
+    assert_manifold_oriented(mesh)
+    assert mesh.n_faces == 3
+    with pytest.raises(
+        MeshError, match=r"faces 1 and 2 lie back to back along edge \(2, 3\)"
+    ) as info:
+        clean_mesh(*folded_sheet(), strict=True)
+    assert info.value.edge == (2, 3)
 
 
 def test_a_mesh_too_small_for_where_it_lies_is_refused():

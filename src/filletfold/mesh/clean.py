@@ -32,6 +32,7 @@ from .repair import (
     corner_turns,
     detach_faces,
     drop_duplicate_faces,
+    edge_keys,
     fix_degenerate_faces,
     planarize,
     plane_axes,
@@ -91,13 +92,16 @@ def clean_mesh(
     Steps, in order: validate; drop faces on non-finite vertices; weld vertices closer than
     ``tol.weld`` of the bounding-box diagonal; split faces that visit a vertex twice and drop
     faces of fewer than three vertices; remove faces of (almost) zero area (inserting their
-    middle vertex into the face beside their longest edge); drop duplicate faces and unused
-    vertices; split non-manifold vertices and cut non-manifold edges open; orient faces
-    consistently per connected component (outward on closed components; a component that
-    cannot be oriented is cut open where it conflicts); triangulate non-planar and non-convex
-    polygons; merge neighbouring coplanar faces into convex polygons; remove straight corners
-    and split polygons at corners within ``tol.straight`` of straight; check every polygon is
-    planar. Every repair is listed in ``log.repairs``.
+    middle vertex into the face beside their longest edge); drop duplicate faces (a face and
+    its reversed copy both, where that leaves no hole) and unused vertices; split non-manifold
+    vertices and cut non-manifold edges open; orient faces consistently per connected
+    component (outward on closed components, the faces reversed reported; a component that
+    cannot be oriented is cut open where it conflicts); cut open the edges along which two
+    faces lie back to back; triangulate non-planar and non-convex polygons (along diagonals
+    that are no edge yet); merge neighbouring coplanar faces into convex polygons; remove
+    straight corners and split polygons at corners within ``tol.straight`` of straight; check
+    every polygon is planar, and (a guard) every edge used at most twice, in opposite
+    directions. Every repair is listed in ``log.repairs``.
 
     Parameters
     ----------
@@ -125,7 +129,7 @@ def clean_mesh(
         index out of range, no faces, a triangle soup (no two faces share an edge, even after
         welding), a mesh with nothing left after repairs; with ``strict``: non-finite
         coordinate, degenerate or duplicate face, non-manifold edge or vertex, non-orientable
-        component, non-planar face.
+        component, faces back to back, non-planar face.
 
     Notes
     -----
@@ -181,21 +185,30 @@ def clean_mesh(
     _check_manifold(he, vert_orig)
 
     # 6. orientation (a component that cannot be oriented is cut where it conflicts)
-    face_list, flipped, conflicts = _orient(he, face_list, v, face_origin, strict)
+    face_list, flipped, conflicts = _orient(
+        he, face_list, v, face_origin, strict, log=log, vert_orig=vert_orig
+    )
     if conflicts:
         face_list, v, vert_orig = split_non_manifold(
             face_list, face_origin, v, vert_orig, log, unpaired=conflicts
         )
         he = _HalfEdges(face_list, len(v))
-        face_list, flipped2, conflicts = _orient(he, face_list, v, face_origin, True)
+        face_list, flipped2, conflicts = _orient(
+            he, face_list, v, face_origin, True, log=log, vert_orig=vert_orig
+        )
         flipped += flipped2
     _check_not_soup(he, face_list, face_origin)
-    _check_not_folded_flat(he, face_list, v, face_origin, vert_orig)
+    face_list, face_origin, v, vert_orig, flipped2 = _unfold(
+        he, face_list, face_origin, v, vert_orig, log, strict
+    )
+    flipped += flipped2
 
     # 7. non-planar and non-convex polygons are triangulated (and regrouped by the merge)
-    face_list, face_origin = _split_non_planar(face_list, face_origin, v, log)
+    n_v = len(v)
+    face_list, face_origin, v = _split_non_planar(face_list, face_origin, v, log)
     if not strict:
-        face_list, face_origin = _split_non_convex(face_list, face_origin, v, log)
+        face_list, face_origin, v = _split_non_convex(face_list, face_origin, v, log)
+    vert_orig = _new_vertices(vert_orig, len(v) - n_v)
 
     # 8. coplanar merge, straight corners, unreferenced vertices
     merged_faces = 0
@@ -230,7 +243,8 @@ def clean_mesh(
         v, residual = planarize(face_list, v, log)
         rest = np.flatnonzero(residual > tol.flat)
         if len(rest):  # polygons the planes of their neighbours do not let be planar
-            face_list, face_origin = triangulate_faces(
+            n_v = len(v)
+            face_list, face_origin, v = triangulate_faces(
                 face_list,
                 face_origin,
                 v,
@@ -242,7 +256,12 @@ def clean_mesh(
                 ),
                 lambda o, i: "",
             )
+            vert_orig = _new_vertices(vert_orig, len(v) - n_v)
     _check_planar(face_list, v, face_origin)
+    face_list, v, vert_orig, flipped2 = _ensure_manifold(
+        face_list, face_origin, v, vert_orig, log, strict
+    )
+    flipped += flipped2
 
     mesh = PolyMesh(v, face_list)
     log = CleanLog(
@@ -256,6 +275,19 @@ def clean_mesh(
     )
     logger.debug("clean_mesh: %s", log)
     return mesh, log
+
+
+def _vertex_name(vert_orig: np.ndarray, x: int) -> str:
+    """Input index of current vertex ``x``, or what it is when a repair added it."""
+    u = int(vert_orig[x])
+    return str(u) if u >= 0 else "(added at the middle of a face)"
+
+
+def _new_vertices(vert_orig: np.ndarray, k: int) -> np.ndarray:
+    """``vert_orig`` with ``k`` vertices added by the repairs (no input index: -1)."""
+    if k <= 0:
+        return vert_orig
+    return np.concatenate([vert_orig, -np.ones(k, dtype=np.int64)])
 
 
 # ------------------------------------------------------------------------------ 1. validate
@@ -537,14 +569,70 @@ def _check_manifold(he: _HalfEdges, vert_orig: np.ndarray) -> None:
         )
 
 
+def _ensure_manifold(face_list, face_origin, v, vert_orig, log: RepairLog, strict: bool):
+    """The last guard: every edge used by at most two faces, in opposite directions.
+
+    The steps after orientation keep that (a triangulation uses no diagonal that is an edge
+    already, a merge or a removed corner makes no new edge), so this does nothing; should a
+    step ever break it, the edges are cut open and the faces oriented again, reported, rather
+    than the mesh refused (or, with ``strict``, the first is named).
+
+    Returns
+    -------
+    faces, v, vert_orig, flipped
+    """
+    fl = _Flat.of(face_list)
+    frm, to = fl.index, fl.index[fl.next]
+    directed = np.sort(frm * len(v) + to)
+    undirected = np.sort(np.minimum(frm, to) * len(v) + np.maximum(frm, to))
+    if not (directed[1:] == directed[:-1]).any() and not (undirected[2:] == undirected[:-2]).any():
+        return face_list, v, vert_orig, 0
+    he = _HalfEdges(face_list, len(v))
+    directed = he.frm * len(v) + he.to
+    if strict:
+        _check_manifold(he, vert_orig)
+        order = np.argsort(directed, kind="stable")
+        h = int(order[np.flatnonzero(np.diff(directed[order]) == 0)[0]])
+        a, b = int(vert_orig[he.frm[h]]), int(vert_orig[he.to[h]])
+        raise MeshError(
+            f"edge ({a}, {b}) is used twice in the same direction: its two faces cannot be "
+            "oriented consistently",
+            edge=(a, b),
+        )
+    face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
+    he = _HalfEdges(face_list, len(v))
+    if (he.edge_count > 2).any():
+        face_list, v, vert_orig = detach_faces(face_list, face_origin, v, vert_orig, he, log)
+        face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
+        he = _HalfEdges(face_list, len(v))
+    _check_manifold(he, vert_orig)
+    face_list, flipped, conflicts = _orient(
+        he, face_list, v, face_origin, False, log=log, vert_orig=vert_orig
+    )
+    if conflicts:
+        face_list, v, vert_orig = split_non_manifold(
+            face_list, face_origin, v, vert_orig, log, unpaired=conflicts
+        )
+        he = _HalfEdges(face_list, len(v))
+        face_list, flipped2, _ = _orient(
+            he, face_list, v, face_origin, True, log=log, vert_orig=vert_orig
+        )
+        flipped += flipped2
+    return face_list, v, vert_orig, flipped
+
+
 # ------------------------------------------------------------------------------ 5. orient
 def _flip(f: np.ndarray) -> np.ndarray:
     return np.concatenate([f[:1], f[:0:-1]])
 
 
-def _orient(he: _HalfEdges, face_list, v, face_origin, strict: bool):
+def _orient(he: _HalfEdges, face_list, v, face_origin, strict: bool, *, log=None, vert_orig=None):
     """Orient every connected component consistently: outward where it is closed, as most of
     its faces where it is open.
+
+    The faces reversed are reported in ``log`` (unless it is strict), one ``flip-face``
+    repair per component: naming an edge two of its faces used in the same direction, or
+    saying that the closed component was inside out.
 
     Returns
     -------
@@ -617,27 +705,184 @@ def _orient(he: _HalfEdges, face_list, v, face_origin, strict: bool):
     invert = np.where(is_open, comp_flips * 2 > comp_size, comp_vol < 0)
     parity = parity ^ invert[component].astype(np.int64)
     out = [_flip(f) if parity[i] else f for i, f in enumerate(face_list)]
+    if log is not None and not log.strict and parity.any():
+        _report_flips(
+            log,
+            parity,
+            component,
+            comp_size,
+            is_open,
+            inner,
+            same,
+            fa,
+            fb,
+            he,
+            face_origin,
+            vert_orig,
+        )
     return out, int(parity.sum()), []
 
 
-def _check_not_folded_flat(he: _HalfEdges, face_list, v, face_origin, vert_orig) -> None:
-    """Raise when two faces meet back to back (their normals opposite within
-    ``tol.coplanar_deg``): the surface doubles back on itself along that edge (faces of two
-    objects lying on each other), which no fillet, crease or repair can make foldable."""
+def _report_flips(
+    log, parity, component, comp_size, is_open, inner, same, fa, fb, he, face_origin, vert_orig
+) -> None:
+    """One ``flip-face`` repair per component with reversed faces (see :func:`_orient`)."""
+    flipped = np.flatnonzero(parity)
+    comps = component[flipped]
+    order = np.argsort(comps, kind="stable")
+    bounds = np.flatnonzero(np.r_[True, comps[order][1:] != comps[order][:-1], True])
+    clash = np.flatnonzero(same == 1)  # inner edges used twice in one direction
+    witness = {}
+    for k in clash[::-1].tolist():  # the first of each component wins
+        witness[int(component[fa[k]])] = k
+    for g in range(len(bounds) - 1):
+        faces = np.sort(face_origin[flipped[order[bounds[g] : bounds[g + 1]]]])
+        c = int(comps[order[bounds[g]]])
+        shown = ", ".join(map(str, faces[:6].tolist())) + (", ..." if len(faces) > 6 else "")
+        where = f"face {shown}" if len(faces) == 1 else f"faces {shown}"
+        if c in witness:
+            k = witness[c]
+            a, b = sorted(int(vert_orig[x]) for x in he.edge_ends[inner[k]])
+            f, h = sorted((int(face_origin[fa[k]]), int(face_origin[fb[k]])))
+            why = (
+                f"faces {f} and {h} use edge ({a}, {b}) in the same direction (inconsistent "
+                f"orientation): {len(faces)} of the {int(comp_size[c])} faces of that piece "
+                "reversed to agree with their neighbours"
+                + ("" if is_open[c] else ", the closed piece facing outward")
+            )
+        else:
+            why = (
+                f"the closed piece of {int(comp_size[c])} faces was inside out (negative "
+                "volume): all its faces reversed to face outward"
+            )
+        log.add("flip-face", where, why, error="")
+
+
+def _folded_edges(he: _HalfEdges, face_list, v) -> list:
+    """The edges along which two faces meet back to back (their normals opposite within
+    ``tol.coplanar_deg``: folded by 180 degrees, the surface doubling back on itself -- a
+    flange or fin modelled without thickness, a triangle folded over, two objects lying on
+    each other), as ``(x, y, f, g)``: current vertices ``x < y`` and faces ``f < g``."""
     normal = _face_newell(_Flat.of(face_list), v)
     normal /= np.linalg.norm(normal, axis=1)[:, None]
     inner = np.flatnonzero(he.edge_count == 2)
     fa, fb = he.face[he.edge_he0[inner]], he.face[he.edge_he1[inner]]
     flat = np.einsum("ij,ij->i", normal[fa], normal[fb]) < -np.cos(np.radians(tol.coplanar_deg))
-    if flat.any():
-        k = int(np.flatnonzero(flat)[0])
-        a, b = (int(vert_orig[x]) for x in he.edge_ends[inner[k]])
-        f, g = int(face_origin[fa[k]]), int(face_origin[fb[k]])
-        raise MeshError(
-            f"faces {f} and {g} lie back to back along edge ({a}, {b}) (folded by 180 deg): the "
-            "surface doubles back on itself there (two objects on each other?)",
-            edge=(a, b),
+    out = []
+    for k in np.flatnonzero(flat).tolist():
+        x, y = (int(u) for u in he.edge_ends[inner[k]])
+        f, g = sorted((int(fa[k]), int(fb[k])))
+        out.append((x, y, f, g))
+    return out
+
+
+def _unfold(he: _HalfEdges, face_list, face_origin, v, vert_orig, log: RepairLog, strict: bool):
+    """Resolve every edge along which two faces lie back to back (:func:`_folded_edges`).
+
+    Such an edge is cut open where that separates its two faces (:func:`split_non_manifold`:
+    where the cuts reach the border or split a vertex's fan); an edge inside the surface
+    cannot be cut alone, and there the face of the two that agrees least with its other
+    neighbours (a triangle folded over) is dropped, leaving a hole. Each reported; a cut
+    makes no new fold, a dropped face none either, so two rounds suffice.
+
+    Returns
+    -------
+    faces, origin, v, vert_orig, flipped
+
+    Raises
+    ------
+    MeshError
+        With ``strict``, naming the first such edge (input indices) and its two faces.
+    """
+    flipped = 0
+    for _ in range(4):
+        folded = _folded_edges(he, face_list, v)
+        if not folded:
+            break
+        x, y, f, g = folded[0]
+        a, b = sorted((int(vert_orig[x]), int(vert_orig[y])))
+        if strict:
+            f0, g0 = int(face_origin[f]), int(face_origin[g])
+            raise MeshError(
+                f"faces {f0} and {g0} lie back to back along edge ({a}, {b}) (folded by 180 deg): "
+                "the surface doubles back on itself there (two objects on each other?)",
+                edge=(a, b),
+            )
+        cut = folded
+        while cut:  # the edges whose cut separates their faces (a trial on a scratch log)
+            trial = split_non_manifold(
+                face_list, face_origin, v, vert_orig, RepairLog(), unpaired=[e[:2] for e in cut]
+            )[0]
+            apart = [e for e in cut if _separated(trial, e)]
+            if len(apart) == len(cut):
+                break
+            cut = apart
+        drop = [e for e in folded if e not in cut]
+        why = {
+            (x, y): (
+                f"faces {int(face_origin[f])} and {int(face_origin[g])} lie back to back along "
+                "it (folded by 180 deg: the surface doubles back on itself there): cut open, "
+                "each face keeps a border there"
+            )
+            for x, y, f, g in cut
+        }
+        if cut:
+            face_list, v, vert_orig = split_non_manifold(
+                face_list, face_origin, v, vert_orig, log, unpaired=[e[:2] for e in cut], why=why
+            )
+        if drop:
+            face_list, face_origin = _drop_folded_over(
+                he, face_list, face_origin, v, vert_orig, drop, log
+            )
+            face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
+        he = _HalfEdges(face_list, len(v))
+        face_list, flipped2, _ = _orient(
+            he, face_list, v, face_origin, True, log=log, vert_orig=vert_orig
         )
+        flipped += flipped2
+        he = _HalfEdges(face_list, len(v))
+    return face_list, face_origin, v, vert_orig, flipped
+
+
+def _separated(faces, e) -> bool:
+    """Whether faces ``f`` and ``g`` of ``e = (x, y, f, g)`` no longer share two vertices."""
+    _, _, f, g = e
+    return len(set(faces[f].tolist()) & set(faces[g].tolist())) < 2
+
+
+def _drop_folded_over(he: _HalfEdges, face_list, face_origin, v, vert_orig, edges, log):
+    """Drop, for each ``(x, y, f, g)`` of ``edges``, the face of ``f``, ``g`` whose normal
+    agrees least (mean cosine) with its neighbours' across its other edges (reported)."""
+    normal = _face_newell(_Flat.of(face_list), v)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    inner = np.flatnonzero(he.edge_count == 2)
+    fa, fb = he.face[he.edge_he0[inner]], he.face[he.edge_he1[inner]]
+    dots = np.einsum("ij,ij->i", normal[fa], normal[fb])
+    agree = np.zeros(len(face_list))
+    count = np.zeros(len(face_list))
+    np.add.at(agree, fa, dots)
+    np.add.at(agree, fb, dots)
+    np.add.at(count, fa, 1)
+    np.add.at(count, fb, 1)
+    dropped = set()
+    for x, y, f, g in edges:
+        if f in dropped or g in dropped:
+            continue
+        d = float(normal[f] @ normal[g])  # their own edge, taken out of both means
+        mean = [(agree[h] - d) / max(count[h] - 1, 1) for h in (f, g)]
+        h, other = (g, f) if mean[1] <= mean[0] else (f, g)
+        dropped.add(h)
+        a, b = sorted((int(vert_orig[x]), int(vert_orig[y])))
+        log.add(
+            "drop-face",
+            f"face {int(face_origin[h])}",
+            f"it lies back to back on face {int(face_origin[other])} along edge ({a}, {b}) "
+            "(folded over by 180 deg, inside the surface where no cut can separate them) and "
+            f"agrees least with its other neighbours: dropped, leaving a hole",
+            error="",
+        )
+    keep = np.array([i not in dropped for i in range(len(face_list))])
+    return [f for f, k in zip(face_list, keep, strict=True) if k], face_origin[keep]
 
 
 def _check_not_soup(he: _HalfEdges, face_list, face_origin) -> None:
@@ -806,6 +1051,8 @@ def _remove_flat_vertices(face_list, face_origin, v, coplanar_deg):
     touched: set[int] = set()
     replace: dict[int, list] = {}  # first face of a fan -> its triangles; others dropped
     dropped: set[int] = set()
+    base = len(v)
+    used = edge_keys(face_list, base)
     for u in candidates.tolist():
         fan = faces_of[u]
         if touched.intersection(fan):
@@ -814,6 +1061,17 @@ def _remove_flat_vertices(face_list, face_origin, v, coplanar_deg):
         if loop is None:
             continue
         tris = triangulate_polygon(v[loop])
+        new = {
+            min(loop[t[i]], loop[t[i - 1]]) * base + max(loop[t[i]], loop[t[i - 1]])
+            for t in tris
+            for i in range(3)
+        }
+        ring = {
+            min(a, b) * base + max(a, b) for a, b in zip(loop, loop[1:] + loop[:1], strict=True)
+        }
+        if (new - ring) & used:
+            continue  # a diagonal that is an edge elsewhere (the mesh crosses itself): keep u
+        used |= new
         touched.update(fan)
         first = min(fan)
         tris = [np.asarray([loop[i] for i in t], dtype=np.int64) for t in tris]
@@ -975,9 +1233,11 @@ def _split_straight_corners(face_list, face_origin, v, vert_orig, coplanar_deg, 
         tuple(e): bool(b) for e, b in zip(he.edge_ends.tolist(), bent.tolist(), strict=True)
     }
     out, origin = [], []
-    pending = list(zip(face_list, face_origin.tolist(), strict=True))
+    base = len(v)
+    used = None  # the edges, as edge_keys gives them: made when a corner is to be split
+    pending = deque(zip(face_list, face_origin.tolist(), strict=True))
     while pending:
-        f, o = pending.pop(0)
+        f, o = pending.popleft()
         if len(f) >= 4:
             axes = plane_axes(polygon_normal(v[f]))
             turn = corner_turns((v[f] - v[f[0]]) @ axes.T)
@@ -990,24 +1250,38 @@ def _split_straight_corners(face_list, face_origin, v, vert_orig, coplanar_deg, 
             bad = [
                 i for i in range(k) if abs(turn[i]) < tol.straight and (sides[i] or sides[i - 1])
             ]
-            if bad:
-                i = bad[0]
-                # to the corner furthest from the straight line at i: both parts keep an area
+            split = None
+            if bad and used is None:
+                used = edge_keys(face_list, base)
+            for i in bad:
+                # to the corner furthest from the straight line at i (both parts keep an area)
+                # whose diagonal is no edge yet
                 p = v[f]
                 d = p[(i + 1) % k] - p[i - 1]
                 off = np.linalg.norm(np.cross(p - p[i], d / np.linalg.norm(d)), axis=1)
                 off[[i - 1, i, (i + 1) % k]] = -1.0
-                j = int(np.argmax(off))
+                for j in np.argsort(-off, kind="stable").tolist():
+                    key = min(fl[i], fl[j]) * base + max(fl[i], fl[j])
+                    if off[j] > 0 and key not in used:
+                        split = i, j
+                        used.add(key)
+                        break
+                if split is not None:
+                    break
+            if split is not None:
+                i, j = split
                 lo, hi = min(i, j), max(i, j)
                 log.add(
                     "split-face",
                     f"face {o}",
-                    f"its corner at vertex {int(vert_orig[f[i]])} is "
+                    f"its corner at vertex {_vertex_name(vert_orig, f[i])} is "
                     f"{np.degrees(abs(turn[i])):.2g} deg from straight (below "
                     f"{np.degrees(tol.straight):.2g}) next to a rounded edge: split there",
                     error="",
                 )
-                pending[:0] = [(f[lo : hi + 1], o), (np.concatenate([f[hi:], f[: lo + 1]]), o)]
+                pending.extendleft(
+                    [(np.concatenate([f[hi:], f[: lo + 1]]), o), (f[lo : hi + 1], o)]
+                )
                 continue
         out.append(f)
         origin.append(o)

@@ -1,7 +1,8 @@
 """Reading and writing polygon meshes.
 
-OBJ and OFF are parsed here, keeping polygon faces as polygons. PLY, STL (ASCII and binary),
-glTF and GLB are read through :func:`trimesh.load` and come back as triangles.
+OBJ, OFF and PLY are parsed here, keeping polygon faces as polygons; PLY in every layout,
+triangle strips too (:func:`read_ply`). STL (ASCII and binary), glTF and GLB are read through
+:func:`trimesh.load` and come back as triangles.
 
 Every error names the file first, then what is wrong and, for OBJ and OFF, on which line.
 """
@@ -9,6 +10,9 @@ Every error names the file first, then what is wrong and, for OBJ and OFF, on wh
 from __future__ import annotations
 
 import os
+import re
+import struct
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,13 +23,13 @@ from ..errors import ExportError, MeshError, MeshReadError
 SUPPORTED_EXTENSIONS: dict[str, str] = {
     ".obj": "filletfold",
     ".off": "filletfold",
-    ".ply": "trimesh",
+    ".ply": "filletfold",
     ".stl": "trimesh",
     ".glb": "trimesh",
     ".gltf": "trimesh",
 }
 
-_TRIMESH_TYPES = {".ply": "ply", ".stl": "stl", ".glb": "glb", ".gltf": "gltf"}
+_TRIMESH_TYPES = {".stl": "stl", ".glb": "glb", ".gltf": "gltf"}
 
 
 def read_mesh(path) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -41,13 +45,14 @@ def read_mesh(path) -> tuple[np.ndarray, list[np.ndarray]]:
     -------
     vertices : (n_vertices, 3) float64
     faces : list of (k,) int64
-        Polygons as stored in the file (0-based indices); PLY, STL and glTF give triangles.
+        Polygons as stored in the file (0-based indices; a PLY's triangle strips as their
+        triangles); STL and glTF give triangles.
 
     Raises
     ------
     MeshReadError
         The file is missing, is not a file, has an unsupported extension, cannot be parsed
-        (OBJ/OFF errors give the line number), or holds no faces.
+        (OBJ/OFF/ASCII PLY errors give the line number), or holds no faces.
     MeshError
         A vertex coordinate is not finite (the message names the vertex, 0-based).
     """
@@ -64,11 +69,14 @@ def read_mesh(path) -> tuple[np.ndarray, list[np.ndarray]]:
         raise MeshReadError(f"{name}: not a regular file")
     if p.stat().st_size == 0:
         raise MeshReadError(f"{name}: the file is empty")
-    if ext in (".obj", ".off"):
+    if ext in (".obj", ".off", ".ply"):
         try:
             data = p.read_bytes()
         except OSError as exc:
             raise MeshReadError(f"{name}: cannot read file: {exc.strerror or exc}") from exc
+    if ext == ".ply":
+        vertices, faces = read_ply(data, name)
+    elif ext in (".obj", ".off"):
         try:
             text = data.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
@@ -270,31 +278,541 @@ def _read_trimesh(p: Path, name: str, ext: str) -> tuple[np.ndarray, list[np.nda
                 f"{name}: no vertices or faces found (empty or unreadable {ext[1:].upper()} file)"
             )
         raise MeshReadError(f"{name}: the file has {len(vertices)} vertices but no faces")
-    if ext == ".ply":
-        _check_ply_counts(p, name, len(vertices), len(faces))
     return vertices.reshape(-1, 3), list(faces)
 
 
-def _check_ply_counts(p: Path, name: str, n_vertices: int, n_faces: int) -> None:
-    """Refuse a PLY file that holds fewer vertices or faces than its header declares (a file
-    cut short, which trimesh reads without a word): the mesh would be silently incomplete.
-    Polygons come back as triangles, so there may be more faces, not fewer."""
-    with p.open("rb") as fh:
-        head = fh.read(1 << 16)
-    end = head.find(b"end_header")
-    if end < 0:
-        return
-    declared = {}
-    for line in head[:end].decode("ascii", "replace").splitlines():
-        words = line.split()
-        if len(words) == 3 and words[0] == "element" and words[2].isdigit():
-            declared[words[1]] = int(words[2])
-    want_v, want_f = declared.get("vertex"), declared.get("face")
-    if (want_v is not None and n_vertices < want_v) or (want_f is not None and n_faces < want_f):
-        raise MeshReadError(
-            f"{name}: the file ends early: its header declares {want_v} vertices and {want_f} "
-            f"faces, {n_vertices} and {n_faces} were read"
+# -------------------------------------------------------------------------------------- PLY
+#: PLY scalar type names -> (numpy code, struct code).
+_TYPES = {
+    "char": ("i1", "b"),
+    "int8": ("i1", "b"),
+    "uchar": ("u1", "B"),
+    "uint8": ("u1", "B"),
+    "short": ("i2", "h"),
+    "int16": ("i2", "h"),
+    "ushort": ("u2", "H"),
+    "uint16": ("u2", "H"),
+    "int": ("i4", "i"),
+    "int32": ("i4", "i"),
+    "uint": ("u4", "I"),
+    "uint32": ("u4", "I"),
+    "int64": ("i8", "q"),
+    "uint64": ("u8", "Q"),
+    "float": ("f4", "f"),
+    "float32": ("f4", "f"),
+    "double": ("f8", "d"),
+    "float64": ("f8", "d"),
+}
+
+#: Element and list names that hold the mesh, in order of preference.
+_VERTEX_NAMES = ("vertex", "vertices", "vert")
+_FACE_NAMES = ("face", "faces", "facet", "polygon")
+_STRIP_NAMES = ("tristrips", "tristrip", "triangle_strips")
+_INDEX_NAMES = ("vertex_indices", "vertex_index", "vertex_indexes")
+
+
+@dataclass
+class _Property:
+    name: str
+    type: str  # numpy code of a scalar, or of a list's items
+    count_type: str | None = None  # numpy code of a list's count; None for a scalar
+
+    @property
+    def is_list(self) -> bool:
+        return self.count_type is not None
+
+
+@dataclass
+class _Element:
+    name: str
+    count: int
+    props: list
+    line: int  # header line of the element
+
+
+def read_ply(data: bytes, name: str) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Vertices and faces of the PLY file whose bytes are ``data`` (``name`` names it in
+    errors).
+
+    Every layout of the format is read: ASCII, binary little- and big-endian; any scalar type
+    (``char`` ... ``double`` and their ``int8`` ... ``float64`` spellings); list properties
+    with any count and item type; extra properties (normals, colours, texture lists) and
+    other elements (``edge``, ``material``), which are skipped. Faces come from the ``face``
+    element's ``vertex_indices`` (or ``vertex_index``) list and stay polygons; triangle strips
+    from a ``tristrips`` element (the Stanford scanning repository's files), see
+    :func:`strip_triangles`. A table of equal rows (triangles) is read at once, rows of
+    different lengths one by one.
+
+    Returns
+    -------
+    vertices : (n_vertices, 3) float64
+    faces : list of (k,) int64
+        The ``face`` element's polygons as stored, then the triangles of the strips.
+
+    Raises
+    ------
+    MeshReadError
+        Not a PLY file, a header that cannot be parsed, a body shorter than the header
+        declares or that cannot be parsed, no vertex coordinates, no faces, or a face index
+        outside the vertex list.
+    """
+    fmt, elements, body = _header(data, name)
+    values: dict[str, dict] = {}
+    read_counts: dict[str, int] = {}
+    wanted = _wanted(elements)
+    if fmt == "ascii":
+        _read_ascii(body, elements, wanted, values, read_counts, name, _header_lines(data))
+    else:
+        _read_binary(
+            body,
+            "<" if fmt == "binary_little_endian" else ">",
+            elements,
+            wanted,
+            values,
+            read_counts,
+            name,
         )
+    return _mesh(elements, values, name)
+
+
+# ------------------------------------------------------------------------------ header
+def _header(data: bytes, name: str) -> tuple[str, list[_Element], bytes]:
+    if not re.match(rb"(?i)ply[ \t]*\r?\n", data[:8]):  # "PLY" too, as trimesh reads it
+        raise MeshReadError(
+            f"{name}: cannot read PLY file: not a PLY file (it does not start with the line 'ply')"
+        )
+    m = re.search(rb"(^|\n)end_header[ \t]*(\r\n|\n|\r)?", data[: 1 << 20])
+    if m is None:
+        raise MeshReadError(f"{name}: cannot read PLY file: no 'end_header' line ends its header")
+    try:
+        text = data[: m.start()].decode("ascii")
+    except UnicodeDecodeError as exc:
+        raise MeshReadError(
+            f"{name}: cannot read PLY file: its header has a non-ASCII byte at {exc.start}"
+        ) from exc
+    fmt = None
+    elements: list[_Element] = []
+    for number, line in enumerate(text.splitlines()[1:], start=2):
+        words = line.split()
+        if not words or words[0] in ("comment", "obj_info"):
+            continue
+        where = f"{name}: line {number}"
+        if words[0] == "format":
+            if len(words) < 2 or words[1] not in (
+                "ascii",
+                "binary_little_endian",
+                "binary_big_endian",
+            ):
+                raise MeshReadError(f"{where}: unknown PLY format {' '.join(words[1:])!r}")
+            fmt = words[1]
+        elif words[0] == "element":
+            if len(words) != 3 or not words[2].isdigit():
+                raise MeshReadError(f"{where}: expected 'element NAME COUNT', got {line.strip()!r}")
+            elements.append(_Element(words[1], int(words[2]), [], number))
+        elif words[0] == "property":
+            if not elements:
+                raise MeshReadError(f"{where}: a property before any element")
+            if len(words) == 5 and words[1] == "list":
+                ct, it = _type(words[2], where), _type(words[3], where)
+                if ct[0] == "f":
+                    raise MeshReadError(
+                        f"{where}: the count of list {words[4]!r} has the type {words[2]!r} "
+                        "(an integer type is needed)"
+                    )
+                elements[-1].props.append(_Property(words[4], it, ct))
+            elif len(words) == 3:
+                elements[-1].props.append(_Property(words[2], _type(words[1], where)))
+            else:
+                raise MeshReadError(
+                    f"{where}: expected 'property TYPE NAME' or 'property list COUNT_TYPE "
+                    f"TYPE NAME', got {line.strip()!r}"
+                )
+        else:
+            raise MeshReadError(f"{where}: unknown PLY header keyword {words[0]!r}")
+    if fmt is None:
+        raise MeshReadError(f"{name}: cannot read PLY file: its header has no 'format' line")
+    return fmt, elements, data[m.end() :]
+
+
+def _header_lines(data: bytes) -> int:
+    end = re.search(rb"(^|\n)end_header[^\n]*\n?", data[: 1 << 20])
+    return data[: end.end()].count(b"\n") + (0 if data[: end.end()].endswith(b"\n") else 1)
+
+
+def _type(word: str, where: str) -> str:
+    if word not in _TYPES:
+        raise MeshReadError(f"{where}: unknown PLY property type {word!r}")
+    return _TYPES[word][0]
+
+
+def _index_prop(el: _Element) -> _Property | None:
+    """The list of vertex indices of a face or strip element: by its usual names, else its
+    only list property."""
+    lists = [p for p in el.props if p.is_list]
+    for want in _INDEX_NAMES:
+        for p in lists:
+            if p.name == want:
+                return p
+    return lists[0] if len(lists) == 1 else None
+
+
+def _wanted(elements) -> set:
+    """(element, property) names to keep."""
+    out = set()
+    for el in elements:
+        if el.name in _VERTEX_NAMES:
+            out.update((el.name, a) for a in ("x", "y", "z"))
+        elif el.name in _FACE_NAMES or el.name in _STRIP_NAMES:
+            p = _index_prop(el)
+            if p is not None:
+                out.add((el.name, p.name))
+    return out
+
+
+# ------------------------------------------------------------------------------ binary body
+def _read_binary(body, endian, elements, wanted, values, read_counts, name) -> None:
+    offset = 0
+    for el in elements:
+        got, n_read, offset = _binary_element(body, offset, endian, el, wanted, name)
+        values[el.name] = got
+        read_counts[el.name] = n_read
+        if n_read < el.count:
+            _ends_early(elements, read_counts, name)
+
+
+def _binary_element(body, offset, endian, el: _Element, wanted, name):
+    """Read ``el`` from ``body`` at ``offset``: (kept values by property, rows read, offset
+    after it)."""
+    lists = [p for p in el.props if p.is_list]
+    if not lists:
+        dt = np.dtype([(f"p{i}", endian + p.type) for i, p in enumerate(el.props)])
+        n = min(el.count, (len(body) - offset) // dt.itemsize) if dt.itemsize else el.count
+        rows = np.frombuffer(body, dtype=dt, count=n, offset=offset)
+        got = {p.name: rows[f"p{i}"] for i, p in enumerate(el.props) if (el.name, p.name) in wanted}
+        return got, n, offset + n * dt.itemsize
+    if len(lists) == 1 and el.count:
+        fixed = _binary_fixed_lists(body, offset, endian, el, wanted)
+        if fixed is not None:
+            return fixed
+    return _binary_rows(body, offset, endian, el, wanted, name)
+
+
+def _binary_fixed_lists(body, offset, endian, el: _Element, wanted):
+    """The fast way, when every row's list has the length of the first row's (triangles):
+    one structured array; None when the lengths differ."""
+    fields, at = [], 0
+    for i, p in enumerate(el.props):
+        if p.is_list:
+            if len(body) < offset + at + np.dtype(p.count_type).itemsize:
+                return None
+            k = int(np.frombuffer(body, endian + p.count_type, 1, offset + at)[0])
+            if k < 0 or k * np.dtype(p.type).itemsize > len(body):
+                return None
+            fields += [(f"c{i}", endian + p.count_type), (f"p{i}", endian + p.type, (k,))]
+        else:
+            fields.append((f"p{i}", endian + p.type))
+        at = np.dtype(fields).itemsize
+    dt = np.dtype(fields)
+    n = min(el.count, (len(body) - offset) // dt.itemsize)
+    rows = np.frombuffer(body, dtype=dt, count=n, offset=offset)
+    i = next(i for i, p in enumerate(el.props) if p.is_list)
+    k = dt[f"p{i}"].shape[0]
+    if (rows[f"c{i}"] != k).any():
+        return None
+    if n < el.count:  # short: count the whole rows the slow way, for the message
+        return None
+    got = {}
+    for j, p in enumerate(el.props):
+        if (el.name, p.name) in wanted:
+            col = rows[f"p{j}"]
+            got[p.name] = col
+    return got, n, offset + n * dt.itemsize
+
+
+def _binary_rows(body, offset, endian, el: _Element, wanted, name):
+    """Row by row (lists of different lengths)."""
+    struct_code = {v[0]: v[1] for v in _TYPES.values()}
+    steps = []
+    for p in el.props:
+        keep = (el.name, p.name) in wanted
+        if p.is_list:
+            count = struct.Struct(endian + struct_code[p.count_type])
+            steps.append((p.name, keep, count, np.dtype(endian + p.type)))
+        else:
+            steps.append((p.name, keep, struct.Struct(endian + struct_code[p.type]), None))
+    got = {p.name: [] for p in el.props if (el.name, p.name) in wanted}
+    n_read = 0
+    end = len(body)
+    try:
+        for _ in range(el.count):
+            for pname, keep, s, item in steps:
+                (x,) = s.unpack_from(body, offset)
+                offset += s.size
+                if item is None:
+                    if keep:
+                        got[pname].append(x)
+                    continue
+                if x < 0:
+                    raise MeshReadError(
+                        f"{name}: row {n_read} of element {el.name!r} has a list {pname!r} of "
+                        f"{x} items"
+                    )
+                if offset + x * item.itemsize > end:
+                    raise struct.error("the list runs past the end of the file")
+                if keep:
+                    got[pname].append(np.frombuffer(body, item, x, offset))
+                offset += x * item.itemsize
+            n_read += 1
+    except struct.error:
+        pass
+    out = {}
+    for p in el.props:
+        if p.name in got:
+            out[p.name] = got[p.name] if p.is_list else np.asarray(got[p.name], dtype=p.type)
+    return out, n_read, offset
+
+
+# ------------------------------------------------------------------------------ ascii body
+def _read_ascii(body, elements, wanted, values, read_counts, name, first_line) -> None:
+    try:
+        text = body.decode("ascii")
+    except UnicodeDecodeError as exc:
+        raise MeshReadError(
+            f"{name}: not an ASCII PLY body (byte {exc.start} after the header is not ASCII)"
+        ) from exc
+    raw = text.splitlines()
+    lines = [(i + first_line + 1, s) for i, s in enumerate(raw) if s.strip()]
+    # a last line without its newline that does not parse: the file was cut there
+    cut_line = lines[-1][0] if lines and not text.endswith(("\n", "\r")) else None
+    at = 0
+    for el in elements:
+        rows = lines[at : at + el.count]
+        at += len(rows)
+        try:
+            values[el.name] = _ascii_element(rows, el, wanted, name, cut_line)
+        except _Cut:
+            read_counts[el.name] = len(rows) - 1
+            _ends_early(elements, read_counts, name)
+        read_counts[el.name] = len(rows)
+        if len(rows) < el.count:
+            _ends_early(elements, read_counts, name)
+
+
+class _Cut(Exception):
+    """The last line of an ASCII body, cut short."""
+
+
+def _ascii_element(rows, el: _Element, wanted, name, cut_line=None) -> dict:
+    n_scalar = len(el.props)
+    lists = [p for p in el.props if p.is_list]
+    if not rows:
+        return {p.name: ([] if p.is_list else np.zeros(0)) for p in el.props}
+    if not lists:
+        flat = " ".join(s for _, s in rows).split()
+        if len(flat) == len(rows) * n_scalar:
+            try:
+                table = np.array(flat, dtype=np.float64).reshape(len(rows), n_scalar)
+            except ValueError:
+                table = None
+            if table is not None:
+                return {
+                    p.name: table[:, i].astype(p.type if p.type[0] != "f" else np.float64)
+                    for i, p in enumerate(el.props)
+                    if (el.name, p.name) in wanted
+                }
+    elif len(lists) == 1:
+        fast = _ascii_fixed_lists(rows, el, wanted)
+        if fast is not None:
+            return fast
+    got = {p.name: [] for p in el.props if (el.name, p.name) in wanted}
+    for number, line in rows:
+        words = line.split()
+        k = 0
+        try:
+            for p in el.props:
+                if p.is_list:
+                    count = _int(words[k])
+                    items = words[k + 1 : k + 1 + count]
+                    if count < 0 or len(items) < count:
+                        raise IndexError
+                    if p.name in got:
+                        got[p.name].append(
+                            np.array([_int(w) for w in items], dtype=np.int64)
+                            if p.type[0] in "iu"
+                            else np.array(items, float)
+                        )
+                    k += 1 + count
+                else:
+                    x = float(words[k])
+                    if p.name in got:
+                        got[p.name].append(x)
+                    k += 1
+        except (IndexError, ValueError) as exc:
+            if number == cut_line:
+                raise _Cut from exc
+            raise MeshReadError(
+                f"{name}: line {number}: cannot parse a row of element {el.name!r} "
+                f"({_describe(el)}) from {line.strip()[:60]!r}"
+            ) from exc
+    out = {}
+    for p in el.props:
+        if p.name in got:
+            out[p.name] = got[p.name] if p.is_list else np.asarray(got[p.name], dtype=np.float64)
+    return out
+
+
+def _ascii_fixed_lists(rows, el: _Element, wanted) -> dict | None:
+    """The fast way, when every row has as many numbers as the first and its list is as long
+    as the first row's (triangles): one table; None otherwise."""
+    first = rows[0][1].split()
+    width = len(first)
+    flat = " ".join(s for _, s in rows).split()
+    if len(flat) != width * len(rows):
+        return None
+    try:
+        table = np.array(flat, dtype=np.float64).reshape(len(rows), width)
+    except ValueError:
+        return None
+    got, k = {}, 0
+    for p in el.props:
+        if p.is_list:
+            count = table[:, k]
+            n = int(count[0]) if count[0] == int(count[0]) else -1
+            if n < 0 or (count != n).any() or k + 1 + n > width:
+                return None
+            items = table[:, k + 1 : k + 1 + n]
+            if (el.name, p.name) in wanted:
+                if p.type[0] in "iu" and (items != np.round(items)).any():
+                    return None
+                got[p.name] = items.astype(np.int64) if p.type[0] in "iu" else items
+            k += 1 + n
+        else:
+            if (el.name, p.name) in wanted:
+                got[p.name] = table[:, k]
+            k += 1
+    return got if k == width else None
+
+
+def _int(word: str) -> int:
+    x = float(word)
+    if x != int(x):
+        raise ValueError(word)
+    return int(x)
+
+
+def _describe(el: _Element) -> str:
+    return ", ".join(("list " if p.is_list else "") + p.name for p in el.props)
+
+
+def _ends_early(elements, read_counts, name):
+    got = {el.name: read_counts.get(el.name, 0) for el in elements}
+    declared = {el.name: el.count for el in elements}
+    v = next((n for n in _VERTEX_NAMES if n in declared), None)
+    f = next((n for n in _FACE_NAMES + _STRIP_NAMES if n in declared), None)
+    if v is not None and f is not None:
+        what = "faces" if f in _FACE_NAMES else "strips"
+        raise MeshReadError(
+            f"{name}: the file ends early: its header declares {declared[v]} vertices and "
+            f"{declared[f]} {what}, {got[v]} and {got[f]} were read"
+        )
+    short = next(el for el in elements if got[el.name] < el.count)
+    raise MeshReadError(
+        f"{name}: the file ends early: its header declares {short.count} {short.name!r} "
+        f"elements, {got[short.name]} were read"
+    )
+
+
+# ------------------------------------------------------------------------------ the mesh
+def _mesh(elements, values, name) -> tuple[np.ndarray, list[np.ndarray]]:
+    by_name = {el.name: el for el in elements}
+    vname = next((n for n in _VERTEX_NAMES if n in by_name), None)
+    if vname is None:
+        raise MeshReadError(f"{name}: no vertices found (the PLY file has no 'vertex' element)")
+    missing = [a for a in ("x", "y", "z") if a not in values[vname]]
+    if missing:
+        raise MeshReadError(
+            f"{name}: the PLY 'vertex' element has no {', '.join(missing)} propert"
+            + ("y" if len(missing) == 1 else "ies")
+        )
+    vertices = np.stack([np.asarray(values[vname][a], dtype=np.float64) for a in "xyz"], axis=1)
+    n = len(vertices)
+    faces: list[np.ndarray] = []
+    for fname in _FACE_NAMES:
+        if fname in by_name:
+            p = _index_prop(by_name[fname])
+            if p is None:
+                raise MeshReadError(
+                    f"{name}: the PLY {fname!r} element has no 'vertex_indices' list"
+                )
+            faces += _as_index_lists(values[fname][p.name])
+    strips = 0
+    for sname in _STRIP_NAMES:
+        if sname in by_name:
+            p = _index_prop(by_name[sname])
+            if p is None:
+                raise MeshReadError(
+                    f"{name}: the PLY {sname!r} element has no 'vertex_indices' list"
+                )
+            for row in _as_index_lists(values[sname][p.name]):
+                tris = strip_triangles(
+                    row, end=int(np.iinfo(p.type).max) if p.type[0] == "u" else None
+                )
+                strips += 1
+                faces += list(tris)
+    if n == 0:
+        raise MeshReadError(f"{name}: no vertices found (the PLY file's vertex element is empty)")
+    if not faces:
+        raise MeshReadError(f"{name}: the file has {n} vertices but no faces")
+    flat = np.concatenate(faces)
+    if flat.min() >= 0 and flat.max() < n:
+        return vertices, faces
+    for i, f in enumerate(faces):
+        if len(f) and (f.min() < 0 or f.max() >= n):
+            k = int(f[(f < 0) | (f >= n)][0])
+            raise MeshReadError(
+                f"{name}: face {i} refers to vertex {k}, outside the {n} vertices (0..{n - 1})"
+            )
+    return vertices, faces
+
+
+def _as_index_lists(col) -> list[np.ndarray]:
+    if isinstance(col, np.ndarray) and col.ndim == 2 and col.dtype.kind in "iu":
+        return list(col.astype(np.int64))
+    out = []
+    for r in col:
+        a = np.asarray(r)
+        if a.dtype.kind != "f" or (np.isfinite(a).all() and (a == np.round(a)).all()):
+            a = a.astype(np.int64)
+        out.append(a)  # non-integer indices are left for the cleaning to name
+    return out
+
+
+def strip_triangles(strip, *, end: int | None = None) -> np.ndarray:
+    """(n_triangles, 3) int64: the triangles of a PLY ``tristrips`` list.
+
+    ``-1`` (or ``end``: the largest value of an unsigned item type) ends a strip. In a strip
+    ``s0, s1, s2, s3, ...`` triangle ``t`` has the corners ``s[t], s[t+1], s[t+2]``, those of
+    odd ``t`` reversed (``s[t+1], s[t], s[t+2]``) so that every triangle has the winding of the
+    first. Triangles with a repeated corner (how a strip turns, or joins the next one) are
+    left out.
+    """
+    s = np.asarray(strip).astype(np.int64)
+    if end is not None:
+        s[s == end] = -1
+    if len(s) < 3:
+        return np.zeros((0, 3), dtype=np.int64)
+    sep = s < 0
+    # first position of the strip each position belongs to
+    pos = np.arange(len(s))
+    start = np.maximum.accumulate(np.where(np.r_[True, sep[:-1]], pos, 0))
+    t = pos[:-2]
+    ok = ~(sep[:-2] | sep[1:-1] | sep[2:])
+    t = t[ok]
+    a, b, c = s[t], s[t + 1], s[t + 2]
+    odd = ((t - start[t]) % 2).astype(bool)
+    tri = np.stack([np.where(odd, b, a), np.where(odd, a, b), c], axis=1)
+    keep = (a != b) & (b != c) & (a != c)
+    return tri[keep]
 
 
 # ---------------------------------------------------------------------------------- writers

@@ -12,14 +12,21 @@ vertices carry ``vorig`` (their input index), so that every message names input 
 * :func:`fix_degenerate_faces` -- faces of (almost) zero area: a triangle whose middle vertex lies
   on its longest edge is removed and that vertex inserted into the face across the edge (what
   CGAL's ``remove_degenerate_faces`` does by edge flips), anything else is dropped;
-* :func:`drop_duplicate_faces` -- a face on the same vertices as an earlier one;
+* :func:`drop_duplicate_faces` -- a face on the same vertices as an earlier one; a face and
+  its reversed copy both, where that opens no hole (a wall between two cells, a fin of zero
+  volume);
 * :func:`split_non_manifold` -- a vertex where separate fans of faces touch becomes one copy
   per fan, and an edge shared by more than two faces is cut open so that each sheet keeps a
   manifold neighbourhood: the faces around the edge are paired by their angular order (CGAL's
   ``duplicate_non_manifold_vertices`` does the first, trimesh's and MeshLab's cleaning the
   second only by deleting faces);
 * :func:`triangulate_faces` -- a polygon that is not planar, or not convex, is triangulated in
-  its plane (the coplanar merge then regroups coplanar triangles into convex parts).
+  its plane, along diagonals that are no edge of the mesh yet (the coplanar merge then
+  regroups coplanar triangles into convex parts).
+
+:mod:`~filletfold.mesh.clean` itself reverses faces to orient each piece (``flip-face``) and
+cuts open the edges where a surface cannot be oriented or where two faces lie back to back
+(``cut-edge``, through :func:`split_non_manifold`).
 """
 
 from __future__ import annotations
@@ -46,7 +53,7 @@ class Repair:
     ----------
     what : str
         The kind of repair: ``"weld"``, ``"drop-face"``, ``"split-face"``, ``"split-vertex"``,
-        ``"cut-edge"``, ``"insert-vertex"``, ...
+        ``"cut-edge"``, ``"flip-face"``, ``"planarize"``, ...
     where : str
         The element, by its index in the input (``"face 7"``, ``"vertex 12"``,
         ``"edge (3, 9)"``, ``"vertices 4, 17"``).
@@ -139,7 +146,7 @@ def split_face_loops(faces, origin, vorig, log: RepairLog):
             out_origin.append(o)
             continue
         g = f[f != np.roll(f, 1)] if len(f) > 1 else f
-        distinct = len(np.unique(g))
+        distinct = len(np.unique(f))
         if distinct < 3:
             log.add(
                 "drop-face",
@@ -155,12 +162,18 @@ def split_face_loops(faces, origin, vorig, log: RepairLog):
             out.append(np.asarray(loops[0], dtype=np.int64))
             out_origin.append(o)
             continue
+        x, times = _repeated(g)
+        shown = g.tolist() if len(g) <= 12 else [*g[:12].tolist(), "..."]
         log.add(
-            "split-face",
+            "split-face" if loops else "drop-face",
             f"face {o}",
-            f"it visits vertex {int(vorig[_repeated(g)])} twice: split into "
-            f"{len(loops)} simple polygon(s)",
-            error=f"degenerate face {o}: it visits a vertex twice ({g.tolist()})",
+            f"it visits vertex {int(vorig[x])} {_times(times)}: "
+            + (
+                f"split into {len(loops)} simple polygon(s)"
+                if loops
+                else "it only goes back and forth (no loop of three vertices)"
+            ),
+            error=f"degenerate face {o}: it visits a vertex twice ({shown})",
             face=o,
         )
         for loop in loops:
@@ -193,26 +206,36 @@ def _faces_to_split(faces) -> np.ndarray:
     return bad
 
 
-def _repeated(g: np.ndarray) -> int:
+def _repeated(g: np.ndarray) -> tuple[int, int]:
+    """The first repeated vertex of ``g`` (smallest index) and how often it is visited."""
     values, counts = np.unique(g, return_counts=True)
-    return int(values[counts > 1][0])
+    k = int(np.flatnonzero(counts > 1)[0])
+    return int(values[k]), int(counts[k])
+
+
+def _times(k: int) -> str:
+    return "twice" if k == 2 else f"{k} times"
 
 
 def _simple_loops(loop: list) -> list[list]:
-    """A closed vertex loop cut at its repeated vertices into simple loops of >= 3 vertices."""
-    done, stack = [], [loop]
-    while stack:
-        cur = stack.pop()
-        seen = {}
-        for i, x in enumerate(cur):
-            if x in seen:
-                j = seen[x]
-                stack += [cur[j:i], cur[:j] + cur[i:]]
-                break
-            seen[x] = i
-        else:
-            if len(cur) >= 3:
-                done.append(cur)
+    """A closed vertex loop cut at its repeated vertices into simple loops of >= 3 vertices,
+    in one pass (linear in its length however often it repeats a vertex): the loop is walked
+    on a stack, and coming back to a vertex on the stack closes the loop from there."""
+    done, stack, at = [], [], {}
+    for x in loop:
+        j = at.get(x)
+        if j is None:
+            at[x] = len(stack)
+            stack.append(x)
+            continue
+        part = stack[j:]  # x ... back to x
+        for y in part[1:]:
+            del at[y]
+        del stack[j + 1 :]
+        if len(part) >= 3:
+            done.append(part)
+    if len(stack) >= 3:
+        done.append(stack)
     return done
 
 
@@ -345,7 +368,16 @@ def _insert_vertices(f: np.ndarray, inserts) -> list[np.ndarray]:
 
 # ------------------------------------------------------------------------- duplicate faces
 def drop_duplicate_faces(faces, origin, log: RepairLog):
-    """Drop every face on the same set of vertices as an earlier face (either orientation).
+    """Drop the faces on the same set of vertices as another one.
+
+    A face and a reversed copy of it (the same vertices in the opposite order) that can both
+    go without opening the surface -- every edge of theirs is then used by two other faces or
+    by none, and some edge of theirs by two others -- are both dropped: a wall between two
+    cells (two solids sharing a face), a fin of zero volume standing on an edge, a doubled
+    sheet hanging from a surface; the faces joined to such a pair by edges and reversed
+    copies themselves go with it, as one piece. Otherwise (a copy in the same order, or a
+    pair whose removal would leave a hole, or that is all there is) the first face is kept
+    and its copies dropped.
 
     Returns
     -------
@@ -355,15 +387,37 @@ def drop_duplicate_faces(faces, origin, log: RepairLog):
     keep = np.ones(len(faces), dtype=bool)
     twin = {}  # dropped face -> the earlier face it repeats
     size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    groups = []  # faces on one vertex set, in face order
     for k in np.unique(size).tolist():
         rows = np.flatnonzero(size == k)
-        keys = np.sort(np.array([faces[i] for i in rows.tolist()]), axis=1)
-        _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        block = np.array([faces[i] for i in rows.tolist()])
+        keys = np.sort(block, axis=1)
+        _, first, inverse, counts = np.unique(
+            keys, axis=0, return_index=True, return_inverse=True, return_counts=True
+        )
         inverse = inverse.reshape(-1)
         for j in np.flatnonzero(np.arange(len(rows)) != first[inverse]).tolist():
             twin[int(rows[j])] = int(rows[first[inverse[j]]])
-    for i in sorted(twin):
+        many = np.flatnonzero(counts[inverse] > 1)
+        by = {}
+        for j in many.tolist():
+            by.setdefault(int(inverse[j]), []).append(int(rows[j]))
+        groups += list(by.values())
+    if not twin:
+        return list(faces), np.asarray(origin, dtype=np.int64)
+    pairs = {} if log.strict else _inner_pairs(faces, groups)  # strict: the copy is named
+    for i in sorted(set(twin) | set(pairs)):
         keep[i] = False
+        if i in pairs:
+            o, o0 = int(origin[i]), int(origin[pairs[i]])
+            log.add(
+                "drop-face",
+                f"face {o}",
+                f"it is face {o0} reversed (a wall between two cells, or a fin or sheet of "
+                "zero volume): both dropped, which leaves no hole",
+                error="",
+            )
+            continue
         o, o0 = int(origin[i]), int(origin[twin[i]])
         log.add(
             "drop-face",
@@ -372,11 +426,90 @@ def drop_duplicate_faces(faces, origin, log: RepairLog):
             error=f"degenerate face {o}: it uses the same vertices as face {o0} (duplicate face)",
             face=o,
         )
-    return [f for f, k in zip(faces, keep, strict=True) if k], origin[keep]
+    return [f for f, k in zip(faces, keep, strict=True) if k], np.asarray(origin)[keep]
+
+
+def _inner_pairs(faces, groups) -> dict:
+    """The faces to drop as reversed pairs (see :func:`drop_duplicate_faces`): face -> the
+    other face of its pair (for the message).
+
+    ``groups`` lists the faces on one vertex set (two or more each). Those with both
+    orientations are candidates; candidates joined by edges form pieces, and a piece goes
+    when removing all its faces leaves each of their edges with zero or two faces and some
+    edge with two."""
+    cand = []
+    partner = {}
+    for g in groups:
+        ref = faces[g[0]].tolist()
+        same = [_same_cycle(ref, faces[i].tolist()) for i in g]
+        if all(same) or not any(same) or len(g) % 2:
+            continue  # one orientation only, or an odd number: keep one copy
+        fw = [i for i, s in zip(g, same, strict=True) if s]
+        bw = [i for i, s in zip(g, same, strict=True) if not s]
+        if len(fw) != len(bw):
+            continue
+        cand += g
+        for x, y in zip(fw, bw, strict=True):
+            partner[x], partner[y] = y, x
+    if not cand:
+        return {}
+    n = int(np.concatenate(faces).max()) + 1
+    keys, counts = _edge_counts(faces, n)
+    count = dict(zip(keys.tolist(), counts.tolist(), strict=True))
+    # pieces: candidates sharing an edge
+    parent = {i: i for i in cand}
+
+    def root(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    owner: dict = {}
+    for i in cand:
+        fl = faces[i].tolist()
+        for a, b in zip(fl, fl[1:] + fl[:1], strict=True):
+            key = (min(a, b), max(a, b))
+            if key in owner:
+                parent[root(i)] = root(owner[key])
+            else:
+                owner[key] = i
+    pieces: dict = {}
+    for i in cand:
+        pieces.setdefault(root(i), []).append(i)
+    out = {}
+    for members in pieces.values():
+        removed: dict = {}
+        for i in members:
+            fl = faces[i].tolist()
+            for a, b in zip(fl, fl[1:] + fl[:1], strict=True):
+                key = min(a, b) * n + max(a, b)
+                removed[key] = removed.get(key, 0) + 1
+        left = [count[k] - r for k, r in removed.items()]
+        if all(x == 0 or x == 2 for x in left) and any(x == 2 for x in left):
+            out.update({i: partner[i] for i in members})
+    return out
+
+
+def _edge_counts(faces, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The undirected edges of ``faces`` as ``min * n + max`` and how many faces use each."""
+    frm = np.concatenate(faces).astype(np.int64)
+    size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    start = np.concatenate([[0], np.cumsum(size)])
+    nxt = np.arange(len(frm)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    to = frm[nxt]
+    return np.unique(np.minimum(frm, to) * n + np.maximum(frm, to), return_counts=True)
+
+
+def _same_cycle(a: list, b: list) -> bool:
+    """Whether polygon ``b`` is polygon ``a`` in the same cyclic order (same vertex set)."""
+    k = b.index(a[0])
+    return b[k:] + b[:k] == a
 
 
 # ------------------------------------------------------------------------- non-manifold
-def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=()):
+def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=(), why=None):
     """Make every edge and vertex manifold by giving vertices one copy per fan.
 
     The corners of a vertex (one per face using it) are joined across each edge whose faces
@@ -386,7 +519,8 @@ def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=()):
     touch along an edge); an odd face out keeps the edge as a border. Each connected set of
     corners of a vertex is a fan; a vertex with several fans gets one copy per fan (the first
     keeps its index). Edges listed in ``unpaired`` (as (a, b), a < b, current indices) are
-    cut open the same way.
+    cut open the same way, each reported with ``why[(a, b)]`` (by default: the surface cannot
+    be oriented across it).
 
     Returns
     -------
@@ -435,12 +569,16 @@ def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=()):
             edge=(int(vorig[a]), int(vorig[b])),
         )
     for a, b in unpaired:
+        ia, ib = sorted((int(vorig[a]), int(vorig[b])))
         log.add(
             "cut-edge",
-            f"edge ({int(vorig[a])}, {int(vorig[b])})",
-            "the surface cannot be oriented consistently across it (a Moebius-like band): cut open",
+            f"edge ({ia}, {ib})",
+            why[(a, b)]
+            if why
+            else "the surface cannot be oriented consistently across it (a Moebius-like "
+            "band): cut open",
             error="non-orientable surface",
-            edge=(int(vorig[a]), int(vorig[b])),
+            edge=(ia, ib),
         )
     pairs = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
     # corner of vertex x in the face of half-edge h (h on edge (x, y)): h if h leaves x
@@ -597,7 +735,8 @@ def triangulate_polygon(p: np.ndarray) -> list[tuple[int, int, int]]:
 
 
 def triangulate_faces(faces, origin, v, which, log: RepairLog, why, error):
-    """Replace the faces ``which`` (indices) by their triangles (:func:`triangulate_polygon`).
+    """Replace the faces ``which`` (indices) by their triangles, choosing diagonals that are
+    no edge of the mesh yet (:func:`triangulate_avoiding`).
 
     ``why(i)`` says what is wrong with face ``i``; ``error(o, i)`` gives the strict-mode
     message for it (``o`` its input face).
@@ -606,29 +745,114 @@ def triangulate_faces(faces, origin, v, which, log: RepairLog, why, error):
     -------
     faces : list of (k,) int
     origin : (n_faces,) int
+    v : (n_vertices', 3) float
+        ``v``, with a vertex appended at the middle of each polygon that had to be split
+        around one (every diagonal of it already an edge).
     """
     which = set(int(i) for i in which)
     if not which:
-        return faces, origin
+        return faces, origin, v
+    base = len(v) + len(which)  # above every vertex index, new ones included
+    used = edge_keys(faces, base)
     out, out_origin = [], []
+    extra = []
     for i, (f, o) in enumerate(zip(faces, origin.tolist(), strict=True)):
         if i not in which:
             out.append(f)
             out_origin.append(o)
             continue
-        tris = triangulate_polygon(v[f])
+        tris, middle = triangulate_avoiding(f, v, used, base, len(v) + len(extra))
+        how = f"split into {len(tris)} triangles"
+        if middle is not None:
+            extra.append(middle)
+            how += (
+                " around a new vertex at its middle (each of its diagonals is an edge of "
+                "the mesh already)"
+            )
         log.add(
             "split-face",
             f"face {o}",
-            f"{why(i)}: split into {len(tris)} triangles (coplanar ones are merged again into "
-            "convex parts)",
+            f"{why(i)}: {how} (coplanar ones are merged again into convex parts)",
             error=error(o, i),
             face=o,
         )
+        out += tris
+        out_origin += [o] * len(tris)
+    if extra:
+        v = np.vstack([v, np.asarray(extra)])
+    return out, np.asarray(out_origin, dtype=np.int64), v
+
+
+def edge_keys(faces, n: int) -> set:
+    """The undirected edges of ``faces`` as ``min * n + max`` (``n`` above every vertex
+    index)."""
+    if not faces:
+        return set()
+    return set(_edge_counts(faces, n)[0].tolist())
+
+
+def triangulate_avoiding(f: np.ndarray, v: np.ndarray, used: set, base: int, new: int):
+    """Triangles of polygon ``f`` (vertex indices into ``v``) none of whose diagonals is in
+    ``used`` (undirected edges as ``min * base + max``, see :func:`edge_keys`), which gets
+    the diagonals chosen.
+
+    Tries :func:`triangulate_polygon`, then the fans from each corner whose triangles all face
+    the polygon's way; when each of these reuses an edge (two polygons on the same pair of
+    opposite corners: their triangles would be one doubled triangle), a fan around a new
+    vertex ``new`` at the polygon's centroid. Two faces sharing a diagonal would make it an
+    edge of three or four faces, or of two in the same direction.
+
+    Returns
+    -------
+    triangles : list of (3,) int
+    middle : (3,) float or None
+        The new vertex, when the fan around it was needed.
+    """
+    k = len(f)
+    fl = f.tolist()
+    p = v[f]
+    n = base
+    own = {min(a, b) * n + max(a, b) for a, b in zip(fl, fl[1:] + fl[:1], strict=True)}
+
+    def diagonals(tris):
+        keys = set()
         for t in tris:
-            out.append(f[list(t)])
-            out_origin.append(o)
-    return out, np.asarray(out_origin, dtype=np.int64)
+            for x, y in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                a, b = fl[x], fl[y]
+                keys.add(min(a, b) * n + max(a, b))
+        return keys - own
+
+    first = triangulate_polygon(p)
+    options = [first]
+    if k > 3:
+        axes = plane_axes(polygon_normal(p))
+        xy = (p - p.mean(axis=0)) @ axes.T
+        scale = float(np.ptp(xy, axis=0).max()) ** 2
+        for c in range(k):
+            fan = [(c, (c + j) % k, (c + j + 1) % k) for j in range(1, k - 1)]
+            if all(_area2(xy, t) > 1e-12 * scale for t in fan):
+                options.append(fan)
+    for tris in options:
+        d = diagonals(tris)
+        if not d & used:
+            used |= d
+            return [f[list(t)] for t in tris], None
+    if k > 3:
+        middle = p.mean(axis=0)
+        c_xy = (middle - p.mean(axis=0)) @ axes.T
+        ring = np.vstack([xy, c_xy])
+        fan = [(k, i, (i + 1) % k) for i in range(k)]
+        if all(_area2(ring, t) > 1e-12 * scale for t in fan):
+            out = [np.array([new, fl[i], fl[(i + 1) % k]], dtype=np.int64) for i in range(k)]
+            return out, middle
+    used |= diagonals(first)  # nothing better: the shared edge is left to the checks
+    return [f[list(t)] for t in first], None
+
+
+def _area2(xy: np.ndarray, t) -> float:
+    """Twice the signed area of triangle ``t`` (local indices) of the 2D points ``xy``."""
+    a, b, c = xy[t[0]], xy[t[1]], xy[t[2]]
+    return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
 
 
 # ------------------------------------------------------------------------- exact planes
