@@ -347,3 +347,16 @@ def test_a_nearly_developable_vertex_is_exact():
     d = filletfold.round_mesh((v.astype(np.float32).astype(float), f))
     assert d.certificate.ok, [c.line() for c in d.certificate.failed]
     assert d.status_counts()["infeasible"] == 0
+
+
+def test_conical_fillets_are_sampled_by_their_normal_too():
+    """A fuzzed hull whose conical fillet turns by 171 degrees: its facets folded 11.4 degrees
+    apart at the arc step's 19 points (10 deg step); sampled by the fillet's own normal they
+    fold by at most the step."""
+    from filletfold.testing.fuzz import case_by_name
+
+    case = case_by_name("hull-10/collapse-edge+quantise#0240")
+    d = filletfold.round_mesh((np.asarray(case.vertices), [np.asarray(f) for f in case.faces]))
+    assert any(p.startswith("fillet ") for p in d.pattern.face_patch)
+    assert d.certificate["facet folds"].ok, d.certificate["facet folds"].line()
+    assert d.certificate["facet folds"].value <= 10.0

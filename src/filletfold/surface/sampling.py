@@ -1,5 +1,5 @@
-"""How many points each arc needs so that no two neighbouring facets of a cone fold by more
-than the arc step.
+"""How many points each arc needs so that no two neighbouring facets of a cone (or of a
+conical fillet) fold by more than the arc step.
 
 The arc step bounds the turn of an arc between two samples: the turn of a cylinder's normal
 too, since a cylinder's normal turns with its arc. A cone's normal does not: between the
@@ -32,9 +32,11 @@ def cone_sample_counts(solved: list, centres, n_edges: int, step_deg: float) -> 
     neighbouring triangles of the cones at both its ends fold by at most ``step_deg``.
 
     Each cone's crease ``F(s)`` (eq. (1)) is evaluated at :data:`DENSE` points per arc; the
-    normal of the triangle ``(V, F(s_k), F(s_k+1))`` turns by ``theta_k`` from one dense
-    interval to the next, so the fastest turn per unit arc is ``max theta_k / ds``, and the arc
-    needs ``ceil(max theta_k / ds * a / (SAFETY step)) + 1`` points. At most
+    normal of the triangle ``(V, F(s_k), F(s_k+1))`` (on a conical fillet also that of
+    ``(S, C(s_k), C(s_k+1))``, the fillet's own cone from its sharp end) turns by
+    ``theta_k`` from one dense interval to the next, so the fastest turn per unit arc is
+    ``max theta_k / ds``, and the arc needs ``ceil(max theta_k / ds * a / (SAFETY step)) + 1``
+    points. At most
     :data:`MAX_CONE_SAMPLES`; 1 on an edge without an arc or without a cone at either end.
 
     Parameters
@@ -69,21 +71,30 @@ def cone_sample_counts(solved: list, centres, n_edges: int, step_deg: float) -> 
             continue
         side = np.repeat(sides, DENSE)
         s = (np.linspace(0.0, 1.0, DENSE)[None] * arc[sides, None]).ravel()
-        _, _, F = chunk.curves(side, s)
+        C, _, F = chunk.curves(side, s)
         F = F.reshape(len(sides), DENSE, 3)
-        V = chunk.apex[chunk.side_vertex[sides]]
-        n = np.cross(F[:, :-1] - V[:, None], np.diff(F, axis=1))
-        length = np.linalg.norm(n, axis=2, keepdims=True)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            n = n / length
-            cos = np.einsum("ijk,ijk->ij", n[:, 1:], n[:, :-1])
-            sin = np.linalg.norm(np.cross(n[:, 1:], n[:, :-1]), axis=2)
-        turn = np.degrees(np.arctan2(sin, cos))  # NaN where a triangle has no area
-        fastest = np.nanmax(np.where(np.isfinite(turn), turn, 0.0), axis=1)
+        fastest = _fastest_turn(F, chunk.apex[chunk.side_vertex[sides]])
+        fillet = np.flatnonzero(sa.conical[sides])
+        if len(fillet):  # a conical fillet: the cone from its sharp end S over its arc
+            C = C.reshape(len(sides), DENSE, 3)[fillet]
+            fastest[fillet] = np.maximum(fastest[fillet], _fastest_turn(C, sa.S[sides[fillet]]))
         count = np.ceil(fastest * (DENSE - 1) / (SAFETY * step_deg)) + 1
         count = np.minimum(count, MAX_CONE_SAMPLES).astype(np.int64)
         np.maximum.at(need, sa.edge[sides], count)
     return need
+
+
+def _fastest_turn(P: np.ndarray, apex: np.ndarray) -> np.ndarray:
+    """(k,) the largest turn (degrees) between the normals of neighbouring triangles
+    ``(apex, P_j, P_j+1)`` of each of ``k`` fans, ``P`` (k, m, 3), ``apex`` (k, 3); a triangle
+    without area turns by nothing."""
+    n = np.cross(P[:, :-1] - apex[:, None], np.diff(P, axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = n / np.linalg.norm(n, axis=2, keepdims=True)
+        cos = np.einsum("ijk,ijk->ij", n[:, 1:], n[:, :-1])
+        sin = np.linalg.norm(np.cross(n[:, 1:], n[:, :-1]), axis=2)
+    turn = np.degrees(np.arctan2(sin, cos))
+    return np.where(np.isfinite(turn), turn, 0.0).max(axis=1, initial=0.0)
 
 
 def facet_limit(step_deg: float) -> float:
