@@ -47,7 +47,8 @@ def _reference_validate(frame, V, v, sigma, n_samples=65, centres=None) -> ApexC
     cone = d - l[:, None] * sa.R[side]
     cone -= np.einsum("ij,ij->i", cone, u)[:, None] * u
     cyl = -sa.R[side] + np.einsum("ij,ij->i", sa.R[side], u)[:, None] * u
-    cyl /= np.linalg.norm(cyl, axis=1)[:, None]
+    norm = np.linalg.norm(cyl, axis=1)
+    cyl /= np.where(norm > 0, norm, 1.0)[:, None]
     crease = np.cos(tol.fold) * nonint - np.sin(tol.fold) * np.einsum("ij,ij->i", cone, cyl)
     measured = valid[side] & (sa.radius[side] > 0) & ~sa.conical[side]
     crease = np.minimum.reduceat(np.where(measured, crease, np.inf), first)

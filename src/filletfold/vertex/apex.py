@@ -733,7 +733,8 @@ def _curved_crease_fold(sa, V, vi, dn, side, s, C, N, l, nonint, valid) -> np.nd
     w = V[i] - (C[rows] + l[rows, None] * R)
     w = w - np.einsum("ij,ij->i", w, u)[:, None] * u
     h = -(R - np.einsum("ij,ij->i", R, u)[:, None] * u)
-    h /= np.linalg.norm(h, axis=1)[:, None]
+    hn = np.linalg.norm(h, axis=1)
+    h /= np.where(hn > 0, hn, 1.0)[:, None]  # a crease along R: no direction, no bound
     out[rows] = np.cos(tol.fold) * nonint[rows] - np.sin(tol.fold) * np.einsum("ij,ij->i", w, h)
     return out
 
