@@ -156,3 +156,14 @@ def test_arc_step_argument_and_unreadable(ico, tmp_path, capsys):
     assert main([str(tmp_path / "x.fold")]) == 2
     assert main([str(ico), "icosahedron"]) == 0
     capsys.readouterr()
+
+
+def test_a_mesh_with_an_edge_of_four_faces_is_not_closed():
+    """Two tetrahedra sharing an edge: no border, but an edge of four faces is no closed sheet
+    (trimesh does not call it watertight either), so its folded form may have a border."""
+    from filletfold.testing.recheck import _closed_by_edge_count
+
+    tet = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]
+    assert _closed_by_edge_count(tet)
+    other = [[a if a < 2 else a + 2 for a in f] for f in tet]  # vertices 0, 1, 4, 5
+    assert not _closed_by_edge_count(tet + other)

@@ -270,9 +270,11 @@ def _report_beside(fold_file: Path) -> dict | None:
 
 
 def _closed_by_edge_count(faces, vertices=None) -> bool:
-    """Whether no edge of the polygons is used by one face only (a border), counting edges
-    between vertices welded where their coordinates are equal (as STL soups store them) when
-    ``vertices`` are given; sides whose ends coincide are left out."""
+    """Whether the polygons are a closed surface: every edge used by exactly two faces (no
+    border, and no edge of three or more faces, where the surface is not one closed sheet: the
+    watertight test of trimesh), counting edges between vertices welded where their coordinates
+    are equal (as STL soups store them) when ``vertices`` are given; sides whose ends coincide
+    are left out."""
     sizes = np.fromiter(map(len, faces), np.int64, len(faces))
     if len(sizes) == 0:
         return False
@@ -288,7 +290,7 @@ def _closed_by_edge_count(faces, vertices=None) -> bool:
     a, b = a[keep], b[keep]
     key = np.minimum(a, b) * (int(flat.max()) + 1) + np.maximum(a, b)
     _, counts = np.unique(key, return_counts=True)
-    return bool(len(counts)) and not (counts == 1).any()
+    return bool(len(counts)) and bool((counts == 2).all())
 
 
 def _crease_limit(report: dict | None) -> float:
