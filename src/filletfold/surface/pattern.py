@@ -297,17 +297,21 @@ class CreasePattern:
         if not len(k):
             return 0
         normals = self.face_normal_3d()
-        na, nb = normals[fa[k]], normals[fb[k]]
-        d = self.vertices_3d[self.edges[cand[k], 1]] - self.vertices_3d[self.edges[cand[k], 0]]
-        d /= np.linalg.norm(d, axis=1)[:, None]
-        theta = np.degrees(
-            np.arctan2(np.einsum("ij,ij->i", np.cross(na, nb), d), np.einsum("ij,ij->i", na, nb))
-        )
+        theta = self._convexity(normals[fa[k]], normals[fb[k]], self.edges[cand[k]])
         fold = np.abs(theta) > tol.coplanar_deg
         e = cand[k[fold]]
         self.edge_assignment[e] = np.where(theta[fold] > 0, "M", "V")
         self.edge_fold_angle[e] = -theta[fold]
         return len(e)
+
+    def _convexity(self, na: np.ndarray, nb: np.ndarray, edges: np.ndarray) -> np.ndarray:
+        """(k,) the signed angle (degrees) from the folded normal ``na`` of the face holding
+        each edge ``a -> b`` (``a < b``) to ``nb`` of the other, about the edge: > 0 where the
+        surface is convex from the front (a mountain)."""
+        d = self.vertices_3d[edges[:, 1]] - self.vertices_3d[edges[:, 0]]
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
+        return np.degrees(np.arctan2(sin, np.einsum("ij,ij->i", na, nb)))
 
     def _halfedges(self):
         """(from (h,), to (h,), face_start (n_faces + 1,), next (h,)) of the faces'
@@ -344,14 +348,7 @@ class CreasePattern:
         angle = np.zeros(len(uniq))
         inner = (ef >= 0).all(axis=1)
         fa, fb = ef[inner, 0], ef[inner, 1]
-        na, nb = normals[fa], normals[fb]
-        # edge direction as traversed in face fa (a -> b with a < b, since fa holds lo -> hi)
-        d = self.vertices_3d[edges[inner, 1]] - self.vertices_3d[edges[inner, 0]]
-        d /= np.linalg.norm(d, axis=1)[:, None]
-        cr = np.cross(na, nb)
-        sin = np.einsum("ij,ij->i", cr, d)
-        cos = np.einsum("ij,ij->i", na, nb)
-        theta = np.degrees(np.arctan2(sin, cos))  # > 0: convex from the front (mountain)
+        theta = self._convexity(normals[fa], normals[fb], edges[inner])
         ids = dict.fromkeys(self.face_patch)  # patch name -> number, in order of first face
         for k, name in enumerate(ids):
             ids[name] = k
