@@ -178,7 +178,7 @@ def test_a_conical_fillet_is_tangent_to_both_faces_and_develops_isometrically(na
     half_length=st.floats(0.05, 3.0),
 )
 def test_the_developed_angle_is_integrated_to_round_off(radius, gamma, half_length):
-    """Gauss-Legendre on [0, s] against adaptive quadrature, on an edge along z through the
+    """The integrated Chebyshev series against adaptive quadrature, on an edge along z through the
     origin (its midpoint), for fillets from thin to twice as wide at the midpoint as half the
     edge is long."""
     assume(radius * np.tan(gamma) <= 2 * half_length)
@@ -198,6 +198,17 @@ def test_the_developed_angle_is_integrated_to_round_off(radius, gamma, half_leng
         want = quad(rate, 0, a, epsabs=1e-16, epsrel=1e-15, limit=200)[0]
     got = developed_angles(O, N0, B, kappa, r, S, np.array([a]))[0]
     assert abs(got - want) <= 1e-13 * want
+    # inside the arc, with a second fillet (the mirror image) in the same call: each row gets
+    # its own fillet's integral from 0 to its s
+    s = a * np.array([0.0, 0.1, 0.37, 0.5, 0.93, 1.0, 0.25])
+    fill = np.array([0, 0, 0, 1, 1, 1, 0])
+    mirror = np.diag([1.0, -1.0, 1.0])
+    rows = [np.vstack([x, x @ mirror])[fill] for x in (O, N0, B)]
+    both = developed_angles(*rows, np.ones(7), np.full(7, radius), np.vstack([S, S])[fill], s)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        each = [quad(rate, 0, x, epsabs=1e-16, epsrel=1e-15, limit=200)[0] for x in s]
+    assert_allclose(both, each, rtol=0, atol=1e-13 * want)
     # the ends of the arc lie on the faces through the edge (the set-up is an edge's)
     C = arc_points(O, N0, B, kappa, r, np.array([0.0, a]))[0]
     assert abs(C[0] @ N0[0]) < 1e-12 * max(1, radius)

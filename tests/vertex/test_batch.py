@@ -168,7 +168,8 @@ def test_phase1_lp_reaches_a_feasible_point_and_never_loses_slack(mesh, loss):
         rows = pack_problems([cons], target[None], cons.n_vars)
         for _ in range(3):
             y0 = rng.normal(scale=0.1, size=cons.n_vars)
-            y, t = phase1_lp(rows, y0)
+            y, t = phase1_lp(rows, y0[None])
+            y, t = y[0], t[0]
             assert t == pytest.approx(rows.min_slack(y[None])[0], abs=1e-15)
             assert t >= rows.min_slack(y0[None])[0]
             assert t > 0
@@ -187,5 +188,32 @@ def test_phase1_lp_stops_at_an_infeasible_problem():
     )
     rows = pack_problems([bad], target[None], 3)
     y0 = np.zeros(3)
-    _, t = phase1_lp(rows, y0)
-    assert rows.min_slack(y0[None])[0] <= t < 0
+    _, t = phase1_lp(rows, y0[None])
+    assert rows.min_slack(y0[None])[0] <= t[0] < 0
+
+
+def test_phase1_lp_solves_a_batch_as_its_problems_one_by_one():
+    """Problems of different row counts, a contradictory one among them, in one batch: each
+    gets the slack it gets alone (the blocks share no variable), the infeasible one keeps its
+    start's slack or better and stays negative."""
+    rng = np.random.default_rng(11)
+    probs = [(c, tg) for c, tg, _ in first_attempts("icosahedron", 0.1, 0.3)[:3]]
+    cons, target, _ = first_attempts("icosahedron", 0.15, 0.3)[0]
+    k = int(np.flatnonzero(cons.lin_kind == "face")[0])
+    bad = dataclasses.replace(
+        cons,
+        lin_a=np.vstack([cons.lin_a, -cons.lin_a[k]]),
+        lin_b=np.append(cons.lin_b, -cons.lin_b[k] - 0.01 * cons.scale),
+        lin_kind=np.append(cons.lin_kind, "face"),
+        lin_element=np.append(cons.lin_element, cons.lin_element[k]),
+    )
+    probs.insert(1, (bad, target))
+    rows = pack_problems([c for c, _ in probs], np.stack([tg for _, tg in probs]), 3)
+    y0 = rng.normal(scale=0.1, size=(len(probs), 3))
+    y0[1] = 0.0
+    y, t = phase1_lp(rows, y0)
+    alone = [phase1_lp(rows.take(np.array([b])), y0[b : b + 1])[1][0] for b in range(len(probs))]
+    np.testing.assert_allclose(t, rows.min_slack(y), atol=1e-15)
+    assert rows.min_slack(y0)[1] <= t[1] < 0
+    assert (np.delete(t, 1) > 0).all() and (np.delete(np.array(alone), 1) > 0).all()
+    assert t[1] == pytest.approx(alone[1], abs=1e-12)

@@ -507,8 +507,8 @@ def solve_apices(
     vertices : iterable of int, optional
         The vertices to solve (default: every vertex whose status is still empty).
     thorough : bool
-        False skips what only decides a hard case (more feasibility starts and the SLSQP
-        fallback of the last attempts): faster, and a vertex may be called infeasible that
+        False skips what only decides a hard case (more feasibility starts and the linear
+        programmes of the last attempts): faster, and a vertex may be called infeasible that
         the thorough solve would solve (the vertex rescue's trial rounds use it).
     size : float, optional
         The mesh's size (:func:`mesh_size`): every crease stays ``tol.ruling`` of it above its
