@@ -209,6 +209,10 @@ def test_the_developed_angle_is_integrated_to_round_off(radius, gamma, half_leng
         warnings.simplefilter("ignore")
         each = [quad(rate, 0, x, epsabs=1e-16, epsrel=1e-15, limit=200)[0] for x in s]
     assert_allclose(both, each, rtol=0, atol=1e-13 * want)
+    named = developed_angles(
+        *rows, np.ones(7), np.full(7, radius), np.vstack([S, S])[fill], s, fillet=fill
+    )
+    assert_allclose(named, both, rtol=0, atol=1e-15 * want)
     # the ends of the arc lie on the faces through the edge (the set-up is an edge's)
     C = arc_points(O, N0, B, kappa, r, np.array([0.0, a]))[0]
     assert abs(C[0] @ N0[0]) < 1e-12 * max(1, radius)

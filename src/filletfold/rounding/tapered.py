@@ -123,7 +123,7 @@ def _chebyshev(nodes: int) -> tuple[np.ndarray, np.ndarray]:
     return x, T
 
 
-def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES):
+def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None):
     """(m,) float: the developed angle ``theta(s)`` a conical fillet sweeps from ``0`` to ``s``.
 
     The rows of one fillet (equal ``O``, ``N0``, ``B``, ``kappa``, ``radius``, ``S``) share one
@@ -141,6 +141,10 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
         Apex of each row's fillet.
     nodes : int
         Chebyshev points per fillet.
+    fillet : (m,) int, optional
+        Which fillet each row is on, when the caller knows (rows with equal ids must have
+        equal parameters); by default rows with equal parameters are found (a sort of the
+        rows, slower).
     """
     s = np.asarray(s, dtype=float)
     if not len(s):
@@ -148,7 +152,11 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     key = np.concatenate(
         [O, N0, B, np.asarray(kappa, float)[:, None], np.asarray(radius, float)[:, None], S], 1
     )
-    key, inv = np.unique(key, axis=0, return_inverse=True)
+    if fillet is None:
+        key, inv = np.unique(key, axis=0, return_inverse=True)
+    else:
+        _, first, inv = np.unique(fillet, return_index=True, return_inverse=True)
+        key = key[first]
     inv = inv.ravel()
     h = np.zeros(len(key))
     np.maximum.at(h, inv, s)
@@ -168,7 +176,7 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     return 0.5 * hs * (u * b1 - b2 + integral[inv, 0])
 
 
-def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES):
+def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None):
     """A conical fillet's base curve and rulings, in 3D and in the side's developed chart.
 
     The chart is a cylinder's at ``s = 0`` (``c(0) = (0, 0)``, ``r(0) = (0, 1)``); the sector's
@@ -179,7 +187,7 @@ def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES):
     O, N0, B : (m, 3) float
     kappa, radius, s : (m,) float
     S : (m, 3) float
-    nodes : int
+    nodes, fillet
         See :func:`developed_angles`.
 
     Returns
@@ -195,7 +203,7 @@ def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES):
     R, rho = cone_rulings(C, S)
     C0, _ = arc_points(O, N0, B, kappa, radius, np.zeros_like(np.asarray(s, dtype=float)))
     rho0 = cone_rulings(C0, S)[1]
-    theta = developed_angles(O, N0, B, kappa, radius, S, s, nodes)
+    theta = developed_angles(O, N0, B, kappa, radius, S, s, nodes, fillet)
     r = np.stack([np.sin(theta), np.cos(theta)], axis=-1)
     q = np.stack([np.zeros_like(rho0), -rho0], axis=-1)
     return C, R, q + rho[:, None] * r, r, q

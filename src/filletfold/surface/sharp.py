@@ -56,7 +56,7 @@ def _side_points(frame: VertexFrame, i: int, conical, n_samples):
     )
     C = arc_points(*rows, s)[0]
     S = np.repeat(U[None], m, 0)
-    return C, cone_rulings(C, S)[1], developed_angles(*rows, S, s)
+    return C, cone_rulings(C, S)[1], developed_angles(*rows, S, s, fillet=np.zeros(m, int))
 
 
 def _fan(frame: VertexFrame, centres: np.ndarray, conical, n_samples):

@@ -224,8 +224,9 @@ class SideArrays:
         if cone.any():
             k = i[cone]
             _, R[cone], c[cone], r[cone], _ = fillet_chart(
-                self.O[k], self.N0[k], self.B[k], self.kappa[k], self.radius[k], self.S[k], s[cone]
-            )
+                self.O[k], self.N0[k], self.B[k], self.kappa[k], self.radius[k], self.S[k], s[cone],
+                fillet=k,
+            )  # fmt: skip
         return C, R, c, r
 
     def row_maps(self, i: np.ndarray, s: np.ndarray):
