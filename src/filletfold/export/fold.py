@@ -456,6 +456,16 @@ def _round(x: float) -> float:
     return 0.0 if r == 0 else r
 
 
+def rounded(x: np.ndarray) -> np.ndarray:
+    """``x`` (any shape, finite) rounded as :func:`fold_json` writes it: each value to
+    :data:`FOLD_DIGITS` significant digits, so that what is derived from the rounded values
+    (a fold angle) is what a reader of the file measures."""
+    x = np.asarray(x, dtype=float)
+    flat = (x + 0.0).ravel().tolist()
+    text = (f"%.{FOLD_DIGITS}g " * len(flat)) % tuple(flat)
+    return np.array(text.split(), dtype=float).reshape(x.shape) + 0.0
+
+
 class _RaggedInts:
     """Integer lists of several lengths, as :func:`face_arrays` (``flat``, ``start``)."""
 

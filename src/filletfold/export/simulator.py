@@ -997,7 +997,20 @@ def simulator_pattern(
         pattern.piece_vertex,
         annotations=pattern.annotations,
     )
-    return _clean_slivers(coarse, min_angle)
+    coarse = _clean_slivers(coarse, min_angle)
+    # the file's fold angles are measured on the coordinates it holds: a thin triangle's
+    # dihedral moves by micro-degrees when its corners are rounded to the file's digits
+    from .fold import rounded
+
+    return CreasePattern(
+        rounded(coarse.vertices_2d),
+        rounded(coarse.vertices_3d),
+        coarse.faces,
+        coarse.face_patch,
+        coarse.face_piece,
+        coarse.piece_vertex,
+        annotations=coarse.annotations,
+    )
 
 
 def _merged_patches(
