@@ -794,6 +794,28 @@ def _apices(
     Returns the frames, classification, rounding and face-piece centres afterwards (the
     rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
     kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
+    if st is None and "saddle" in sharp_kinds and "saddle" in res.status:
+        # saddles are known before any apex: sharp first, so that their neighbours are solved
+        # once, with their sides toward them conical (a reused design's frames are so already)
+        frames = list(frames)
+        classified = copy.deepcopy(classified)
+        _stage("sharp vertices")
+        rounding, centres, _ = sharpen_vertices(
+            pm,
+            rounding,
+            frames,
+            res,
+            depths,
+            centres,
+            face_piece_centres,
+            {},
+            {"saddle"},
+            flat_deg=coplanar_deg,
+            floor=floor,
+            min_width=min_width,
+            classified=classified,
+            solve=False,
+        )
     pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
     kept = set()
     if st is not None:
@@ -823,9 +845,13 @@ def _apices(
             apices=apices,
             classified=classified,
             vertices=pending,
+            sharp=np.array([f.sharp for f in frames], dtype=bool),
         )
         kept -= rescue.resolved
-    if sharp_kinds and any(sharp_kind(s) in sharp_kinds for s in res.status):
+    already = np.array([f.sharp for f in frames], dtype=bool)
+    if sharp_kinds and any(
+        sharp_kind(s) in sharp_kinds and not a for s, a in zip(res.status, already, strict=True)
+    ):
         frames = list(frames)
         classified = copy.deepcopy(classified)
         _stage("sharp vertices")
@@ -845,6 +871,7 @@ def _apices(
             size=size,
             progress=progress,
             classified=classified,
+            sharp=np.array([f.sharp for f in frames], dtype=bool),
         )
         kept -= sharpening.resolved | set(np.flatnonzero(sharpening.sharp).tolist())
     solved = [

@@ -70,6 +70,7 @@ def rescue_vertices(
     apices: dict,
     classified: VertexResult | None = None,
     vertices=None,
+    sharp: np.ndarray | None = None,
 ) -> tuple[EdgeRounding, np.ndarray, Rescue]:
     """Try smaller radii on the edges of every infeasible cone vertex.
 
@@ -99,6 +100,9 @@ def rescue_vertices(
         the re-classified vertices (``apply``).
     vertices : iterable of int, optional
         Try only these vertices (default: every infeasible cone vertex).
+    sharp : (n_vertices,) bool, optional
+        Sharp vertices (:mod:`~filletfold.vertex.sharpen`): the frames built again keep their
+        neighbours' sides conical, and they keep their status and reason.
 
     Returns
     -------
@@ -144,8 +148,12 @@ def rescue_vertices(
             affected = np.array(sorted(bad), dtype=np.int64)
             target = trial
         fresh = VertexResult.empty(mesh.n_vertices)
+        kept = [] if sharp is None else [u for u in affected.tolist() if sharp[u]]
+        status = {u: (target.status[u], target.kind[u], target.reason[u]) for u in kept}
         target.take(fresh, affected)
-        new_frames = classify_vertices(mesh, new_rounding, target, affected)
+        new_frames = classify_vertices(mesh, new_rounding, target, affected, sharp=sharp)
+        for u, (st, kind, reason) in status.items():  # a sharp vertex keeps why it is sharp
+            target.status[u], target.kind[u], target.reason[u] = st, kind, reason
         if apply and classified is not None:
             classified.take(target, affected)
         todo = [u for u in affected.tolist() if target.status[u] == ""]

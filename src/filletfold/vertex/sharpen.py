@@ -134,6 +134,8 @@ def sharpen_vertices(
     size: float | None = None,
     progress=None,
     classified: VertexResult | None = None,
+    sharp: np.ndarray | None = None,
+    solve: bool = True,
 ) -> tuple[EdgeRounding, np.ndarray, Sharpening]:
     """Make the cone-less vertices of ``kinds`` sharp and solve their neighbours again.
 
@@ -162,6 +164,13 @@ def sharpen_vertices(
     progress : callable, optional
     classified : VertexResult, optional
         The classification before the apices (for a later ``reuse``): updated alike.
+    sharp : (n_vertices,) bool, optional
+        Vertices already sharp (their frames built so): they stay sharp and keep their
+        reasons. Default: none.
+    solve : bool
+        False: only classify the neighbours again, with their sides toward the sharp vertices
+        conical, and leave their apices to the caller (status ``""``): the saddles, known
+        before any apex, are made sharp so, and their neighbours are solved once.
 
     Returns
     -------
@@ -171,7 +180,8 @@ def sharpen_vertices(
     """
     kinds = frozenset(kinds)
     n = mesh.n_vertices
-    sharp = np.zeros(n, dtype=bool)
+    sharp = np.zeros(n, dtype=bool) if sharp is None else np.array(sharp, dtype=bool)
+    initial = sharp.copy()
     out = Sharpening(sharp)
     if not kinds:
         return rounding, centres, out
@@ -220,12 +230,12 @@ def sharpen_vertices(
         todo = [int(u) for u in again if res.status[u] == ""]
         for u in np.flatnonzero(sharp).tolist():
             apices.pop(u, None)
-        if todo:
+        if todo and solve:
             solved = solve_apices(
                 {u: frames[u] for u in todo}, depths, res, centres, progress, todo, size=size
             )
             apices.update(solved)
         out.resolved.update(int(u) for u in again)
-    for u in np.flatnonzero(sharp).tolist():
+    for u in np.flatnonzero(sharp & ~initial).tolist():
         res.reason[u] = (res.reason[u] or "no cone") + "; kept sharp (its corner, no hole)"
     return rounding, centres, out
