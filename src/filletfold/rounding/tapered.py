@@ -149,14 +149,12 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     s = np.asarray(s, dtype=float)
     if not len(s):
         return np.zeros(0)
-    key = np.concatenate(
-        [O, N0, B, np.asarray(kappa, float)[:, None], np.asarray(radius, float)[:, None], S], 1
-    )
+    parts = (O, N0, B, np.asarray(kappa, float)[:, None], np.asarray(radius, float)[:, None], S)
     if fillet is None:
-        key, inv = np.unique(key, axis=0, return_inverse=True)
+        key, inv = np.unique(np.concatenate(parts, 1), axis=0, return_inverse=True)
     else:
         _, first, inv = np.unique(fillet, return_index=True, return_inverse=True)
-        key = key[first]
+        key = np.concatenate([np.asarray(x)[first] for x in parts], 1)
     inv = inv.ravel()
     h = np.zeros(len(key))
     np.maximum.at(h, inv, s)
@@ -165,8 +163,7 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     C, dC = arc_points(
         key[:, None, 0:3], key[:, None, 3:6], key[:, None, 6:9], key[:, 9:10], key[:, 10:11], t
     )
-    coef = sweep_rate(C, dC, key[:, None, 11:14]) @ T.T  # the rate's series in x
-    integral = np.polynomial.chebyshev.chebint(coef, lbnd=-1.0, axis=1)  # zero at s = 0
+    integral = _integrated(sweep_rate(C, dC, key[:, None, 11:14]) @ T.T)
     hs = h[inv]
     u = np.where(hs > 0, 2.0 * s / np.where(hs > 0, hs, 1.0) - 1.0, -1.0)
     b1 = np.zeros(len(s))
@@ -174,6 +171,26 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     for k in range(integral.shape[1] - 1, 0, -1):  # Clenshaw, each row its fillet's series
         b1, b2 = 2.0 * u * b1 - b2 + integral[inv, k], b1
     return 0.5 * hs * (u * b1 - b2 + integral[inv, 0])
+
+
+def _integrated(c: np.ndarray) -> np.ndarray:
+    """(k, m) Chebyshev coefficients of the integrals from ``x = -1`` of the series ``c``
+    (k, n), without the trailing terms under 1e-16 of the largest in every row (round-off).
+
+    ``int T_0 = T_1``, ``int T_1 = T_2 / 4`` and ``int T_j = T_(j+1) / (2 (j + 1)) -
+    T_(j-1) / (2 (j - 1))``; the constant makes each integral 0 at ``x = -1``.
+    """
+    k, n = c.shape
+    pad = np.zeros((k, n + 2))
+    pad[:, :n] = c
+    out = np.zeros((k, n + 1))
+    j = np.arange(1, n + 1)
+    out[:, 1:] = (pad[:, :n] - pad[:, 2 : n + 2]) / (2.0 * j)
+    out[:, 1] = pad[:, 0] - 0.5 * pad[:, 2]
+    out[:, 0] = -(out[:, 1:] * (-1.0) ** j).sum(axis=1)
+    size = np.abs(out).max(axis=1, keepdims=True)
+    live = np.flatnonzero((np.abs(out) > 1e-16 * size).any(axis=0))
+    return out[:, : (live[-1] + 1 if len(live) else 1)]
 
 
 def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None):
