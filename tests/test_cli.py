@@ -238,3 +238,23 @@ def test_view_turns_the_preview_only(tmp_path):
     assert main(["export", str(front), "--format", "png", "--view", "back"]) == 0
     assert main(["export", str(back), "--format", "png", "--view", "120,25"]) == 0
     assert (front / "preview.png").read_bytes() == (back / "preview.png").read_bytes()
+
+
+def test_a_log_gets_a_line_per_stage(tmp_path):
+    """With stderr not a terminal (CI, a pipe), progress is one line per stage with its
+    seconds and counts; --quiet prints none."""
+    import subprocess
+    import sys
+
+    def run(*extra):
+        cmd = [sys.executable, "-m", "filletfold", "round", "blob", "-o", str(tmp_path / "b")]
+        done = subprocess.run([*cmd, *extra], capture_output=True, text=True, check=True)
+        return [line for line in done.stderr.splitlines() if line.startswith("filletfold: ")]
+
+    lines = run()
+    names = [line.split(" in ")[0] for line in lines]
+    assert names[0] == "filletfold: reading the mesh"
+    assert any(n.startswith("filletfold: apices ") and "/" in n for n in names)
+    assert "filletfold: certificate" in names and names[-1] == "filletfold: writing the files"
+    assert all(line.endswith(" s") for line in lines)
+    assert run("--quiet") == []

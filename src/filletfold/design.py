@@ -581,6 +581,7 @@ def round_mesh(
     if input_key is not None and cleaned is not None and cleaned[0] == input_key:
         _, pm, clean_log, shift = cleaned  # the same input, cleaned the same way: take it over
     else:
+        _stage("reading the mesh")
         pm, clean_log = load_mesh(mesh, coplanar_deg=coplanar_deg, strict=strict)
         shift = far_offset(pm.vertices)
         if shift is not None:  # far from the origin: compute about the centre, shift back later

@@ -6,6 +6,7 @@ type and print its message; nothing below it should surface as a traceback.
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import functools
 
@@ -93,9 +94,27 @@ def one_line(exc: BaseException, limit: int = 300) -> str:
 _STAGE: contextvars.ContextVar = contextvars.ContextVar("filletfold_stage", default="design")
 
 
+#: Who is told of each new stage (:func:`watching_stages`), or None.
+_WATCH: contextvars.ContextVar = contextvars.ContextVar("filletfold_stage_watch", default=None)
+
+
 def stage(name: str) -> None:
     """Say which stage of the pipeline runs from here on."""
     _STAGE.set(name)
+    watch = _WATCH.get()
+    if watch is not None:
+        watch(name)
+
+
+@contextlib.contextmanager
+def watching_stages(callback):
+    """Within the block, ``callback(name)`` is called whenever a stage begins
+    (:func:`stage`): a front end's log of the pipeline."""
+    token = _WATCH.set(callback)
+    try:
+        yield
+    finally:
+        _WATCH.reset(token)
 
 
 def named_stages(first: str):
