@@ -1,0 +1,63 @@
+"""How much work the apex stage does, in counts rather than seconds (issue 27).
+
+Seconds depend on the machine; the number of apex problems solved per vertex and of linear
+programmes run does not. These bounds are today's counts on real meshes of the corpus plus a
+tenth: a change that makes the pipeline solve vertices again, or go back to one programme per
+problem, fails here before anyone times it.
+"""
+
+from __future__ import annotations
+
+import collections
+from pathlib import Path
+
+import pytest
+
+import filletfold
+import filletfold.vertex.batch as batch
+import filletfold.vertex.solve as solve
+
+CORPUS = Path(__file__).parent / "data" / "corpus"
+
+#: mesh -> (apex problems, linear programmes) measured when the bounds were set (2026-12-04:
+#: saddles sharp before the apices, one block LP per round).
+MEASURED = {
+    "geometry-central-sphere_small.ply": (162, 0),
+    "geometry-central-fox.ply": (1116, 7),
+    "meshio-bun_zipper_res4.ply": (1234, 9),
+}
+
+
+def _counted(monkeypatch, path: Path):
+    seen = collections.Counter()
+    solve_batch, lp = solve.solve_apex_batch, batch.phase1_lp
+
+    def counting_solve(problems, *args, **kwargs):
+        seen["problems"] += len(problems)
+        return solve_batch(problems, *args, **kwargs)
+
+    def counting_lp(rows, y):
+        seen["programmes"] += 1
+        return lp(rows, y)
+
+    monkeypatch.setattr(solve, "solve_apex_batch", counting_solve)
+    monkeypatch.setattr(batch, "phase1_lp", counting_lp)
+    design = filletfold.round_mesh(str(path))
+    return design, seen
+
+
+@pytest.mark.parametrize("name", sorted(MEASURED))
+def test_apex_work_does_not_grow(monkeypatch, name):
+    design, seen = _counted(monkeypatch, CORPUS / name)
+    problems, programmes = MEASURED[name]
+    assert seen["problems"] <= 1.1 * problems, seen
+    assert seen["programmes"] <= 1.1 * programmes + 1, seen
+    assert design.certificate.ok
+
+
+def test_a_convex_mesh_solves_each_vertex_once(monkeypatch):
+    """The common case: every vertex a cone, each feasible at its first attempt."""
+    design, seen = _counted(monkeypatch, CORPUS / "geometry-central-sphere_small.ply")
+    assert design.status_counts()["ok"] == design.mesh.n_vertices
+    assert seen["problems"] == design.mesh.n_vertices
+    assert seen["programmes"] == 0
