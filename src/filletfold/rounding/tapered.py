@@ -158,19 +158,44 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     inv = inv.ravel()
     h = np.zeros(len(key))
     np.maximum.at(h, inv, s)
-    x, T = _chebyshev(nodes)
-    t = 0.5 * h[:, None] * (x + 1.0)  # (fillets, nodes)
-    C, dC = arc_points(
-        key[:, None, 0:3], key[:, None, 3:6], key[:, None, 6:9], key[:, 9:10], key[:, 10:11], t
+    series = angle_series(
+        key[:, 0:3], key[:, 3:6], key[:, 6:9], key[:, 9], key[:, 10], key[:, 11:14], h, nodes
     )
-    integral = _integrated(sweep_rate(C, dC, key[:, None, 11:14]) @ T.T)
-    hs = h[inv]
+    return series_angles(series, h, inv, s)
+
+
+def angle_series(O, N0, B, kappa, radius, S, span, nodes: int = QUADRATURE_NODES) -> np.ndarray:
+    """(k, L) float: per fillet, the Chebyshev series on ``[0, span]`` of its developed angle
+    ``theta(s)`` (0 at ``s = 0``), evaluated by :func:`series_angles`.
+
+    Parameters
+    ----------
+    O, N0, B, S : (k, 3) float
+    kappa, radius, span : (k,) float
+        One row per fillet; ``span`` the largest ``s`` it will be evaluated at (its arc).
+    nodes : int
+        Chebyshev points per fillet.
+    """
+    x, T = _chebyshev(nodes)
+    t = 0.5 * np.asarray(span, dtype=float)[:, None] * (x + 1.0)  # (fillets, nodes)
+    C, dC = arc_points(
+        O[:, None], N0[:, None], B[:, None], np.asarray(kappa)[:, None],
+        np.asarray(radius)[:, None], t,
+    )  # fmt: skip
+    return _integrated(sweep_rate(C, dC, S[:, None]) @ T.T)
+
+
+def series_angles(series: np.ndarray, span: np.ndarray, fillet: np.ndarray, s) -> np.ndarray:
+    """(m,) float: ``theta(s)`` of rows on fillets ``fillet`` (m,) int, rows of ``series`` and
+    ``span`` (:func:`angle_series`), at their ``s`` (m,)."""
+    s = np.asarray(s, dtype=float)
+    hs = np.asarray(span, dtype=float)[fillet]
     u = np.where(hs > 0, 2.0 * s / np.where(hs > 0, hs, 1.0) - 1.0, -1.0)
     b1 = np.zeros(len(s))
     b2 = np.zeros(len(s))
-    for k in range(integral.shape[1] - 1, 0, -1):  # Clenshaw, each row its fillet's series
-        b1, b2 = 2.0 * u * b1 - b2 + integral[inv, k], b1
-    return 0.5 * hs * (u * b1 - b2 + integral[inv, 0])
+    for k in range(series.shape[1] - 1, 0, -1):  # Clenshaw, each row its fillet's series
+        b1, b2 = 2.0 * u * b1 - b2 + series[fillet, k], b1
+    return 0.5 * hs * (u * b1 - b2 + series[fillet, 0])
 
 
 def _integrated(c: np.ndarray) -> np.ndarray:
@@ -193,7 +218,9 @@ def _integrated(c: np.ndarray) -> np.ndarray:
     return out[:, : (live[-1] + 1 if len(live) else 1)]
 
 
-def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None):
+def fillet_chart(
+    O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None, theta=None
+):
     """A conical fillet's base curve and rulings, in 3D and in the side's developed chart.
 
     The chart is a cylinder's at ``s = 0`` (``c(0) = (0, 0)``, ``r(0) = (0, 1)``); the sector's
@@ -206,6 +233,8 @@ def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, f
     S : (m, 3) float
     nodes, fillet
         See :func:`developed_angles`.
+    theta : (m,) float, optional
+        The developed angles at ``s``, when the caller has them (:func:`series_angles`).
 
     Returns
     -------
@@ -220,7 +249,8 @@ def fillet_chart(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, f
     R, rho = cone_rulings(C, S)
     C0, _ = arc_points(O, N0, B, kappa, radius, np.zeros_like(np.asarray(s, dtype=float)))
     rho0 = cone_rulings(C0, S)[1]
-    theta = developed_angles(O, N0, B, kappa, radius, S, s, nodes, fillet)
+    if theta is None:
+        theta = developed_angles(O, N0, B, kappa, radius, S, s, nodes, fillet)
     r = np.stack([np.sin(theta), np.cos(theta)], axis=-1)
     q = np.stack([np.zeros_like(rho0), -rho0], axis=-1)
     return C, R, q + rho[:, None] * r, r, q

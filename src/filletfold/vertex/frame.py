@@ -28,7 +28,13 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
 from ..rounding.edges import EdgeRounding
-from ..rounding.tapered import fillet_chart, perpendiculars, ruled_gluing_maps
+from ..rounding.tapered import (
+    angle_series,
+    fillet_chart,
+    perpendiculars,
+    ruled_gluing_maps,
+    series_angles,
+)
 from ..tolerances import tol
 
 
@@ -223,11 +229,30 @@ class SideArrays:
         cone = self.conical[i]
         if cone.any():
             k = i[cone]
+            theta = series_angles(self.angle_series(), self.arc, k, s[cone])
             _, R[cone], c[cone], r[cone], _ = fillet_chart(
                 self.O[k], self.N0[k], self.B[k], self.kappa[k], self.radius[k], self.S[k], s[cone],
-                fillet=k,
+                theta=theta,
             )  # fmt: skip
         return C, R, c, r
+
+    def angle_series(self) -> np.ndarray:
+        """(k, L) float: per side, the series of its conical fillet's developed angle over its
+        arc (:func:`~filletfold.rounding.tapered.angle_series`; zero on the other sides),
+        computed once per :class:`SideArrays`."""
+        series = self.__dict__.get("_angle_series")
+        if series is None:
+            cone = np.flatnonzero(self.conical)
+            series = np.zeros((len(self.edge), 1))
+            if len(cone):
+                found = angle_series(
+                    self.O[cone], self.N0[cone], self.B[cone], self.kappa[cone],
+                    self.radius[cone], self.S[cone], self.arc[cone],
+                )  # fmt: skip
+                series = np.zeros((len(self.edge), found.shape[1]))
+                series[cone] = found
+            self.__dict__["_angle_series"] = series
+        return series
 
     def row_maps(self, i: np.ndarray, s: np.ndarray):
         """Per-row charts in which every side reads as a cylinder, for eq. (1) as written.
