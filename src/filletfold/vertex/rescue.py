@@ -6,7 +6,9 @@ requested radii is tried again with the radii of its own rounded edges halved, u
 :data:`ROUNDS` times. :func:`rescue_vertices` does this for all infeasible vertices at once,
 round after round:
 
-* ``apply=True`` (``--fit-vertices``): the halved radii are kept; every vertex of a face that
+* ``apply=True`` (``--fit-vertices``): each infeasible vertex's own factor is found first on
+  a copy (:func:`_probe`: only it is solved again after each halving), then applied in one
+  round; the halved radii are kept; every vertex of a face that
   has a changed edge is classified and solved again (its frame, or the face piece centres its
   creases must stay short of, changed), so the design stays consistent; a vertex that no
   halving rescues has its edges left sharp at last: a sharp vertex, its faces meeting at it,
@@ -122,18 +124,28 @@ def rescue_vertices(
     factor = {u: 1.0 for u in bad}
     tries = {u: 0 for u in bad}  # each vertex is halved ROUNDS times, then left sharp (apply)
     trial = VertexResult.empty(mesh.n_vertices) if not apply else None
+    probed: set = set()
     for _ in range(2 * ROUNDS + 2):  # vertices made infeasible by a change join later rounds
         if not apply:
             bad = [u for u in bad if tries[u] < ROUNDS]
         if not bad:
             break
+        jump = {}
+        if apply:  # each new vertex's own factor first, found on a copy: one round, not four
+            new = [u for u in bad if tries[u] == 0 and u not in probed]
+            probed.update(new)
+            jump = _probe(
+                mesh, radius, rounding.half_angle, frames, depths, face_centres, new,
+                flat_deg, floor, min_width, sharp,
+            )  # fmt: skip
         scale = np.ones(len(radius))
         for u in bad:
-            step = 0.5 if tries[u] < ROUNDS else 0.0  # halve; at last leave them sharp
+            halvings = jump.get(u, 1)
+            step = 0.5**halvings if tries[u] < ROUNDS else 0.0  # halve; at last leave them sharp
             e = frames[u].ring.edges
             scale[e] = np.minimum(scale[e], step)
             factor[u] *= step
-            tries[u] += 1
+            tries[u] += halvings if tries[u] < ROUNDS else 1
         edges = np.flatnonzero((scale < 1) & (radius > 0))
         if not len(edges):
             break
@@ -210,6 +222,54 @@ def rescue_vertices(
                 f"(at most {r.max() * f:.4g}): --fit-vertices does so"
             )
     return rounding, centres, out
+
+
+def _probe(
+    mesh,
+    radius,
+    half_angle,
+    frames,
+    depths,
+    face_centres,
+    vertices,
+    flat_deg,
+    floor,
+    min_width,
+    sharp,
+) -> dict:
+    """How many halvings of its edges' radii (1 to :data:`ROUNDS`) each of ``vertices`` needs
+    for a feasible cone, found on a copy: ``vertices`` alone are classified and solved again
+    (quick solves) after each halving, as ``apply=False`` does. A vertex no halving makes
+    feasible so gets :data:`ROUNDS` (the last factor, tried thoroughly when applied)."""
+    need = dict.fromkeys(vertices, ROUNDS)
+    todo = list(vertices)
+    trial = VertexResult.empty(mesh.n_vertices)
+    for j in range(1, ROUNDS + 1):
+        if not todo:
+            break
+        scale = np.ones(len(radius))
+        for u in todo:
+            scale[frames[u].ring.edges] = 0.5**j
+        _, rounding, centres = reround(
+            mesh, radius * scale, half_angle, face_centres, flat_deg, floor, min_width
+        )
+        idx = np.array(todo, dtype=np.int64)
+        trial.take(VertexResult.empty(mesh.n_vertices), idx)
+        new_frames = classify_vertices(mesh, rounding, trial, idx, sharp=sharp)
+        solve_apices(
+            dict(zip(todo, new_frames, strict=True)),
+            depths,
+            trial,
+            centres,
+            vertices=[u for u in todo if trial.status[u] == ""],
+            thorough=False,
+            size=mesh_size(mesh),
+        )
+        for u in todo:
+            if trial.status[u] == "ok":
+                need[u] = j
+        todo = [u for u in todo if trial.status[u] != "ok"]
+    return need
 
 
 def reround(
