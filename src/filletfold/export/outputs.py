@@ -223,10 +223,12 @@ def _vertex_records(res) -> Records:
 
 
 def _fabrication_report(design) -> dict:
-    """Pieces, glue tabs, and (with sheets) pieces per sheet and material use."""
+    """Pieces, glue tabs, and (with sheets) pieces per sheet and material use. The seams (one
+    record per cut border) are not repeated here: ``assembly.txt`` lists them."""
     out = {"pieces": int(design.pattern.n_pieces)}
     for k, v in design.fabrication.items():
-        out[k] = v if isinstance(v, list | dict) else int(v)
+        if k != "seams":
+            out[k] = v if isinstance(v, list | dict) else int(v)
     return out
 
 
