@@ -37,34 +37,49 @@ from .piece import Piece
 SEAM_MARGIN = 0.05
 
 
-def _side_points(frame: VertexFrame, i: int, conical, n_samples):
-    """The half of side ``i`` seen from the sharp vertex: 3D points, their distances to ``S``
-    and their developed angles from the side's start (one point, ``M``, when not conical)."""
-    side = frame.sides[i]
-    U = frame.U
-    if not ((side.radius > 0) if conical is None else (conical[side.edge] and side.radius > 0)):
-        return side.M[None], np.array([0.5 * side.length]), np.zeros(1)
-    n = int(n_samples) if np.ndim(n_samples) == 0 else int(n_samples[side.edge])
-    s = np.linspace(0.0, side.arc, max(n, 2))
-    m = len(s)
-    rows = (
-        np.repeat(side.O[None], m, 0),
-        np.repeat(side.N0[None], m, 0),
-        np.repeat(side.B[None], m, 0),
-        np.full(m, float(side.kappa)),
-        np.full(m, side.radius),
-    )
-    C = arc_points(*rows, s)[0]
-    S = np.repeat(U[None], m, 0)
-    return C, cone_rulings(C, S)[1], developed_angles(*rows, S, s, fillet=np.zeros(m, int))
+def _side_points(frames: list, conical, n_samples) -> list[list[tuple]]:
+    """Per frame, the half of each side seen from the sharp vertex: 3D points, their
+    distances to ``S`` and their developed angles from the side's start (one point, ``M``,
+    when not conical). The conical halves of all frames are computed together."""
+    out = []
+    rows = []  # (frame, side, s) of the conical halves
+    for k, frame in enumerate(frames):
+        halves = []
+        for i, side in enumerate(frame.sides):
+            rounded = side.radius > 0 and (conical is None or conical[side.edge])
+            if not rounded:
+                halves.append((side.M[None], np.array([0.5 * side.length]), np.zeros(1)))
+                continue
+            n = int(n_samples) if np.ndim(n_samples) == 0 else int(n_samples[side.edge])
+            rows.append((k, i, np.linspace(0.0, side.arc, max(n, 2))))
+            halves.append(None)
+        out.append(halves)
+    if not rows:
+        return out
+    count = np.array([len(s) for _, _, s in rows])
+    which = np.repeat(np.arange(len(rows)), count)
+    sides = [frames[k].sides[i] for k, i, _ in rows]
+    s = np.concatenate([s for _, _, s in rows])
+    O, N0, B = (np.array([getattr(x, a) for x in sides])[which] for a in ("O", "N0", "B"))
+    kappa = np.array([float(x.kappa) for x in sides])[which]
+    radius = np.array([x.radius for x in sides])[which]
+    S = np.array([frames[k].U for k, _, _ in rows])[which]
+    C = arc_points(O, N0, B, kappa, radius, s)[0]
+    rho = cone_rulings(C, S)[1]
+    theta = developed_angles(O, N0, B, kappa, radius, S, s, fillet=which)
+    bounds = np.cumsum(count)[:-1]
+    for (k, i, _), c, r, th in zip(
+        rows, np.split(C, bounds), np.split(rho, bounds), np.split(theta, bounds), strict=True
+    ):
+        out[k][i] = (c, r, th)
+    return out
 
 
-def _fan(frame: VertexFrame, centres: np.ndarray, conical, n_samples):
-    """Every side's half (:func:`_side_points`), every face's wedge at ``S`` and its three
-    corners ``P``, centre, ``P'`` in the face's chart with the chart angle of ``P``."""
+def _fan(frame: VertexFrame, centres: np.ndarray, sides: list):
+    """Every face's wedge at ``S`` and its three corners ``P``, centre, ``P'`` in the face's
+    chart with the chart angle of ``P``, given the frame's side halves (:func:`_side_points`)."""
     ring = frame.ring
     n_e, n_f = len(ring.edges), len(ring.faces)
-    sides = [_side_points(frame, i, conical, n_samples) for i in range(len(ring.edges))]
     chart_points = []
     wedge = np.zeros(n_f)
     for f in range(n_f):
@@ -75,7 +90,7 @@ def _fan(frame: VertexFrame, centres: np.ndarray, conical, n_samples):
         rel = np.mod(np.arctan2(ch[:, 1], ch[:, 0]) - a0, 2 * np.pi)
         wedge[f] = rel[2]
         chart_points.append((ch, a0))
-    return sides, wedge, chart_points
+    return wedge, chart_points
 
 
 def _polar(angle: np.ndarray, radius: np.ndarray) -> np.ndarray:
@@ -83,18 +98,20 @@ def _polar(angle: np.ndarray, radius: np.ndarray) -> np.ndarray:
 
 
 def sharp_module(frame: VertexFrame, centres: np.ndarray, conical, n_samples) -> list[Piece]:
-    """The flat piece(s) of one sharp vertex (:func:`sharp_modules` of a batch of one).
+    """The flat piece(s) of one sharp vertex (:func:`sharp_modules` of a batch of one)."""
+    return sharp_modules([frame], centres, conical, n_samples)[0]
+
+
+def _module(frame: VertexFrame, centres: np.ndarray, sides: list) -> list[Piece]:
+    """The flat piece(s) of one sharp vertex from its side halves (:func:`_side_points`).
 
     Parameters
     ----------
     frame : VertexFrame
     centres : (n_faces, 3) float
         Face piece centres, by mesh face.
-    conical : (n_edges,) bool or None
-        Which edges are conical fillets (the other end takes a cone); None: every rounded
-        side (radius > 0: an edge between two sharp vertices has radius 0).
-    n_samples : int or (n_edges,) int
-        Points per fillet arc.
+    sides : list
+        Its side halves.
 
     Returns
     -------
@@ -103,7 +120,7 @@ def sharp_module(frame: VertexFrame, centres: np.ndarray, conical, n_samples) ->
     ring = frame.ring
     n_e, n_f = len(ring.edges), len(ring.faces)
     U = frame.U
-    sides, wedge, chart_points = _fan(frame, centres, conical, n_samples)
+    wedge, chart_points = _fan(frame, centres, sides)
     # elements in ring order: side 0, face 0, side 1, ..., (closed) face n_f - 1
     elements = []
     for i in range(n_e):
@@ -126,10 +143,8 @@ def sharp_module(frame: VertexFrame, centres: np.ndarray, conical, n_samples) ->
         apex = piece.point(("S",), (0.0, 0.0), U)
         if kind == "side":
             C, rho, theta = sides[i]
-            idx = [
-                piece.point(("side", i, k), _polar(phi + theta[k], rho[k]), C[k])
-                for k in range(len(C))
-            ]
+            flat = _polar(phi + theta, rho)
+            idx = [piece.point(("side", i, k), flat[k], C[k]) for k in range(len(C))]
             patch = f"fillet {ring.edges[i]}"
             for k in range(len(idx) - 1):
                 piece.face([apex, idx[k], idx[k + 1]], patch)
@@ -152,26 +167,33 @@ def sharp_module(frame: VertexFrame, centres: np.ndarray, conical, n_samples) ->
 
 
 def sharp_modules(frames: list, centres: np.ndarray, conical, n_samples) -> list[list[Piece]]:
-    """The modules of many sharp vertices: :func:`sharp_module` of each frame.
+    """The modules of many sharp vertices.
 
     Parameters
     ----------
     frames : sequence of VertexFrame
     centres : (n_faces, 3) float
+        Face piece centres, by mesh face.
     conical : (n_edges,) bool or None
+        Which edges are conical fillets (the other end takes a cone); None: every rounded
+        side (radius > 0: an edge between two sharp vertices has radius 0).
     n_samples : int or (n_edges,) int
+        Points per fillet arc.
 
     Returns
     -------
     list of list of Piece
-        One module per frame, in order.
+        One module per frame, in order (the fillets of all frames computed together).
     """
-    return [sharp_module(f, centres, conical, n_samples) for f in frames]
+    frames = list(frames)
+    halves = _side_points(frames, conical, n_samples)
+    return [_module(f, centres, h) for f, h in zip(frames, halves, strict=True)]
 
 
 def fan_angle(frame: VertexFrame, centres: np.ndarray, conical=None) -> float:
     """The angle the sharp vertex's fan sweeps in the development (radians): the faces'
     wedges at ``S`` (each corner angle less ``psi`` beside each conical side) plus the
     fillets' sectors ``theta(a)``."""
-    sides, wedge, _ = _fan(frame, centres, conical, 2)
+    sides = _side_points([frame], conical, 2)[0]
+    wedge, _ = _fan(frame, centres, sides)
     return float(wedge.sum() + sum(side[2][-1] for side in sides))
