@@ -795,13 +795,15 @@ def _apices(
     Returns the frames, classification, rounding and face-piece centres afterwards (the
     rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
     kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
-    if st is None and "saddle" in sharp_kinds and "saddle" in res.status:
-        # saddles are known before any apex: sharp first, so that their neighbours are solved
-        # once, with their sides toward them conical (a reused design's frames are so already)
+
+    def sharpen(kinds, apices, **options):
+        """:func:`sharpen_vertices` of ``kinds`` on this stage's state (frames and the
+        classification copied first); the new rounding, centres and Sharpening."""
+        nonlocal frames, classified
         frames = list(frames)
         classified = copy.deepcopy(classified)
         _stage("sharp vertices")
-        rounding, centres, _ = sharpen_vertices(
+        return sharpen_vertices(
             pm,
             rounding,
             frames,
@@ -809,14 +811,20 @@ def _apices(
             depths,
             centres,
             face_piece_centres,
-            {},
-            {"saddle"},
+            apices,
+            kinds,
             flat_deg=coplanar_deg,
             floor=floor,
             min_width=min_width,
             classified=classified,
-            solve=False,
+            sharp=_sharp_frames(frames),
+            **options,
         )
+
+    if st is None and "saddle" in sharp_kinds and "saddle" in res.status:
+        # saddles are known before any apex: sharp first, so that their neighbours are solved
+        # once, with their sides toward them conical (a reused design's frames are so already)
+        rounding, centres, _ = sharpen({"saddle"}, {}, solve=False)
     pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
     kept = set()
     if st is not None:
@@ -846,41 +854,26 @@ def _apices(
             apices=apices,
             classified=classified,
             vertices=pending,
-            sharp=np.array([f.sharp for f in frames], dtype=bool),
+            sharp=_sharp_frames(frames),
         )
         kept -= rescue.resolved
-    already = np.array([f.sharp for f in frames], dtype=bool)
+    already = _sharp_frames(frames)
     if sharp_kinds and any(
         sharp_kind(s) in sharp_kinds and not a for s, a in zip(res.status, already, strict=True)
     ):
-        frames = list(frames)
-        classified = copy.deepcopy(classified)
-        _stage("sharp vertices")
-        rounding, centres, sharpening = sharpen_vertices(
-            pm,
-            rounding,
-            frames,
-            res,
-            depths,
-            centres,
-            face_piece_centres,
-            apices,
-            sharp_kinds,
-            flat_deg=coplanar_deg,
-            floor=floor,
-            min_width=min_width,
-            size=size,
-            progress=progress,
-            classified=classified,
-            sharp=np.array([f.sharp for f in frames], dtype=bool),
-        )
+        rounding, centres, sharpening = sharpen(sharp_kinds, apices, size=size, progress=progress)
         kept -= sharpening.resolved | set(np.flatnonzero(sharpening.sharp).tolist())
     solved = [
         st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
         for u, frame in enumerate(frames)
     ]
-    set_treatments(res, np.array([f.sharp for f in frames], dtype=bool))
+    set_treatments(res, _sharp_frames(frames))
     return frames, classified, rounding, centres, solved, kept, rescue
+
+
+def _sharp_frames(frames) -> np.ndarray:
+    """(n_vertices,) bool: the vertices whose frames are built sharp."""
+    return np.array([f.sharp for f in frames], dtype=bool)
 
 
 def resolve_chord_tol(value, reference: float) -> float:

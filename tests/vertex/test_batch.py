@@ -175,17 +175,22 @@ def test_phase1_lp_reaches_a_feasible_point_and_never_loses_slack(mesh, loss):
             assert t > 0
 
 
-def test_phase1_lp_stops_at_an_infeasible_problem():
-    """Two contradictory face rows: the slack stays negative and the start is not lost."""
-    cons, target, _ = first_attempts("icosahedron", 0.15, 0.3)[0]
+def _contradictory(cons):
+    """``cons`` with its first face row repeated reversed and shifted: infeasible."""
     k = int(np.flatnonzero(cons.lin_kind == "face")[0])
-    bad = dataclasses.replace(
+    return dataclasses.replace(
         cons,
         lin_a=np.vstack([cons.lin_a, -cons.lin_a[k]]),
         lin_b=np.append(cons.lin_b, -cons.lin_b[k] - 0.01 * cons.scale),
         lin_kind=np.append(cons.lin_kind, "face"),
         lin_element=np.append(cons.lin_element, cons.lin_element[k]),
     )
+
+
+def test_phase1_lp_stops_at_an_infeasible_problem():
+    """Two contradictory face rows: the slack stays negative and the start is not lost."""
+    cons, target, _ = first_attempts("icosahedron", 0.15, 0.3)[0]
+    bad = _contradictory(cons)
     rows = pack_problems([bad], target[None], 3)
     y0 = np.zeros(3)
     _, t = phase1_lp(rows, y0[None])
@@ -199,14 +204,7 @@ def test_phase1_lp_solves_a_batch_as_its_problems_one_by_one():
     rng = np.random.default_rng(11)
     probs = [(c, tg) for c, tg, _ in first_attempts("icosahedron", 0.1, 0.3)[:3]]
     cons, target, _ = first_attempts("icosahedron", 0.15, 0.3)[0]
-    k = int(np.flatnonzero(cons.lin_kind == "face")[0])
-    bad = dataclasses.replace(
-        cons,
-        lin_a=np.vstack([cons.lin_a, -cons.lin_a[k]]),
-        lin_b=np.append(cons.lin_b, -cons.lin_b[k] - 0.01 * cons.scale),
-        lin_kind=np.append(cons.lin_kind, "face"),
-        lin_element=np.append(cons.lin_element, cons.lin_element[k]),
-    )
+    bad = _contradictory(cons)
     probs.insert(1, (bad, target))
     rows = pack_problems([c for c, _ in probs], np.stack([tg for _, tg in probs]), 3)
     y0 = rng.normal(scale=0.1, size=(len(probs), 3))
