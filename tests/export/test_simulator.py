@@ -279,11 +279,13 @@ def test_simulator_svg_is_the_fold_file_in_the_apps_colours(name):
     drawn += v2.min(axis=0) - np.array([drawn[:, 0].min(), drawn[:, 1].min()])
     size = np.linalg.norm(np.ptp(v2, axis=0))
     # points within SIM_SVG_WELD of the size, flat and folded, are welded into one (the
-    # notch of a nearly flat sharp vertex of a real mesh, closed when folded)
+    # notch of a nearly flat sharp vertex of a real mesh, closed when folded), as _welded
+    # does: the flat extent's share flat, the folded diameter's share folded
     extent = np.ptp(v2, axis=0).max()
+    diameter = np.linalg.norm(np.ptp(v3, axis=0))
     rep = np.arange(len(v2))
     for a, b in sorted(cKDTree(v2).query_pairs(SIM_SVG_WELD * extent)):
-        if np.linalg.norm(v3[a] - v3[b]) <= SIM_SVG_WELD * size:
+        if np.linalg.norm(v3[a] - v3[b]) <= SIM_SVG_WELD * diameter:
             rep[rep == rep[b]] = rep[a]
     gap, at = cKDTree(v2).query(drawn)
     assert gap.max() <= 1e-6 * size
