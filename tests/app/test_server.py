@@ -258,6 +258,7 @@ def app():
         app.stop()
 
 
+@pytest.mark.slow
 def test_page_draws_slider_changes_design_and_bad_upload_shows_error(app, browser, tmp_path):
     ARTIFACTS.mkdir(exist_ok=True)
     browser.get(app.url + "/")

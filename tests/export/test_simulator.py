@@ -58,7 +58,11 @@ DESIGNS = ["cube", "icosahedron net", "miura material-loss", "compas-boxes"]
 #: border where a cylinder was collapsed or an edge left sharp, skinny face pieces. Until
 #: the simulator copy checked every merge, bunny-lowres stopped with "fillet 251 of the
 #: pattern has no outline" and pyvista-nut with "pattern face 624 is clockwise".
-CORPUS_DESIGNS = ["blob default", "bunny-lowres", "pyvista-nut"]
+CORPUS_DESIGNS = [
+    "blob default",
+    pytest.param("bunny-lowres", marks=pytest.mark.slow),
+    pytest.param("pyvista-nut", marks=pytest.mark.slow),
+]
 ALL_DESIGNS = DESIGNS + CORPUS_DESIGNS
 
 

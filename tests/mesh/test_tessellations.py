@@ -167,6 +167,7 @@ def test_resch_mountains_and_valleys():
     assert (deg == 12).sum() == 6  # one interior vertex of degree 12 per star
 
 
+@pytest.mark.slow
 def test_resch_4x4_at_the_default_fold_loads_and_is_developable():
     """At fold 0.5 a few rim spokes of a 4x4 patch fold the other way, nearly flat."""
     mesh, log = load_mesh("resch:4x4")

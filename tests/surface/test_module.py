@@ -109,6 +109,7 @@ def test_holes_open_rings_and_runs_at_other_radii(name, radius, depth):
     compare(d, d.stages.samples)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["pyvista-ant.ply", "compas-tubemesh.obj"])
 def test_real_meshes_give_the_modules_of_the_oracle(name):
     """Hole borders through a corner T (28 of the ant's hole modules), sharp edges whose
