@@ -541,6 +541,46 @@ def test_missing_or_unreadable_input_exits_2_with_one_line(tmp_path, tmp_root, c
     (folder / "design.fold").write_text(open(f"{ico}/design.fold").read())  # another design's
     (folder / "report.json").write_text(open(f"{cube}/report.json").read())
     err = _error_line(["check", str(folder)], capsys)
-    assert "does not match report.json" in err and "there is no mesh" in err
+    assert "does not match report.json" in err and "12 vertices, 30 edges and 20 faces" in err
     (folder / "report.json").write_text("[1, 2")
     assert "report.json: not a report (invalid JSON" in _error_line(["check", str(folder)], capsys)
+
+
+def test_the_mesh_comes_from_the_fold_or_from_the_report_tables(tmp_path, capsys):
+    """design.fold holds the mesh's per-element data; a folder whose FOLD lacks it (written
+    before it had it) is checked from the tables of report.json; with neither, one line."""
+    d = design_of("icosahedron", radius=0.1)
+    d.export(tmp_path / "ref", formats="fold,json")
+    ref = check_folder(tmp_path / "ref")
+    folder = tmp_path / "tables"
+    d.export(folder, formats="fold,json", tables=True)
+    _rewrite_fold(
+        folder,
+        lambda doc: [doc.pop(k) for k in list(doc) if k.startswith("filletfold:mesh_")],
+    )
+    again = check_folder(folder)
+    assert again.ok and [c.name for c in again.checks] == [c.name for c in ref.checks]
+    # the FOLD's mesh has 12 digits, the report's tables 17: the same to rounding
+    a, b = (np.array([c.value for c in x.checks], dtype=float) for x in (again, ref))
+    np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-11)
+    plain = tmp_path / "plain"
+    d.export(plain, formats="fold,json")
+    _rewrite_fold(plain, lambda doc: doc.pop("filletfold:mesh_vertices_coords"))
+    err = _error_line(["check", str(plain)], capsys)
+    assert "has no mesh data and report.json no tables" in err
+
+
+def test_a_radius_changed_in_the_fold_fails_the_cylinders(tmp_path):
+    """The mesh's data in design.fold is measured, not trusted: a cylinder whose radius the
+    file gives 1% larger than its points lie at fails "on cylinders"."""
+    folder = tmp_path / "ico"
+    design_of("icosahedron", radius=0.1).export(folder, formats="fold,json")
+
+    def grow(doc):
+        r = doc["filletfold:mesh_edges_radius"]
+        r[3] *= 1.01
+
+    _rewrite_fold(folder, grow)
+    cert = check_folder(folder)
+    assert "on cylinders" in _failed(cert)
+    assert "cylinder 3" in cert["on cylinders"].detail

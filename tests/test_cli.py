@@ -28,7 +28,20 @@ def test_round_writes_the_design(tmp_path, capsys):
 
 def test_relative_radius_and_depth(tmp_path):
     assert (
-        main(["round", "cube", "--radius", "10%", "--depth", "60%", "-o", str(tmp_path / "c")]) == 0
+        main(
+            [
+                "round",
+                "cube",
+                "--radius",
+                "10%",
+                "--depth",
+                "60%",
+                "--report-tables",
+                "-o",
+                f"{tmp_path}/c",
+            ]
+        )
+        == 0
     )
     report = json.loads((tmp_path / "c" / "report.json").read_text())
     assert report["edges"][0]["radius"] == pytest.approx(0.1)
@@ -155,7 +168,18 @@ def test_unreadable_file(tmp_path, capsys):
 
 def test_material_loss_reports_the_programme(tmp_path, capsys):
     assert (
-        main(["round", "cube", "--material-loss", "--max-loss", "5%", "-o", str(tmp_path / "c")])
+        main(
+            [
+                "round",
+                "cube",
+                "--material-loss",
+                "--max-loss",
+                "5%",
+                "--report-tables",
+                "-o",
+                f"{tmp_path}/c",
+            ]
+        )
         == 0
     )
     out = " ".join(capsys.readouterr().out.split())

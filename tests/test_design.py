@@ -180,13 +180,17 @@ def test_export_writes_the_four_files(tmp_path):
     frame = fold["file_frames"][0]
     assert frame["frame_classes"] == ["foldedForm"] and frame["frame_parent"] == 0
     assert frame["frame_inherit"] is True and len(frame["vertices_coords"][0]) == 3
-    n_edges, n_faces = len(report["edges"]), len(report["mesh"]["faces"])
+    n_edges = len(fold["filletfold:mesh_edges_vertices"])
+    n_faces = len(fold["filletfold:mesh_faces_vertices"])
+    assert report["mesh_counts"] == {"vertices": 8, "edges": n_edges, "faces": n_faces}
     for name in fold["filletfold:faces_patch"]:
         kind, idx = re.fullmatch(r"(cone|cylinder|face) (\d+)", name).groups()
-        bound = {"cone": len(report["mesh"]["vertices"]), "cylinder": n_edges, "face": n_faces}
+        bound = {"cone": 8, "cylinder": n_edges, "face": n_faces}
         assert int(idx) < bound[kind]
-    assert report["mesh"]["vertices"] == d.mesh.vertices.tolist()
-    assert all(v["status"] == "ok" for v in report["vertices"])
+    assert fold["filletfold:mesh_vertices_coords"] == d.mesh.vertices.tolist()
+    assert report["treatment_counts"] == {"cone": 8, "sharp": 0, "hole": 0}
+    assert "edges" not in report and "vertices" not in report  # a summary
+    report = d.report()  # the tables
     for e in report["edges"]:
         assert set(e) >= {"vertices", "faces", "radius", "half_angle"}
     assert set(report["vertices"][0]) >= {

@@ -60,7 +60,7 @@ import shapely
 from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
-from .export.fold_read import _edge_faces, read_fold
+from .export.fold_read import _edge_faces, read_fold_document
 from .surface.pattern import CreasePattern, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
@@ -1313,8 +1313,8 @@ def check_folder(path) -> Certificate:
     for f in (fold, report):
         if not f.is_file():
             raise MeshReadError(f"{f}: no such file (write the design with 'filletfold round')")
-    pattern = read_fold(fold)
-    mesh_vertices, mesh_faces, edges, apex, arc_step = _read_report(report)
+    pattern, doc = read_fold_document(fold)
+    mesh_vertices, mesh_faces, edges, apex, arc_step = _read_report(report, doc, fold)
     try:
         return certify(
             pattern,
@@ -1329,35 +1329,55 @@ def check_folder(path) -> Certificate:
         raise MeshReadError(f"{fold} does not match {report.name}: {exc}") from None
 
 
-def _read_report(path: Path):
-    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step) of a ``report.json``
-    (the arc step its parameters name, else the default)."""
+#: The prefix of the mesh's keys in ``design.fold`` (see ``mesh_fold_keys`` in
+#: :mod:`filletfold.export.outputs`).
+MESH_KEY = "filletfold:mesh_"
+
+
+def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | None = None):
+    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step) of a design: the mesh
+    and its edges and apices from the ``filletfold:mesh_*`` keys of its FOLD document when it
+    has them, else from the tables of its ``report.json`` (written with ``--report-tables``,
+    or by filletfold before 0.2); the arc step the report's parameters name, else the
+    default."""
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as exc:
         raise MeshReadError(f"{path}: cannot read: {exc}") from None
     except json.JSONDecodeError as exc:
         raise MeshReadError(f"{path}: not a report (invalid JSON: {exc.msg})") from None
+    if not isinstance(doc, dict) or "parameters" not in doc:
+        raise MeshReadError(f"{path}: not a filletfold report (no key 'parameters')")
+    if fold_doc is not None and MESH_KEY + "vertices_coords" in fold_doc:
+        where = fold_path or "design.fold"
+        try:
+            vertices, faces, ev, ef, radius, gamma, kappa, apex = _mesh_of_fold(fold_doc)
+        except KeyError as exc:
+            raise MeshReadError(f"{where}: the mesh's data lacks the key {exc}") from None
+        except (TypeError, ValueError, AttributeError) as exc:
+            raise MeshReadError(f"{where}: the mesh's data is malformed: {exc}") from None
+        counts = doc.get("mesh_counts")
+        mine = {"vertices": len(vertices), "edges": len(ev), "faces": len(faces)}
+        if isinstance(counts, dict) and {k: counts.get(k) for k in mine} != mine:
+            raise MeshReadError(
+                f"{where} does not match {path.name}: its mesh has {mine['vertices']} vertices, "
+                f"{mine['edges']} edges and {mine['faces']} faces, the report's "
+                f"{counts.get('vertices')}, {counts.get('edges')} and {counts.get('faces')}"
+            )
+    elif "edges" not in doc:
+        raise MeshReadError(
+            f"{fold_path or 'design.fold'} has no mesh data and {path.name} no tables "
+            "(write the design again with 'filletfold round')"
+        )
+    else:
+        try:
+            vertices, faces, ev, ef, radius, gamma, kappa, apex = _mesh_of_report(doc)
+        except KeyError as exc:
+            raise MeshReadError(f"{path}: not a filletfold report (no key {exc})") from None
+        except (TypeError, ValueError, AttributeError) as exc:
+            raise MeshReadError(f"{path}: not a filletfold report (malformed: {exc})") from None
     try:
-        mesh = doc["mesh"]
-        vertices = np.asarray(mesh["vertices"], dtype=np.float64).reshape(-1, 3)
-        faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in mesh["faces"]]
-        records = doc["edges"]
-        ev = np.array([r["vertices"] for r in records], dtype=np.int64).reshape(-1, 2)
-        ef = np.array(
-            [[-1, -1] if r["faces"] is None else r["faces"] for r in records], dtype=np.int64
-        ).reshape(-1, 2)
-        radius = np.array([_number(r["radius"]) for r in records], dtype=np.float64)
-        gamma = np.array([_number(r["half_angle"]) for r in records], dtype=np.float64)
-        sign = {"M": 1.0, "V": -1.0}
-        kappa = np.array([sign.get(r["assignment"], 0.0) for r in records], dtype=np.float64)
-        apex = np.array(
-            [[np.nan] * 3 if v["apex"] is None else v["apex"] for v in doc["vertices"]],
-            dtype=np.float64,
-        ).reshape(-1, 3)
         arc_step = float((doc.get("parameters") or {}).get("arc_step", DEFAULT_ARC_STEP))
-    except KeyError as exc:
-        raise MeshReadError(f"{path}: not a filletfold report (no key {exc})") from None
     except (TypeError, ValueError, AttributeError) as exc:
         raise MeshReadError(f"{path}: not a filletfold report (malformed: {exc})") from None
     if len(apex) != len(vertices):
@@ -1369,6 +1389,49 @@ def _read_report(path: Path):
     if not (math.isfinite(arc_step) and 0 <= arc_step <= 180):
         raise MeshReadError(f"{path}: arc_step {arc_step} is not in [0, 180] degrees")
     return vertices, faces, edges, apex, arc_step
+
+
+def _mesh_of_fold(doc: dict) -> tuple:
+    """The mesh, its edges' rounding and its apices from the ``filletfold:mesh_*`` keys."""
+
+    def key(name):
+        return doc[MESH_KEY + name]
+
+    vertices = np.asarray(key("vertices_coords"), dtype=np.float64).reshape(-1, 3)
+    faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in key("faces_vertices")]
+    ev = np.asarray(key("edges_vertices"), dtype=np.int64).reshape(-1, 2)
+    ef = np.asarray(key("edges_faces"), dtype=np.int64).reshape(-1, 2)
+    radius = np.array([_number(r) for r in key("edges_radius")], dtype=np.float64)
+    gamma = np.array([_number(g) for g in key("edges_halfAngle")], dtype=np.float64)
+    sign = {"M": 1.0, "V": -1.0}
+    kappa = np.array([sign.get(a, 0.0) for a in key("edges_assignment")], dtype=np.float64)
+    apex = np.array(
+        [[np.nan] * 3 if a is None else a for a in key("vertices_apex")], dtype=np.float64
+    ).reshape(-1, 3)
+    if not (len(ev) == len(ef) == len(radius) == len(gamma) == len(kappa)):
+        raise ValueError("its edge arrays differ in length")
+    return vertices, faces, ev, ef, radius, gamma, kappa, apex
+
+
+def _mesh_of_report(doc: dict) -> tuple:
+    """The mesh, its edges' rounding and its apices from a report's tables."""
+    mesh = doc["mesh"]
+    vertices = np.asarray(mesh["vertices"], dtype=np.float64).reshape(-1, 3)
+    faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in mesh["faces"]]
+    records = doc["edges"]
+    ev = np.array([r["vertices"] for r in records], dtype=np.int64).reshape(-1, 2)
+    ef = np.array(
+        [[-1, -1] if r["faces"] is None else r["faces"] for r in records], dtype=np.int64
+    ).reshape(-1, 2)
+    radius = np.array([_number(r["radius"]) for r in records], dtype=np.float64)
+    gamma = np.array([_number(r["half_angle"]) for r in records], dtype=np.float64)
+    sign = {"M": 1.0, "V": -1.0}
+    kappa = np.array([sign.get(r["assignment"], 0.0) for r in records], dtype=np.float64)
+    apex = np.array(
+        [[np.nan] * 3 if v["apex"] is None else v["apex"] for v in doc["vertices"]],
+        dtype=np.float64,
+    ).reshape(-1, 3)
+    return vertices, faces, ev, ef, radius, gamma, kappa, apex
 
 
 def _number(x) -> float:

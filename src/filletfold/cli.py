@@ -327,11 +327,20 @@ def round_cmd(
             "or 'auto' (sparrow when installed, else shelf).",
         ),
     ] = "shelf",
+    report_tables: Annotated[
+        bool,
+        typer.Option(
+            "--report-tables",
+            help="Write the per-element tables (mesh, edges, vertices) into report.json too; "
+            "without it the report is a summary.",
+        ),
+    ] = False,
 ):
     """Round every edge and vertex of MESH; write the design into the output folder.
 
-    Writes design.fold (crease pattern + folded form), report.json (with timings.json beside
-    it), folded.obj and pattern.svg, all or nothing; --format all adds every other format
+    Writes design.fold (crease pattern + folded form + the mesh's data), report.json (a
+    summary, with timings.json beside it), folded.obj and pattern.svg, all or nothing;
+    --format all adds every other format
     (simulator.fold and simulator.svg for Origami Simulator, pattern.dxf, pattern.pdf,
     pattern.png and preview.png, the 3dm, glb, ply and stl files). Every file but
     timings.json has the same bytes for the same input and options.
@@ -414,6 +423,7 @@ def round_cmd(
             page=sheet or "A4",
             preset=preset,
             view=view,
+            tables=report_tables,
         )
         if log is not None:
             log.finish()

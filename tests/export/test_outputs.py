@@ -12,6 +12,7 @@ import pytest
 
 from filletfold.export.outputs import (
     OUTPUT_FILES,
+    REPORT_TABLES,
     design_report,
     design_summary,
     edge_mismatch,
@@ -67,4 +68,16 @@ def test_export_design_writes_the_default_files(tmp_path):
     for p in written:
         assert p.stat().st_size > 0
     report = json.loads((tmp_path / "out" / "report.json").read_text())
-    assert report == json.loads(json.dumps(design_report(d)))
+    full = json.loads(json.dumps(design_report(d)))
+    assert report == {k: v for k, v in full.items() if k not in REPORT_TABLES}  # a summary
+    assert report["mesh_counts"] == {"vertices": 8, "edges": 12, "faces": 6}
+    assert report["treatment_counts"] == {"cone": 8, "sharp": 0, "hole": 0}
+    # the tables on request; the mesh's data in design.fold either way
+    export_design(d, tmp_path / "tables", formats="fold,json", tables=True)
+    assert json.loads((tmp_path / "tables" / "report.json").read_text()) == full
+    fold = json.loads((tmp_path / "out" / "design.fold").read_text())
+    np.testing.assert_allclose(fold["filletfold:mesh_vertices_coords"], d.mesh.vertices)
+    np.testing.assert_allclose(fold["filletfold:mesh_edges_radius"], d.rounding.radius)
+    assert fold["filletfold:mesh_edges_vertices"] == d.mesh.edges.tolist()
+    apex = [v["apex"] for v in full["vertices"]]
+    np.testing.assert_allclose(fold["filletfold:mesh_vertices_apex"], apex, rtol=1e-11)

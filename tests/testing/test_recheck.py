@@ -151,7 +151,7 @@ def test_arc_step_argument_and_unreadable(ico, tmp_path, capsys):
     r = recheck_fold(ico / "design.fold", arc_step_deg=1.0)  # tighter than the design's 10
     assert r["arc_step_source"] == "argument" and not r["ok"]
     assert any("> arc step 1°" in s for s in r["failures"])
-    assert r["mesh_closed"] is True and r["mesh_closed_source"].startswith("report.json mesh")
+    assert r["mesh_closed"] is True and r["mesh_closed_source"].startswith("design.fold mesh")
     (tmp_path / "x.fold").write_text("{}")
     assert main([str(tmp_path / "x.fold")]) == 2
     assert main([str(ico), "icosahedron"]) == 0

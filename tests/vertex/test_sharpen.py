@@ -111,7 +111,7 @@ def test_fillet_mismatch_converges_under_refinement():
 
 def test_treatments_in_the_report(tmp_path):
     out = tmp_path / "lp"
-    assert main(["round", "l-prism", "-o", str(out), "-q"]) == 0
+    assert main(["round", "l-prism", "-o", str(out), "-q", "--report-tables"]) == 0
     report = json.loads((out / "report.json").read_text())
     vt = [v["treatment"] for v in report["vertices"]]
     et = [e["treatment"] for e in report["edges"]]

@@ -279,6 +279,7 @@ def cut_files(
     lazy: bool = False,
     preset: str | Preset | None = None,
     view=None,
+    fold_extra: Mapping | None = None,
 ) -> dict:
     """Build the output files of ``formats`` for a crease pattern (nothing is written).
 
@@ -309,6 +310,9 @@ def cut_files(
     preset : str or Preset, optional
         Cutter preset of the SVG and DXF (:data:`~filletfold.export.presets.PRESETS`; default
         ``origami-simulator``).
+    fold_extra : mapping, optional
+        More namespaced top-level keys of ``design.fold`` (``filletfold round`` adds the mesh's
+        per-element data, :func:`~filletfold.export.outputs.mesh_fold_keys`).
 
     Returns
     -------
@@ -345,7 +349,13 @@ def cut_files(
 
     def fold():
         doc = _fold_document(
-            pattern, faces, title=title, description=description, arrays=True, annotations=False
+            pattern,
+            faces,
+            title=title,
+            description=description,
+            extra=fold_extra,
+            arrays=True,
+            annotations=False,
         )
         return fold_json(doc)
 

@@ -37,7 +37,8 @@ _REQUIRED = (
 
 
 def read_fold(path) -> CreasePattern:
-    """Read a filletfold ``design.fold`` back into a crease pattern.
+    """Read a filletfold ``design.fold`` back into a crease pattern
+    (:func:`read_fold_document` without the document).
 
     Parameters
     ----------
@@ -56,6 +57,12 @@ def read_fold(path) -> CreasePattern:
         (a required key or the folded frame is missing, or the data is inconsistent); the
         message names the file and the problem.
     """
+    return read_fold_document(path)[0]
+
+
+def read_fold_document(path) -> tuple[CreasePattern, dict]:
+    """:func:`read_fold`, and the parsed document (for its other keys, such as the mesh's
+    ``filletfold:mesh_*`` that ``filletfold check`` reads)."""
     path = Path(os.fspath(path))
     doc = _load_json(path, "a FOLD file")
     try:
@@ -64,7 +71,7 @@ def read_fold(path) -> CreasePattern:
         raise MeshReadError(f"{path}: {exc}") from None
     if NAMESPACE + "annotations" not in doc:
         pattern.annotations = read_annotations(path.with_name(ANNOTATIONS_FILE), pattern)
-    return pattern
+    return pattern, doc
 
 
 def read_annotations(path, pattern: CreasePattern) -> Annotations:

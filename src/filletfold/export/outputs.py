@@ -79,6 +79,12 @@ def report_records(design) -> dict:
         "mean_edge_length": float(mesh.mean_edge_length),
         "uniform_radius_limit": _num(rd.uniform_limit),
         "status_counts": design.status_counts(),
+        "treatment_counts": _treatment_counts(design.vertices.treatment),
+        "mesh_counts": {
+            "vertices": int(mesh.n_vertices),
+            "edges": int(mesh.n_edges),
+            "faces": int(mesh.n_faces),
+        },
         "mesh": {"vertices": mesh.vertices, "faces": list(mesh.faces)},
         "edges": _edge_records(
             mesh, rd, design.fitting.get("radius_requested"), design.vertices.treatment
@@ -99,6 +105,69 @@ def report_records(design) -> dict:
         "layout": {"kind": design.layout, "note": design.layout_note or None},
         "fabrication": _fabrication_report(design),
         "material_loss": _loss_report(design.material_loss),
+    }
+
+
+#: The per-element tables of :func:`report_records`, in ``report.json`` only on request
+#: (``export_design(tables=True)``, ``filletfold round --report-tables``): the file is a
+#: summary, and what ``filletfold check`` needs per element is in ``design.fold``
+#: (:func:`mesh_fold_keys`).
+REPORT_TABLES = ("mesh", "edges", "vertices")
+
+
+def _treatment_counts(treatment) -> dict:
+    """Vertices per treatment: ``cone``, ``sharp``, ``hole`` (every key, zeros included)."""
+    out = dict.fromkeys(("cone", "sharp", "hole"), 0)
+    for t in treatment:
+        out[t] = out.get(t, 0) + 1
+    return out
+
+
+def summary_records(design, tables: bool = False) -> dict:
+    """:func:`report_records` as ``report.json`` has it: without :data:`REPORT_TABLES` unless
+    ``tables``."""
+    report = report_records(design)
+    if tables:
+        return report
+    return {k: v for k, v in report.items() if k not in REPORT_TABLES}
+
+
+def mesh_fold_keys(design) -> dict:
+    """What ``filletfold check`` needs per element of the (cleaned) mesh, as namespaced keys
+    of ``design.fold``: the certificate can be measured again from the file alone.
+
+    Keys (``E`` mesh edges, ``V`` mesh vertices): ``filletfold:mesh_vertices_coords``
+    (V, 3); ``filletfold:mesh_faces_vertices`` (the polygons, counter-clockwise seen from
+    outside); ``filletfold:mesh_edges_vertices`` (E, 2) and ``filletfold:mesh_edges_faces``
+    (E, 2, ``-1`` where an edge has one face); ``filletfold:mesh_edges_radius`` (E,),
+    ``filletfold:mesh_edges_halfAngle`` (E, radians: half the turn between the two faces'
+    normals) and ``filletfold:mesh_edges_assignment`` (E, ``M``/``V``/``B``) of the rounding;
+    ``filletfold:mesh_vertices_apex`` (V, the cone's apex, ``null`` at a vertex without one).
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    dict
+    """
+    mesh, rd = design.mesh, design.rounding
+    boundary = (mesh.edge_faces < 0).any(axis=1)
+    apex = np.asarray(design.vertices.apex, dtype=float).reshape(-1, 3)
+    has = np.isfinite(apex).all(axis=1)
+    apex_rows = [row if ok else None for row, ok in zip(apex.tolist(), has.tolist(), strict=True)]
+    return {
+        "filletfold:mesh_vertices_coords": np.asarray(mesh.vertices, dtype=float),
+        "filletfold:mesh_faces_vertices": [list(map(int, f)) for f in mesh.faces],
+        "filletfold:mesh_edges_vertices": np.asarray(mesh.edges, dtype=np.int64),
+        "filletfold:mesh_edges_faces": np.asarray(mesh.edge_faces, dtype=np.int64),
+        "filletfold:mesh_edges_radius": np.asarray(rd.radius, dtype=float),
+        "filletfold:mesh_edges_halfAngle": np.asarray(rd.half_angle, dtype=float),
+        "filletfold:mesh_edges_assignment": np.where(
+            boundary, "B", np.where(rd.kappa > 0, "M", "V")
+        ).tolist(),
+        "filletfold:mesh_vertices_apex": apex_rows,
     }
 
 
@@ -423,6 +492,7 @@ def export_design(
     page: str = "A4",
     preset=None,
     view=None,
+    tables: bool = False,
 ) -> list[Path]:
     """Write the design's files into ``folder`` atomically (all of them or none).
 
@@ -448,6 +518,10 @@ def export_design(
     view : str or (2,) float, optional
         The direction ``preview.png`` is seen from (see
         :func:`~filletfold.export.cutfiles.cut_files`).
+    tables : bool
+        Whether ``report.json`` holds the per-element tables ``mesh``, ``edges`` and
+        ``vertices`` (:data:`REPORT_TABLES`); by default it is a summary, and ``design.fold``
+        holds what ``filletfold check`` needs per element (:func:`mesh_fold_keys`).
 
     Returns
     -------
@@ -471,6 +545,7 @@ def export_design(
             description="Curved-crease rounded design: vertex modules",
             lazy=True,  # built one at a time as they are written
             preset=preset,
+            fold_extra=mesh_fold_keys(design),
         )
     if "json" in formats:
 
@@ -478,7 +553,7 @@ def export_design(
             design.timings["export"] = time.perf_counter() - t  # the files built before it
             return timings_json(design)
 
-        files["report.json"] = lambda: report_json(report_records(design))
+        files["report.json"] = lambda: report_json(summary_records(design, tables))
         files["timings.json"] = timings
     names = list(output_names(formats))
     seams = design.fabrication.get("seams")

@@ -14,7 +14,8 @@ geometry, certificate or export code:
   degrees; a step of 0 is no limit), and equal to the ``edges_foldAngle`` the file gives it;
 * **creases**: on ``M``/``V`` edges the folded dihedral has the sign of the assignment (valley
   positive, as FOLD has it), matches ``edges_foldAngle``, and stays within 179 degrees (or the
-  mesh's sharpest dihedral in ``report.json``, where that is sharper);
+  mesh's sharpest dihedral, from the FOLD's ``filletfold:mesh_edges_halfAngle`` or the tables of
+  ``report.json``, where that is sharper);
 * **faces**: each face's corner-to-corner distances agree in 2D and 3D (the sides, and the
   diagonals of polygons) within the edges' mismatch limit, each face is planar in 3D (its
   corners' distance from the plane through its centroid with its Newell normal, over its
@@ -245,7 +246,11 @@ def _read(fold_file: Path) -> dict:
         if isinstance(v, int | float) and not isinstance(v, bool):
             arc_step = float(v)
             break
+    half = doc.get("filletfold:mesh_edges_halfAngle")
+    mesh_faces = doc.get("filletfold:mesh_faces_vertices")
     return {
+        "half_angles": half if isinstance(half, list) else None,
+        "mesh_faces": mesh_faces if isinstance(mesh_faces, list) else None,
         "v2": v2,
         "v3": v3,
         "edges": edges,
@@ -293,22 +298,27 @@ def _closed_by_edge_count(faces, vertices=None) -> bool:
     return bool(len(counts)) and bool((counts == 2).all())
 
 
-def _crease_limit(report: dict | None) -> float:
-    """:data:`CREASE_LIMIT_DEG`, or the mesh's sharpest dihedral (twice the largest
-    ``half_angle`` of an edge in ``report.json``) where that is sharper."""
+def _crease_limit(report: dict | None, half_angles: list | None = None) -> float:
+    """:data:`CREASE_LIMIT_DEG`, or the mesh's sharpest dihedral (twice the largest half
+    angle of an edge: ``filletfold:mesh_edges_halfAngle`` of the FOLD, else the ``half_angle``
+    of the edges in ``report.json``) where that is sharper."""
     sharpest = 0.0
-    for edge in (report or {}).get("edges") or []:
-        half = edge.get("half_angle") if isinstance(edge, dict) else None
+    if half_angles is None:
+        edges = (report or {}).get("edges") or []
+        half_angles = [e.get("half_angle") if isinstance(e, dict) else None for e in edges]
+    for half in half_angles:
         if isinstance(half, int | float) and math.isfinite(half):
             sharpest = max(sharpest, math.degrees(2.0 * abs(half)))
     return max(CREASE_LIMIT_DEG, sharpest)
 
 
-def _mesh_closed(mesh_path, report: dict | None) -> tuple[bool | None, str]:
+def _mesh_closed(
+    mesh_path, report: dict | None, mesh_faces: list | None = None
+) -> tuple[bool | None, str]:
     """Whether the input mesh is closed, and where that was learnt: a mesh file is read as
     it is (:func:`filletfold.mesh.read_mesh`, edges counted), a built-in example's name loaded
-    with :func:`filletfold.mesh.load_mesh`; without a mesh, the cleaned mesh ``report.json``
-    records."""
+    with :func:`filletfold.mesh.load_mesh`; without a mesh, the cleaned mesh the FOLD
+    (``filletfold:mesh_faces_vertices``) or ``report.json`` records."""
     if mesh_path is not None:
         from ..mesh import load_mesh, read_mesh
 
@@ -318,6 +328,8 @@ def _mesh_closed(mesh_path, report: dict | None) -> tuple[bool | None, str]:
         mesh, _ = load_mesh(str(mesh_path))  # a built-in example (or an error naming it)
         closed = mesh.is_closed  # a property of PolyMesh
         return bool(closed() if callable(closed) else closed), "built-in mesh"
+    if mesh_faces:
+        return _closed_by_edge_count(mesh_faces), "design.fold mesh (edge count)"
     mesh = (report or {}).get("mesh")
     if isinstance(mesh, dict) and isinstance(mesh.get("faces"), list) and mesh["faces"]:
         return _closed_by_edge_count(mesh["faces"]), "report.json mesh (edge count)"
@@ -490,7 +502,7 @@ def recheck_fold(fold_path, mesh_path=None, *, arc_step_deg: float | None = None
     step = float(step)
     # a side across a bent facet spans at most two facets' turns; a step of 0 is no limit
     share = chord_share(min(EDGE_TURNS * step, 180.0) if step > 0 else 180.0)
-    crease_limit = _crease_limit(report)
+    crease_limit = _crease_limit(report, d["half_angles"])
     tick("report")
 
     v2, v3, edges, assign, angle = d["v2"], d["v3"], d["edges"], d["assign"], d["angle"]
@@ -902,7 +914,7 @@ def recheck_fold(fold_path, mesh_path=None, *, arc_step_deg: float | None = None
     )
     out["boundary_length"] = float(border_len.sum() / size) if size else 0.0
     out["folded_nonmanifold_edges"] = int((wcount > 2).sum())
-    closed, closed_src = _mesh_closed(mesh_path, report)
+    closed, closed_src = _mesh_closed(mesh_path, report, d["mesh_faces"])
     out["mesh_closed"] = closed
     out["mesh_closed_source"] = closed_src
     out["open_boundary_length"] = out["boundary_length"] if closed else 0.0
