@@ -833,8 +833,12 @@ def _apices(
         pending = [u for u in pending if u not in kept]
     _stage("apices")
     # thorough even with the rescue to come: a quick solve calls vertices infeasible that are
-    # not, and the rescue would shrink their radii for nothing
-    apices = _solve_apices(frames, depths, res, centres, progress, pending, size)
+    # not, and the rescue would shrink their radii for nothing; but without the linear
+    # programmes when the rescue follows (they pay for themselves only there)
+    rescue_follows = fit_vertices and not material_loss
+    apices = _solve_apices(
+        frames, depths, res, centres, progress, pending, size, lp=not rescue_follows
+    )
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
         frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
@@ -974,15 +978,16 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
 
 
 def _solve_apices(
-    frames, depths, res: VertexResult, centres, progress, pending, size, thorough=True
+    frames, depths, res: VertexResult, centres, progress, pending, size, thorough=True, lp=True
 ) -> dict:
     """:func:`solve_apices` of the vertices ``pending``; when it fails unforeseen, the
     vertices are solved one by one and a vertex whose solve fails is infeasible, with the
     failure as its reason (a failure is data, not the end of the design)."""
     try:
         return solve_apices(
-            frames, depths, res, centres, progress, vertices=pending, size=size, thorough=thorough
-        )
+            frames, depths, res, centres, progress, vertices=pending, size=size,
+            thorough=thorough, lp=lp,
+        )  # fmt: skip
     except FilletfoldError:
         raise
     except Exception as exc:
@@ -994,7 +999,14 @@ def _solve_apices(
             try:
                 out.update(
                     solve_apices(
-                        frames, depths, res, centres, vertices=[u], size=size, thorough=thorough
+                        frames,
+                        depths,
+                        res,
+                        centres,
+                        vertices=[u],
+                        size=size,
+                        thorough=thorough,
+                        lp=lp,
                     )
                 )
             except FilletfoldError:

@@ -479,6 +479,7 @@ def solve_apices(
     vertices=None,
     thorough: bool = True,
     size: float | None = None,
+    lp: bool = True,
 ) -> dict:
     """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
 
@@ -510,6 +511,9 @@ def solve_apices(
         False skips what only decides a hard case (more feasibility starts and the linear
         programmes of the last attempts): faster, and a vertex may be called infeasible that
         the thorough solve would solve (the vertex rescue's trial rounds use it).
+    lp : bool
+        Whether a thorough solve tries linear programmes before it calls a vertex infeasible
+        (see :func:`~filletfold.vertex.batch.solve_apex_batch`); off where a rescue follows.
     size : float, optional
         The mesh's size (:func:`mesh_size`): every crease stays ``tol.ruling`` of it above its
         base curve (or a quarter of the vertex's shortest ``l_max``), so that no cylinder
@@ -537,7 +541,7 @@ def solve_apices(
         slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
         # the slices are independent (each settles its own vertices): in threads
         for _ in thread_map(
-            lambda part: _solve_round(part, pending, res, out, centres, thorough), slices
+            lambda part: _solve_round(part, pending, res, out, centres, thorough, lp), slices
         ):
             if progress is not None:
                 progress("apices", total - len(pending), total)
@@ -576,7 +580,13 @@ def _shorten_creases(p: ApexProblem, attempt: tuple[int, float]) -> None:
 
 
 def _solve_round(
-    order: list, pending: dict, res: VertexResult, out: dict, centres, thorough: bool = True
+    order: list,
+    pending: dict,
+    res: VertexResult,
+    out: dict,
+    centres,
+    thorough: bool = True,
+    lp: bool = True,
 ) -> None:
     """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
     solved ones at once, and settle every vertex that is done (ok, or out of attempts)."""
@@ -588,6 +598,7 @@ def _solve_round(
         [pending[u].target for u in order],
         [pending[u].starts for u in order],
         thorough=[thorough and t[1] < 1.0 for t in tries],  # only thin attempts end a vertex
+        lp=lp,
     )
     # the dense validation of every solved vertex at once
     solved = [
