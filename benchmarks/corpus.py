@@ -138,12 +138,12 @@ def run(mesh: Path, out: Path, timeout: float, extra: list[str]) -> dict:
     for rep in r.get("repairs", []):
         kinds[rep["what"]] = kinds.get(rep["what"], 0) + 1
     cert = r.get("certificate")
-    treat = [v.get("treatment") for v in r.get("vertices", [])]
+    treat = r.get("treatment_counts") or {}
     row.update(
         outcome="design",
-        vertices=len(r["mesh"]["vertices"]),
-        cones=treat.count("cone"),
-        sharp=treat.count("sharp"),
+        vertices=r["mesh_counts"]["vertices"],
+        cones=treat.get("cone", 0),
+        sharp=treat.get("sharp", 0),
         repairs=kinds,
         fitted=fit.get("radii_reduced", 0),
         sharp_edges=len(fit.get("sharp", [])),

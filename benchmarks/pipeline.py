@@ -342,7 +342,8 @@ def one_run(mesh: str, out: Path, args, extra: list[str]) -> dict:
             row["timings"] = json.loads(timings.read_text())
         if report.is_file():
             rep = json.loads(report.read_text())
-            row["vertices"] = len(rep["mesh"]["vertices"])
+            counts = rep.get("mesh_counts")  # reports before it: the mesh itself
+            row["vertices"] = counts["vertices"] if counts else len(rep["mesh"]["vertices"])
             row["layout"] = rep.get("layout", {}).get("kind")
             row["status"] = {k: v for k, v in rep.get("status_counts", {}).items() if v}
     if out.is_dir():
