@@ -756,7 +756,7 @@ def round_mesh(
         fabrication=fab,
         stages=stages,
         repairs=list(clean_log.repairs),
-        fitting=_fitting(rounding_out, requested, fitted_radius, rescue),
+        fitting=_fitting(rounding_out, requested, fitted_radius, rescue, res),
     )
     if certify:
         from .check import certify_design
@@ -1045,9 +1045,10 @@ def _build_modules(pm: PolyMesh, solved: list, centres, points, progress) -> lis
         raise  # every module built alone: the failure was in the batch (re-raise it)
 
 
-def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue) -> dict:
+def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res) -> dict:
     """What :attr:`Design.fitting` holds: the radii asked for, the edges reduced to fit their
-    limits, the edges left sharp, the vertices rescued (:mod:`filletfold.vertex.rescue`)."""
+    limits, the edges left sharp, the vertices rescued (:mod:`filletfold.vertex.rescue`), the
+    cones whose apex needed the solver's linear programmes."""
     bent = rounding.half_angle > 0  # rounded or left sharp (not boundary, not flat)
     asked = np.where(bent, requested, 0.0)
     sharp = rounding.sharp if rounding.sharp is not None else np.zeros(len(bent), dtype=bool)
@@ -1060,4 +1061,7 @@ def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue) -> dict:
         "rescued": dict(sorted(rescue.rescued.items())),
         "rescue_applied": rescue.applied,
         "sharpened": sorted(rescue.sharpened),
+        "cones_by_lp": sum(
+            1 for st, s in zip(res.status, res.solver, strict=True) if st == "ok" and "lp" in s
+        ),
     }

@@ -18,6 +18,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from filletfold.vertex import batch
 from filletfold.vertex.batch import (
     pack,
     pack_problems,
@@ -215,3 +216,25 @@ def test_phase1_lp_solves_a_batch_as_its_problems_one_by_one():
     assert rows.min_slack(y0)[1] <= t[1] < 0
     assert (np.delete(t, 1) > 0).all() and (np.delete(np.array(alone), 1) > 0).all()
     assert t[1] == pytest.approx(alone[1], abs=1e-12)
+
+
+@pytest.mark.parametrize("mesh", ["torus", "blob"])
+def test_a_problem_the_linear_programmes_solve_is_labelled(mesh, monkeypatch):
+    """With the interior-point phase 1 made useless (it returns its start), a thorough solve
+    reaches feasibility by the linear programmes alone and says so (``lp+ipm``); without them
+    (``lp=False``, the first solve where a rescue follows) the same problem is not solved."""
+    problems = [
+        (c, t, s)
+        for c, t, s in first_attempts(mesh, 0.1, 0.3)
+        if pack_problems([c], t[None], c.n_vars).min_slack(np.zeros((1, c.n_vars)))[0] < 0
+    ][:3]
+    assert problems, "no problem whose target is infeasible"
+    monkeypatch.setattr(batch, "_phase1", lambda rows, y0, *a, **k: y0)
+    cons, targets, _ = zip(*problems, strict=True)
+    starts = [[] for _ in cons]  # from the (infeasible) target alone
+    with_lp = solve_apex_batch(cons, targets, starts, thorough=True)
+    assert all(s.ok and s.solver.startswith("lp+ipm") for s in with_lp), [
+        (s.ok, s.solver) for s in with_lp
+    ]
+    without = solve_apex_batch(cons, targets, starts, thorough=True, lp=False)
+    assert not any(s.ok for s in without)

@@ -210,6 +210,7 @@ def _fitting_report(design) -> dict:
         "rescue_applied": bool(fit["rescue_applied"]),
         "rescued": [{"vertex": int(u), "factor": float(f)} for u, f in fit["rescued"].items()],
         "sharpened": [int(u) for u in fit.get("sharpened", [])],
+        "cones_by_lp": int(fit.get("cones_by_lp", 0)),
     }
 
 

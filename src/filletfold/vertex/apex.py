@@ -432,7 +432,8 @@ class ApexSolution:
         True when the target itself was feasible.
     solver : str
         What found it: ``"target"``, ``"ipm"`` (the batched interior-point method),
-        ``"ipm+slsqp"`` (finished by SLSQP), ``"slsqp"`` (the reference solver).
+        ``"lp+ipm"`` (its feasibility phase needed the linear programmes), either with
+        ``"+slsqp"`` (finished by SLSQP), ``"slsqp"`` (the reference solver).
     """
 
     ok: bool

@@ -736,10 +736,12 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         keep_best(again, _phase1(rows.take(again), best[again], again, max_iter))
     # the interior-point phase 1 can stall short of a thin window: linear programmes next
     stalled = np.nonzero(need & (best_g <= 0) & thorough)[0]
+    by_lp = np.zeros(B, dtype=bool)  # made feasible by the linear programmes
     if len(stalled) and lp:
         y_lp, t_lp = phase1_lp(rows.take(stalled), best[stalled])
         up = t_lp > best_g[stalled]
         best[stalled[up]], best_g[stalled[up]] = y_lp[up], t_lp[up]
+        by_lp[stalled[up & (t_lp > 0)]] = True
     # the give-up rule is only a hint here: the rest continue from their best point, longer
     rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
     if len(rest):
@@ -759,12 +761,12 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         if at_target[b]:
             result.append(ApexSolution(True, T[b].copy(), [], True, "target"))
         elif feasible[b]:
-            x, how = X[b], "ipm"
+            x, how = X[b], "lp+ipm" if by_lp[b] else "ipm"
             if not converged[b] and not kkt_point(p, T[b], x):
                 # rare: finish with SLSQP from the feasible point
                 x_s = project_slsqp(p, T[b], x)
                 if np.sum((x_s - T[b]) ** 2) < np.sum((x - T[b]) ** 2):
-                    x, how = x_s, "ipm+slsqp"
+                    x, how = x_s, how + "+slsqp"
             result.append(ApexSolution(True, x, [], False, how))
         else:
             x = T[b] + L[b] * best[b]

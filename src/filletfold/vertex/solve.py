@@ -64,6 +64,10 @@ class VertexResult:
         corner kept: made sharp by :mod:`filletfold.vertex.sharpen`, or every edge unrounded)
         or ``"hole"`` (no cone and not kept sharp: a hole border, or a notch at a boundary
         vertex); ``""`` until the apex stage has run.
+    solver : list of str
+        What found each cone's apex (:attr:`~filletfold.vertex.apex.ApexSolution.solver`:
+        ``"target"``, ``"ipm"``, ``"lp+ipm"`` when the feasibility phase needed the linear
+        programmes, with ``"+slsqp"`` when SLSQP finished it); ``""`` without a cone.
     """
 
     kind: list
@@ -82,10 +86,13 @@ class VertexResult:
     apex_2d: np.ndarray
     margin: np.ndarray
     treatment: list = None
+    solver: list = None
 
     def __post_init__(self):
         if self.treatment is None:
             self.treatment = [""] * len(self.kind)
+        if self.solver is None:
+            self.solver = [""] * len(self.kind)
 
     def take(self, other: VertexResult, vertices) -> None:
         """Copy every per-vertex field of ``other`` at ``vertices`` into this result."""
@@ -631,6 +638,7 @@ def _solve_round(
                 res.apex_developed[u] = v_sol
                 res.depth[u] = float((sol.apex - p.frame.U) @ res.normal[u])
                 res.margin[u] = check.margin
+                res.solver[u] = sol.solver
                 out[u] = (sol.apex, v_sol)
                 del pending[u]
                 continue
