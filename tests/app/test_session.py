@@ -23,6 +23,7 @@ from filletfold.app.view import (
     triangulate_faces,
     triangulate_polygon,
 )
+from filletfold.check import check_folder
 from filletfold.cli import main
 from filletfold.errors import MeshReadError, ParameterError
 
@@ -164,9 +165,10 @@ def test_vertex_depth_changes_only_that_vertex():
     json.dumps(info)  # plain values only
 
 
-def test_export_zip_holds_the_files_and_they_parse(cube_session):
+def test_export_zip_holds_the_files_and_they_parse(cube_session, tmp_path):
     data = cube_session.export_zip()
     with zipfile.ZipFile(io.BytesIO(data)) as zf:
+        zf.extractall(tmp_path / "unzipped")
         names = set(zf.namelist())
         assert ZIP_NAMES <= names
         fold = json.loads(zf.read("design.fold"))
@@ -188,6 +190,9 @@ def test_export_zip_holds_the_files_and_they_parse(cube_session):
     assert "\nv " in obj and "\nf " in obj
     assert svg.lstrip().startswith("<") and "<svg" in svg
     assert "SECTION" in dxf and "EOF" in dxf
+    # as the CLI writes them: a summary report, the mesh's data in design.fold; they check
+    assert "vertices" not in report and report["mesh_counts"]["vertices"] == 8
+    assert check_folder(tmp_path / "unzipped").ok
 
 
 def test_shown_design_has_no_tabs_but_the_download_does(cube_session):

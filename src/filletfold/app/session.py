@@ -31,6 +31,7 @@ from ..design import (
 )
 from ..errors import MeshReadError, ParameterError
 from ..export.cutfiles import cut_files
+from ..export.outputs import mesh_fold_keys, summary_records
 from ..export.report import report_json
 from ..layout.tabs import assembly_text
 from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
@@ -409,9 +410,10 @@ class AppSession:
                 ZIP_FORMATS,
                 title=f"filletfold design of {design.source}",
                 description="Curved-crease rounded design: vertex modules",
+                fold_extra=mesh_fold_keys(design),
             )
         )
-        files["report.json"] = report_json(design.report())
+        files["report.json"] = report_json(summary_records(design))  # as the CLI writes it
         seams = design.fabrication.get("seams")
         if seams:
             files["assembly.txt"] = assembly_text(seams)
