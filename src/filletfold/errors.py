@@ -99,7 +99,11 @@ _WATCH: contextvars.ContextVar = contextvars.ContextVar("filletfold_stage_watch"
 
 
 def stage(name: str) -> None:
-    """Say which stage of the pipeline runs from here on."""
+    """Say which stage of the pipeline runs from here on; the memory the stages before freed
+    goes back to the system first (:func:`filletfold.memory.release_memory`)."""
+    from .memory import release_memory
+
+    release_memory()
     _STAGE.set(name)
     watch = _WATCH.get()
     if watch is not None:

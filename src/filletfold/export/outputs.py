@@ -10,6 +10,7 @@ import numpy as np
 from .. import __version__
 from ..errors import named_stages
 from ..layout.tabs import assembly_text
+from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
 from ..tolerances import tol
 from . import report_json, write_outputs
@@ -530,6 +531,7 @@ def export_design(
         The files written.
     """
     t = time.perf_counter()
+    release_memory()  # what the design's stages freed, before the files are built
     formats = parse_formats(formats)
     title = title or f"filletfold design of {design.source}"
     pattern_formats = [f for f in formats if f != "json"]
