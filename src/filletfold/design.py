@@ -47,7 +47,7 @@ from .surface.assemble import locate_apices
 from .surface.centres import face_piece_centres
 from .surface.module import build_modules
 from .surface.pattern import CreasePattern
-from .surface.sampling import cone_sample_counts
+from .surface.sampling import cone_sample_counts, unsampled_cones
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
@@ -645,6 +645,9 @@ def round_mesh(
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()
+    # the shortest chord an arc is sampled at: no pattern edge under the certificate's limit
+    min_chord = 0.0 if strict else 2 * tol.ruling * size
+    needs: dict = {}  # each cone's sampling needs, measured once (apex stage, then surface)
     frames, classified, rounding, centres, solved, kept, rescue = _apices(
         pm,
         rounding,
@@ -662,6 +665,9 @@ def round_mesh(
         floor=floor,
         min_width=min_width,
         sharp_kinds=kinds,
+        arc_step=float(arc_step),
+        min_chord=min_chord,
+        needs=needs,
     )
     timings["apices"] = time.perf_counter() - t
 
@@ -670,12 +676,14 @@ def round_mesh(
     points = rounding.arc_points(
         int(samples),
         float(arc_step),
-        min_chord=0.0 if strict else 2 * tol.ruling * size,
+        min_chord=min_chord,
         chord_tol=chord,
         radius_scale=np.where(conical_sides(frames, pm.n_edges), 2.0, 1.0),
     )
     # a cone's normal may turn faster than its arc: more points where it does
-    points = np.maximum(points, cone_sample_counts(solved, centres, pm.n_edges, float(arc_step)))
+    points = np.maximum(
+        points, cone_sample_counts(solved, centres, pm.n_edges, float(arc_step), needs)
+    )
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]
@@ -787,11 +795,18 @@ def _apices(
     floor,
     min_width,
     sharp_kinds=frozenset(),
+    arc_step=0.0,
+    min_chord=0.0,
+    needs=None,
 ):
     """The apex stage of :func:`round_mesh`: every pending vertex's apex (those of a reused
     design's vertices whose depth did not change are kept), then the rescue of the infeasible
     ones, then the cone-less vertices of ``sharp_kinds`` made sharp and their neighbours solved
-    again (:func:`~filletfold.vertex.sharpen.sharpen_vertices`).
+    again (:func:`~filletfold.vertex.sharpen.sharpen_vertices`). With ``infeasible`` among
+    ``sharp_kinds`` (and without ``material_loss``), a cone that no sampling of its arcs at
+    ``arc_step`` (degrees) with chords of at least ``min_chord`` can follow
+    (:func:`~filletfold.surface.sampling.unsampled_cones`) is infeasible too, and made sharp;
+    up to :data:`SAMPLING_ROUNDS` times, as its neighbours' new cones may be so in turn.
     Returns the frames, classification, rounding and face-piece centres afterwards (the
     rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
     kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
@@ -861,18 +876,36 @@ def _apices(
             sharp=_sharp_frames(frames),
         )
         kept -= rescue.resolved
-    already = _sharp_frames(frames)
-    if sharp_kinds and any(
-        sharp_kind(s) in sharp_kinds and not a for s, a in zip(res.status, already, strict=True)
-    ):
+    check = set(apices)  # the cones solved here (those kept from ``st`` were checked then)
+    for _ in range(SAMPLING_ROUNDS):
+        if "infeasible" in sharp_kinds and check and not material_loss:
+            # a cone no sampling can follow (its facets would fold past the arc step, or
+            # its arcs need sliver chords) is infeasible: sharp, its neighbours solved again
+            # (not with the material-loss radii, which fold one uncut sheet as they are)
+            cones = [(frames[u], *apices[u]) for u in sorted(check) if apices[u][0] is not None]
+            for u, why in unsampled_cones(cones, centres, arc_step, min_chord, needs).items():
+                res.status[u], res.reason[u], apices[u] = "infeasible", why, (None, None)
+                res.apex[u], res.apex_developed[u] = np.nan, np.nan  # no cone: no apex
+                res.depth[u], res.margin[u], res.solver[u] = np.nan, np.nan, ""
+        already = _sharp_frames(frames)
+        if not sharp_kinds or not any(
+            sharp_kind(s) in sharp_kinds and not a for s, a in zip(res.status, already, strict=True)
+        ):
+            break
         rounding, centres, sharpening = sharpen(sharp_kinds, apices, size=size, progress=progress)
         kept -= sharpening.resolved | set(np.flatnonzero(sharpening.sharp).tolist())
+        check = {u for u in sharpening.resolved if u in apices}
     solved = [
         st.solved[u] if u in kept else (frame, *apices.get(u, (None, None)))
         for u, frame in enumerate(frames)
     ]
     set_treatments(res, _sharp_frames(frames))
     return frames, classified, rounding, centres, solved, kept, rescue
+
+
+#: Rounds of :func:`_apices`' last step: cones no sampling can follow made sharp, their
+#: neighbours solved again (whose new cones may be such in turn).
+SAMPLING_ROUNDS = 3
 
 
 def _sharp_frames(frames) -> np.ndarray:
