@@ -51,3 +51,10 @@ def test_a_new_stage_releases_the_memory_the_last_one_freed():
     before = _resident_mb()
     stage("a test stage")
     assert before - _resident_mb() > 100
+
+
+@needs_glibc
+def test_the_arenas_can_be_capped():
+    from filletfold.memory import limit_arenas
+
+    assert limit_arenas(2)
