@@ -281,12 +281,13 @@ class CreasePattern:
         far = np.where(at_a[:, None], b, a)
         ruling = at_a ^ at_b
         order = np.argsort(u, kind="stable")
+        u_sorted = u[order]  # once: sorting per edge made this quadratic on large meshes
         mv = np.asarray(mesh_vertices, dtype=float)
         on = np.zeros(len(cand), dtype=bool)
         for e in sharp.tolist():
             p, q = mv[mesh_edges[e, 0]], mv[mesh_edges[e, 1]]
             for end in mesh_edges[e].tolist():
-                lo, hi = np.searchsorted(u[order], [end, end + 1])
+                lo, hi = np.searchsorted(u_sorted, [end, end + 1])
                 j = order[lo:hi]
                 j = j[ruling[j] & ~on[j]]
                 if len(j):
