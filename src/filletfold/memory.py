@@ -21,18 +21,23 @@ import sys
 
 
 @functools.cache
-def _malloc_trim():
-    """glibc's ``malloc_trim``, or None where there is none."""
+def _glibc(name: str, argtypes: tuple):
+    """The glibc function ``name`` taking ``argtypes`` and returning an int, or None where
+    there is no glibc (another system or C library)."""
     if not sys.platform.startswith("linux"):
         return None
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        trim = libc.malloc_trim
+        func = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6"), name)
     except (OSError, AttributeError):
         return None
-    trim.argtypes = [ctypes.c_size_t]
-    trim.restype = ctypes.c_int
-    return trim
+    func.argtypes = list(argtypes)
+    func.restype = ctypes.c_int
+    return func
+
+
+def _malloc_trim():
+    """glibc's ``malloc_trim``, or None where there is none."""
+    return _glibc("malloc_trim", (ctypes.c_size_t,))
 
 
 #: glibc's ``mallopt`` parameter ``M_ARENA_MAX``.
@@ -42,16 +47,8 @@ _M_ARENA_MAX = -8
 def limit_arenas(n: int = 2) -> bool:
     """Let glibc's allocator create at most ``n`` arenas from now on (``mallopt``), so that
     threads share them; whether it took (False where there is no glibc)."""
-    if _malloc_trim() is None:  # not glibc
-        return False
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):
-        return False
-    mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
-    mallopt.restype = ctypes.c_int
-    return bool(mallopt(_M_ARENA_MAX, int(n)))
+    mallopt = _glibc("mallopt", (ctypes.c_int, ctypes.c_int)) if _malloc_trim() else None
+    return bool(mallopt(_M_ARENA_MAX, int(n))) if mallopt is not None else False
 
 
 def release_memory() -> bool:
