@@ -568,6 +568,11 @@ def test_the_mesh_comes_from_the_fold_or_from_the_report_tables(tmp_path, capsys
     _rewrite_fold(plain, lambda doc: doc.pop("filletfold:mesh_vertices_coords"))
     err = _error_line(["check", str(plain)], capsys)
     assert "has no mesh data and report.json no tables" in err
+    short = tmp_path / "short"
+    d.export(short, formats="fold,json")
+    _rewrite_fold(short, lambda doc: doc["filletfold:mesh_edges_radius"].pop())
+    err = _error_line(["check", str(short)], capsys)
+    assert "design.fold: not filletfold's mesh data (malformed" in err
 
 
 def test_a_radius_changed_in_the_fold_fails_the_cylinders(tmp_path):

@@ -1348,14 +1348,22 @@ def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | Non
         raise MeshReadError(f"{path}: not a report (invalid JSON: {exc.msg})") from None
     if not isinstance(doc, dict) or "parameters" not in doc:
         raise MeshReadError(f"{path}: not a filletfold report (no key 'parameters')")
-    if fold_doc is not None and MESH_KEY + "vertices_coords" in fold_doc:
-        where = fold_path or "design.fold"
-        try:
-            vertices, faces, ev, ef, radius, gamma, kappa, apex = _mesh_of_fold(fold_doc)
-        except KeyError as exc:
-            raise MeshReadError(f"{where}: the mesh's data lacks the key {exc}") from None
-        except (TypeError, ValueError, AttributeError) as exc:
-            raise MeshReadError(f"{where}: the mesh's data is malformed: {exc}") from None
+    in_fold = fold_doc is not None and MESH_KEY + "vertices_coords" in fold_doc
+    where = fold_path or "design.fold"
+    if not in_fold and "edges" not in doc:
+        raise MeshReadError(
+            f"{where} has no mesh data and {path.name} no tables "
+            "(write the design again with 'filletfold round')"
+        )
+    source, what = (where, "filletfold's mesh data") if in_fold else (path, "a filletfold report")
+    try:
+        columns = _fold_columns(fold_doc) if in_fold else _report_columns(doc)
+        vertices, faces, ev, ef, radius, gamma, kappa, apex = _mesh_arrays(*columns)
+    except KeyError as exc:
+        raise MeshReadError(f"{source}: not {what} (no key {exc})") from None
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise MeshReadError(f"{source}: not {what} (malformed: {exc})") from None
+    if in_fold:
         counts = doc.get("mesh_counts")
         mine = {"vertices": len(vertices), "edges": len(ev), "faces": len(faces)}
         if isinstance(counts, dict) and {k: counts.get(k) for k in mine} != mine:
@@ -1364,25 +1372,13 @@ def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | Non
                 f"{mine['edges']} edges and {mine['faces']} faces, the report's "
                 f"{counts.get('vertices')}, {counts.get('edges')} and {counts.get('faces')}"
             )
-    elif "edges" not in doc:
-        raise MeshReadError(
-            f"{fold_path or 'design.fold'} has no mesh data and {path.name} no tables "
-            "(write the design again with 'filletfold round')"
-        )
-    else:
-        try:
-            vertices, faces, ev, ef, radius, gamma, kappa, apex = _mesh_of_report(doc)
-        except KeyError as exc:
-            raise MeshReadError(f"{path}: not a filletfold report (no key {exc})") from None
-        except (TypeError, ValueError, AttributeError) as exc:
-            raise MeshReadError(f"{path}: not a filletfold report (malformed: {exc})") from None
     try:
         arc_step = float((doc.get("parameters") or {}).get("arc_step", DEFAULT_ARC_STEP))
     except (TypeError, ValueError, AttributeError) as exc:
         raise MeshReadError(f"{path}: not a filletfold report (malformed: {exc})") from None
     if len(apex) != len(vertices):
         raise MeshReadError(
-            f"{path}: {len(apex)} vertex records for a mesh of {len(vertices)} vertices"
+            f"{source}: {len(apex)} vertex apices for a mesh of {len(vertices)} vertices"
         )
     kappa = np.where((radius > 0) & (ef >= 0).all(axis=1), kappa, 0.0)  # flat edges: no cylinder
     edges = {"vertices": ev, "faces": ef, "radius": radius, "half_angle": gamma, "kappa": kappa}
@@ -1391,46 +1387,56 @@ def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | Non
     return vertices, faces, edges, apex, arc_step
 
 
-def _mesh_of_fold(doc: dict) -> tuple:
-    """The mesh, its edges' rounding and its apices from the ``filletfold:mesh_*`` keys."""
+def _fold_columns(doc: dict) -> tuple:
+    """The mesh's columns (see :func:`_mesh_arrays`) from the ``filletfold:mesh_*`` keys."""
 
     def key(name):
         return doc[MESH_KEY + name]
 
-    vertices = np.asarray(key("vertices_coords"), dtype=np.float64).reshape(-1, 3)
-    faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in key("faces_vertices")]
-    ev = np.asarray(key("edges_vertices"), dtype=np.int64).reshape(-1, 2)
-    ef = np.asarray(key("edges_faces"), dtype=np.int64).reshape(-1, 2)
-    radius = np.array([_number(r) for r in key("edges_radius")], dtype=np.float64)
-    gamma = np.array([_number(g) for g in key("edges_halfAngle")], dtype=np.float64)
-    sign = {"M": 1.0, "V": -1.0}
-    kappa = np.array([sign.get(a, 0.0) for a in key("edges_assignment")], dtype=np.float64)
-    apex = np.array(
-        [[np.nan] * 3 if a is None else a for a in key("vertices_apex")], dtype=np.float64
-    ).reshape(-1, 3)
-    if not (len(ev) == len(ef) == len(radius) == len(gamma) == len(kappa)):
-        raise ValueError("its edge arrays differ in length")
-    return vertices, faces, ev, ef, radius, gamma, kappa, apex
+    return (
+        key("vertices_coords"),
+        key("faces_vertices"),
+        key("edges_vertices"),
+        key("edges_faces"),
+        key("edges_radius"),
+        key("edges_halfAngle"),
+        key("edges_assignment"),
+        key("vertices_apex"),
+    )
 
 
-def _mesh_of_report(doc: dict) -> tuple:
-    """The mesh, its edges' rounding and its apices from a report's tables."""
-    mesh = doc["mesh"]
-    vertices = np.asarray(mesh["vertices"], dtype=np.float64).reshape(-1, 3)
-    faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in mesh["faces"]]
+def _report_columns(doc: dict) -> tuple:
+    """The mesh's columns (see :func:`_mesh_arrays`) from a report's tables."""
     records = doc["edges"]
-    ev = np.array([r["vertices"] for r in records], dtype=np.int64).reshape(-1, 2)
-    ef = np.array(
-        [[-1, -1] if r["faces"] is None else r["faces"] for r in records], dtype=np.int64
-    ).reshape(-1, 2)
-    radius = np.array([_number(r["radius"]) for r in records], dtype=np.float64)
-    gamma = np.array([_number(r["half_angle"]) for r in records], dtype=np.float64)
+    return (
+        doc["mesh"]["vertices"],
+        doc["mesh"]["faces"],
+        [r["vertices"] for r in records],
+        [[-1, -1] if r["faces"] is None else r["faces"] for r in records],
+        [r["radius"] for r in records],
+        [r["half_angle"] for r in records],
+        [r["assignment"] for r in records],
+        [v["apex"] for v in doc["vertices"]],
+    )
+
+
+def _mesh_arrays(vertices, faces, ev, ef, radius, half, assignment, apex) -> tuple:
+    """(vertices, faces, edge vertices, edge faces, radius, half angle, kappa, apex) as
+    arrays, from the columns a FOLD or a report holds: ``null`` radii and half angles NaN,
+    kappa +1 / -1 for ``M`` / ``V`` (0 otherwise), a ``null`` apex a row of NaN."""
+    vertices = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in faces]
+    ev = np.asarray(ev, dtype=np.int64).reshape(-1, 2)
+    ef = np.asarray(ef, dtype=np.int64).reshape(-1, 2)
+    radius = np.array([_number(r) for r in radius], dtype=np.float64)
+    gamma = np.array([_number(g) for g in half], dtype=np.float64)
     sign = {"M": 1.0, "V": -1.0}
-    kappa = np.array([sign.get(r["assignment"], 0.0) for r in records], dtype=np.float64)
-    apex = np.array(
-        [[np.nan] * 3 if v["apex"] is None else v["apex"] for v in doc["vertices"]],
-        dtype=np.float64,
-    ).reshape(-1, 3)
+    kappa = np.array([sign.get(a, 0.0) for a in assignment], dtype=np.float64)
+    apex = np.array([[np.nan] * 3 if a is None else a for a in apex], dtype=np.float64).reshape(
+        -1, 3
+    )
+    if not (len(ev) == len(ef) == len(radius) == len(gamma) == len(kappa)):
+        raise ValueError("its edge columns differ in length")
     return vertices, faces, ev, ef, radius, gamma, kappa, apex
 
 

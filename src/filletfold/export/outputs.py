@@ -154,7 +154,6 @@ def mesh_fold_keys(design) -> dict:
     dict
     """
     mesh, rd = design.mesh, design.rounding
-    boundary = (mesh.edge_faces < 0).any(axis=1)
     apex = np.asarray(design.vertices.apex, dtype=float).reshape(-1, 3)
     has = np.isfinite(apex).all(axis=1)
     apex_rows = [row if ok else None for row, ok in zip(apex.tolist(), has.tolist(), strict=True)]
@@ -165,11 +164,15 @@ def mesh_fold_keys(design) -> dict:
         "filletfold:mesh_edges_faces": np.asarray(mesh.edge_faces, dtype=np.int64),
         "filletfold:mesh_edges_radius": np.asarray(rd.radius, dtype=float),
         "filletfold:mesh_edges_halfAngle": np.asarray(rd.half_angle, dtype=float),
-        "filletfold:mesh_edges_assignment": np.where(
-            boundary, "B", np.where(rd.kappa > 0, "M", "V")
-        ).tolist(),
+        "filletfold:mesh_edges_assignment": _edge_assignment(mesh, rd),
         "filletfold:mesh_vertices_apex": apex_rows,
     }
+
+
+def _edge_assignment(mesh, rd) -> list:
+    """Per mesh edge: ``B`` at the boundary, else ``M`` or ``V`` by the rounding's sign."""
+    boundary = (mesh.edge_faces < 0).any(axis=1)
+    return np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist()
 
 
 def timings_json(design) -> str:
@@ -246,7 +249,7 @@ def _edge_records(mesh, rd, design_requested=None, treatment=None) -> Records:
                 np.zeros(mesh.n_edges, dtype=bool) if rd.sharp is None else rd.sharp
             ).tolist(),
             "half_angle": np.asarray(rd.half_angle, dtype=float),
-            "assignment": np.where(boundary, "B", np.where(rd.kappa > 0, "M", "V")).tolist(),
+            "assignment": _edge_assignment(mesh, rd),
             "treatment": edge_treatments(mesh, rd, treatment),
             "arc_length": np.asarray(rd.arc_length, dtype=float),
             "strip_width": np.asarray(rd.strip_width, dtype=float),
