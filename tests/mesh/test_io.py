@@ -230,6 +230,25 @@ def test_ascii_stl(tmp_path):
     assert log.merged_vertices == 24 - 6  # STL repeats every corner
 
 
+def test_ascii_stl_without_endsolid_and_binary_starting_with_solid(tmp_path):
+    """A file cut after its last facet still reads; a binary STL whose header says 'solid' too."""
+    v, faces = example_mesh("octahedron")
+    mesh = trimesh.Trimesh(v, np.array(faces))
+    text = trimesh.exchange.stl.export_stl_ascii(mesh)
+    cut = text[: text.rindex("endsolid")]
+    path = tmp_path / "cut.stl"
+    path.write_text(cut)
+    verts, tris = read_mesh(path)
+    assert len(tris) == 8 and len(verts) == 24
+    assert_allclose(verts[np.concatenate(tris)].reshape(8, 3, 3), v[np.array(faces)], atol=1e-6)
+    binary = bytearray(trimesh.exchange.stl.export_stl(mesh))
+    binary[:6] = b"solid "
+    path = tmp_path / "binary.stl"
+    path.write_bytes(bytes(binary))
+    verts, tris = read_mesh(path)
+    assert len(tris) == 8
+
+
 @pytest.mark.parametrize(
     "name, data, pattern",
     [
@@ -237,8 +256,26 @@ def test_ascii_stl(tmp_path):
         (
             "bad.stl",
             b"solid x\n facet normal 0 0 1\n garbage\n",
-            r"no vertices or faces found \(empty or unreadable STL file\)",
+            r"line 3: unexpected 'garbage' in ASCII STL",
         ),
+        ("bad.stl", b"solid x\nendsolid x\n", r"no vertices or faces found"),
+        (
+            "bad.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n",
+            r"line 3: facet needs at least 3 vertices, got 2",
+        ),
+        (
+            "bad.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
+            r"line 3: the file ends inside a facet",
+        ),
+        (
+            "bad.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 x 0\n"
+            b"vertex 0 1 0\nendloop\nendfacet\n",
+            r"line 5: cannot parse vertex coordinates '1 x 0'",
+        ),
+        ("bad.stl", b"solid \xff\xfe", r"not an ASCII STL file \(byte 6"),
         ("bad.glb", b"glTF-but-not-really" * 3, r"cannot read GLB file"),
     ],
 )

@@ -1,8 +1,9 @@
 """Reading and writing polygon meshes.
 
 OBJ, OFF and PLY are parsed here, keeping polygon faces as polygons; PLY in every layout,
-triangle strips too (:func:`read_ply`). STL (ASCII and binary), glTF and GLB are read through
-:func:`trimesh.load` and come back as triangles.
+triangle strips too (:func:`read_ply`); ASCII STL too, facet by facet, so that a file cut short
+after its last complete facet (no ``endsolid``, as some exporters write) still reads. Binary
+STL, glTF and GLB are read through :func:`trimesh.load` and come back as triangles.
 
 Every error names the file first, then what is wrong and, for OBJ and OFF, on which line.
 """
@@ -69,7 +70,7 @@ def read_mesh(path) -> tuple[np.ndarray, list[np.ndarray]]:
         raise MeshReadError(f"{name}: not a regular file")
     if p.stat().st_size == 0:
         raise MeshReadError(f"{name}: the file is empty")
-    if ext in (".obj", ".off", ".ply"):
+    if ext in (".obj", ".off", ".ply", ".stl"):
         try:
             data = p.read_bytes()
         except OSError as exc:
@@ -87,6 +88,8 @@ def read_mesh(path) -> tuple[np.ndarray, list[np.ndarray]]:
             vertices, faces = _parse_obj(text, name)
         else:
             vertices, faces = _parse_off(text, name)
+    elif ext == ".stl" and _is_ascii_stl(data):
+        vertices, faces = _parse_stl_ascii(data, name)
     else:
         vertices, faces = _read_trimesh(p, name, ext)
     _check_finite(vertices, name)
@@ -259,6 +262,99 @@ def _parse_off(text: str, name: str) -> tuple[np.ndarray, list[np.ndarray]]:
     if not faces:
         raise MeshReadError(f"{name}: the file has {n_vertices} vertices but no faces")
     return vertices, faces
+
+
+def _is_ascii_stl(data: bytes) -> bool:
+    """True for an ASCII STL: it starts with ``solid`` and is not sized as a binary one.
+
+    A binary STL is 84 bytes of header and count and 50 bytes per triangle; some exporters
+    begin its 80-byte header with ``solid`` too, so the size decides.
+    """
+    if not data.lstrip()[:5].lower() == b"solid":
+        return False
+    if len(data) >= 84:
+        (count,) = struct.unpack_from("<I", data, 80)
+        if len(data) == 84 + 50 * count:
+            return False
+    return True
+
+
+def _parse_stl_ascii(data: bytes, name: str) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Facets of an ASCII STL as polygons (triangles in a well-formed file).
+
+    Every ``outer loop ... endloop`` gives one face of its ``vertex`` lines, one vertex per
+    line (welded later by :func:`filletfold.mesh.clean.clean_mesh`). Several ``solid`` blocks are
+    read one after the other; a file that ends after a complete facet without ``endsolid``
+    is read up to there. A loop of fewer than 3 vertices, an unparseable coordinate or a
+    loop cut off by the end of the file is an error naming its line.
+    """
+    try:
+        text = data.decode("ascii")
+    except UnicodeDecodeError as exc:
+        raise MeshReadError(
+            f"{name}: not an ASCII STL file (byte {exc.start} is not ASCII)"
+        ) from exc
+    coords: list[str] = []
+    sizes: list[int] = []
+    loop_line = 0
+    in_loop = False
+    for number, raw in enumerate(text.splitlines(), start=1):
+        tokens = raw.split()
+        if not tokens:
+            continue
+        key = tokens[0].lower()
+        if key == "vertex":
+            if not in_loop:
+                raise MeshReadError(f"{name}: line {number}: vertex outside an 'outer loop'")
+            if len(tokens) != 4:
+                raise MeshReadError(
+                    f"{name}: line {number}: vertex needs 3 coordinates, got {len(tokens) - 1}"
+                )
+            coords.extend(tokens[1:])
+            sizes[-1] += 1
+        elif key == "outer":
+            if in_loop:
+                raise MeshReadError(f"{name}: line {number}: 'outer loop' inside another loop")
+            in_loop, loop_line = True, number
+            sizes.append(0)
+        elif key == "endloop":
+            if not in_loop:
+                raise MeshReadError(f"{name}: line {number}: 'endloop' without 'outer loop'")
+            if sizes[-1] < 3:
+                raise MeshReadError(
+                    f"{name}: line {loop_line}: facet needs at least 3 vertices, got {sizes[-1]}"
+                )
+            in_loop = False
+        elif key not in ("solid", "endsolid", "facet", "endfacet"):
+            raise MeshReadError(f"{name}: line {number}: unexpected {tokens[0]!r} in ASCII STL")
+    if in_loop:
+        raise MeshReadError(
+            f"{name}: line {loop_line}: the file ends inside a facet (no 'endloop')"
+        )
+    if not sizes:
+        raise MeshReadError(f"{name}: no vertices or faces found (empty or unreadable STL file)")
+    try:
+        vertices = np.array(coords, dtype=np.float64).reshape(-1, 3)
+    except ValueError as exc:
+        number, tokens = next(
+            (n, t)
+            for n, t in enumerate((r.split() for r in text.splitlines()), start=1)
+            if t and t[0].lower() == "vertex" and not all(map(_is_float, t[1:]))
+        )
+        raise MeshReadError(
+            f"{name}: line {number}: cannot parse vertex coordinates {' '.join(tokens[1:])!r}"
+        ) from exc
+    ends = np.cumsum(sizes)
+    faces = [np.arange(e - k, e, dtype=np.int64) for e, k in zip(ends.tolist(), sizes, strict=True)]
+    return vertices, faces
+
+
+def _is_float(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
 
 
 def _read_trimesh(p: Path, name: str, ext: str) -> tuple[np.ndarray, list[np.ndarray]]:
