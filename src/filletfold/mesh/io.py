@@ -270,7 +270,7 @@ def _is_ascii_stl(data: bytes) -> bool:
     A binary STL is 84 bytes of header and count and 50 bytes per triangle; some exporters
     begin its 80-byte header with ``solid`` too, so the size decides.
     """
-    if not data.lstrip()[:5].lower() == b"solid":
+    if data.lstrip()[:5].lower() != b"solid":
         return False
     if len(data) >= 84:
         (count,) = struct.unpack_from("<I", data, 80)
@@ -294,7 +294,7 @@ def _parse_stl_ascii(data: bytes, name: str) -> tuple[np.ndarray, list[np.ndarra
         raise MeshReadError(
             f"{name}: not an ASCII STL file (byte {exc.start} is not ASCII)"
         ) from exc
-    coords: list[str] = []
+    coords: list[tuple[float, float, float]] = []
     sizes: list[int] = []
     loop_line = 0
     in_loop = False
@@ -310,7 +310,13 @@ def _parse_stl_ascii(data: bytes, name: str) -> tuple[np.ndarray, list[np.ndarra
                 raise MeshReadError(
                     f"{name}: line {number}: vertex needs 3 coordinates, got {len(tokens) - 1}"
                 )
-            coords.extend(tokens[1:])
+            try:
+                coords.append((float(tokens[1]), float(tokens[2]), float(tokens[3])))
+            except ValueError as exc:
+                raise MeshReadError(
+                    f"{name}: line {number}: cannot parse vertex coordinates "
+                    f"{' '.join(tokens[1:])!r}"
+                ) from exc
             sizes[-1] += 1
         elif key == "outer":
             if in_loop:
@@ -333,28 +339,10 @@ def _parse_stl_ascii(data: bytes, name: str) -> tuple[np.ndarray, list[np.ndarra
         )
     if not sizes:
         raise MeshReadError(f"{name}: no vertices or faces found (empty or unreadable STL file)")
-    try:
-        vertices = np.array(coords, dtype=np.float64).reshape(-1, 3)
-    except ValueError as exc:
-        number, tokens = next(
-            (n, t)
-            for n, t in enumerate((r.split() for r in text.splitlines()), start=1)
-            if t and t[0].lower() == "vertex" and not all(map(_is_float, t[1:]))
-        )
-        raise MeshReadError(
-            f"{name}: line {number}: cannot parse vertex coordinates {' '.join(tokens[1:])!r}"
-        ) from exc
+    vertices = np.array(coords, dtype=np.float64).reshape(-1, 3)
     ends = np.cumsum(sizes)
     faces = [np.arange(e - k, e, dtype=np.int64) for e, k in zip(ends.tolist(), sizes, strict=True)]
     return vertices, faces
-
-
-def _is_float(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
 
 
 def _read_trimesh(p: Path, name: str, ext: str) -> tuple[np.ndarray, list[np.ndarray]]:
