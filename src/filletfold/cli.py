@@ -126,10 +126,12 @@ PresetOption = Annotated[
     str | None,
     typer.Option(
         "--preset",
-        help="Cutter preset of pattern.svg and pattern.dxf: origami-simulator (Origami "
-        "Simulator's colours and fold-angle opacities; DXF layers CUT/MOUNTAIN/VALLEY/TAB/LABEL), "
+        help="Cutter preset of pattern.svg and pattern.dxf: print (to print and cut: cut black, "
+        "mountain red, valley blue, joined paths, no facet lines; DXF layers "
+        "CUT/MOUNTAIN/VALLEY/TAB/LABEL), origami-simulator (Origami Simulator's import: facet "
+        "lines, fold-angle opacities), "
         "laser (hairlines, cut red, scores blue/green), plotter (dashed score lines) or card "
-        "(perforated fold lines) [default: origami-simulator].",
+        "(perforated fold lines) [default: print].",
     ),
 ]
 ViewOption = Annotated[

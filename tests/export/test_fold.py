@@ -164,7 +164,7 @@ def test_fold_cylinder_face_join_is_flat():
     doc = fold_document(p)
     by_edge = dict(zip(map(tuple, doc["edges_vertices"]), doc["edges_assignment"], strict=True))
     assert (by_edge[(1, 6)], by_edge[(2, 5)]) == ("F", "M")
-    root = ET.fromstring(pattern_svg(p))
+    root = ET.fromstring(pattern_svg(p, preset="origami-simulator"))
     groups = {g.get("id"): g.findall(f"{SVG_NS}line") for g in root.iter(SVG_NS + "g")}
     # the join is a facet line (drawn for Origami Simulator), not a crease
     assert len(groups["flat"]) == 1 and len(groups["mountain"]) == 1

@@ -302,10 +302,18 @@ def _line_lengths(elements) -> np.ndarray:
     return np.hypot(xy[:, 2] - xy[:, 0], xy[:, 3] - xy[:, 1]) if len(xy) else np.zeros(0)
 
 
-def _rounding(lengths: np.ndarray) -> float:
+def _rounding(lengths: np.ndarray, text: str | None = None) -> float:
     """What rounding the SVG's coordinates (9 significant digits of the drawing, 4 decimals at
-    least) can do to a line's length."""
-    return 4 * max(1e-4, 1e-9 * float(np.max(lengths, initial=0.0)) * 1e3)
+    least; with ``text``, a cut-file preset's drawing, also its resolution of
+    :data:`~filletfold.export.presets.RESOLUTION_MM` printed) can do to a line's length."""
+    from filletfold.export.presets import RESOLUTION_MM
+
+    digits = 4 * max(1e-4, 1e-9 * float(np.max(lengths, initial=0.0)) * 1e3)
+    if text is None:
+        return digits
+    root = ET.fromstring(text)
+    user = float(root.get("viewBox").split()[2]) / float(root.get("width")[:-2])
+    return max(digits, 2 * RESOLUTION_MM * user)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -313,7 +321,7 @@ def test_svg_lines_are_the_pattern_edges(name):
     """Each assignment's group has one line per pattern edge, in edge order, as long as the
     edge times one drawing scale (the SVG's numbers round to 1e-9 of its extent)."""
     p = design_of(name).pattern
-    text = pattern_svg(p)
+    text = pattern_svg(p, preset="origami-simulator")
     groups = _svg_groups(text)
     length = np.linalg.norm(np.diff(p.vertices_2d[p.edges], axis=1)[:, 0], axis=1)
     got, want = [], []
@@ -325,7 +333,7 @@ def test_svg_lines_are_the_pattern_edges(name):
     got, want = np.concatenate(got), np.concatenate(want)
     k = np.median(got[want > 0] / want[want > 0])
     assert_allclose(got, k * want, atol=_rounding(got))
-    assert cut_files(p, "svg")["pattern.svg"] == text
+    assert cut_files(p, "svg", preset="origami-simulator")["pattern.svg"] == text
 
 
 def test_svg_numbers_match_the_formatter():
@@ -363,7 +371,8 @@ def test_svg_annotations_are_the_patterns(name):
     else:
         p = design_of(name).pattern
     ann = p.annotations
-    groups = _svg_groups(pattern_svg(p))
+    text = pattern_svg(p)
+    groups = _svg_groups(text)
     if not len(ann.tab_hinges) and not len(ann.labels):
         assert "tab-hinge" not in groups and "labels" not in groups
         return
@@ -384,9 +393,14 @@ def test_svg_annotations_are_the_patterns(name):
         got = _line_lengths(hinges)
         if len(edges):
             k = np.median(_line_lengths(edges)[border > 0] / border[border > 0])
-        else:
-            k = np.median(got[want > 0] / want[want > 0])
-        assert_allclose(got, k * want, atol=_rounding(got))
+        else:  # unitless: the larger side of the pattern is printed 200 mm
+            root = ET.fromstring(text)
+            user = float(root.get("viewBox").split()[2]) / float(root.get("width")[:-2])
+            from filletfold.export.paths import pattern_extent
+
+            lo, hi = pattern_extent(p)
+            k = 200.0 * user / float((hi - lo).max())
+        assert_allclose(got, k * want, atol=_rounding(got, text))
 
 
 # ---------------------------------------------------------------- report.json

@@ -13,7 +13,7 @@ from numpy.testing import assert_allclose
 from filletfold.errors import ParameterError
 from filletfold.export import pattern_svg
 from filletfold.export.paths import pattern_extent
-from filletfold.export.presets import PRESETS
+from filletfold.export.presets import PRESETS, RESOLUTION_MM
 from filletfold.export.svg import MIN_POINT_SPACING, nice_length
 
 from ..conftest import PATTERNS, signed_area, square_pattern, strip_pattern, two_pieces
@@ -26,7 +26,12 @@ ATOL = 1e-9
 # ---------------------------------------------------------------- SVG
 
 
+OS = "origami-simulator"
+
+
 def _svg(pattern, **kw):
+    """The SVG of ``pattern``, parsed; Origami Simulator's preset unless ``preset`` is given."""
+    kw.setdefault("preset", OS)
     return ET.fromstring(pattern_svg(pattern, **kw))
 
 
@@ -153,7 +158,7 @@ def test_svg_points_far_apart_for_origami_simulator(n):
     Simulator's vertex merge tolerance, however fine the curve is sampled."""
     from scipy.spatial import cKDTree
 
-    root = ET.fromstring(pattern_svg(arc_pattern(n)))
+    root = ET.fromstring(pattern_svg(arc_pattern(n), preset=OS))
     pts = np.unique(_endpoints(root, {"flat", "border", "mountain", "valley"}), axis=0)
     d, _ = cKDTree(pts).query(pts, k=2)
     assert d[:, 1].min() >= MIN_POINT_SPACING
@@ -188,11 +193,12 @@ def test_svg_every_crease_opacity_is_its_angle():
             assert float(ln.get("stroke-opacity")) == pytest.approx(want, abs=5e-7)
 
 
-def test_svg_default_has_no_unstroked_shape_outside_defs(cube):
+@pytest.mark.parametrize("preset", ["print", OS])
+def test_svg_has_no_unstroked_shape_outside_defs(cube, preset):
     """What Origami Simulator reads: every line, rect, path, polygon and polyline outside
     ``<defs>`` has one of the stroke colours it knows; the legend sits inside ``<defs>``."""
     known = {"#000000", "#ff0000", "#0000ff", "#00ff00", "#ffff00", "#ff00ff"}
-    root = ET.fromstring(pattern_svg(cube.pattern))
+    root = ET.fromstring(pattern_svg(cube.pattern, preset=preset))
     shapes = ("line", "rect", "path", "polygon", "polyline")
     (defs,) = root.findall(SVG_NS + "defs")
     hidden = set(map(id, defs.iter()))
@@ -201,11 +207,46 @@ def test_svg_default_has_no_unstroked_shape_outside_defs(cube):
         if el.tag.removeprefix(SVG_NS) in shapes and id(el) not in hidden:
             assert el.get("stroke") in known, ET.tostring(el)[:80]
             seen += 1
-    assert seen > 1000
+    assert seen > (1000 if preset == OS else 50)
     assert any(el.tag == SVG_NS + "rect" for el in defs.iter())  # legend and scale bar
     (use,) = root.findall(SVG_NS + "use")
     assert use.get("href") == "#annotation"
     assert _group(root, "annotation") in list(defs)
+
+
+def _polyline_length(group) -> float:
+    """Total length (user units) of the ``<polyline>``/``<polygon>`` paths of a group."""
+    total = 0.0
+    for el in group:
+        q = np.array([p.split(",") for p in el.get("points").split()], dtype=float)
+        if el.tag == SVG_NS + "polygon":
+            q = np.vstack([q, q[:1]])
+        total += float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum())
+    return total
+
+
+def test_svg_default_is_the_print_preset(cube):
+    """The default draws what is cut and folded, each layer joined into paths, and no facet
+    (``F``) lines: every mountain, valley and border edge is drawn once, at its length."""
+    pattern = cube.pattern
+    text = pattern_svg(pattern)
+    assert text == pattern_svg(pattern, preset="print")
+    root = ET.fromstring(text)
+    ids = {g.get("id") for g in root.iter(SVG_NS + "g")}
+    assert "flat" not in ids
+    assert "#ffff00" not in text and "stroke-opacity" not in text
+    k = _user_per_mm(root) * 200 / np.ptp(pattern_extent(pattern), axis=0).max()
+    v = pattern.vertices_2d
+    for code, gid in (("M", "mountain"), ("V", "valley"), ("B", "border")):
+        e = pattern.edges[pattern.edge_assignment == code]
+        want = float(np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1).sum()) * k
+        group = _group(root, gid)
+        assert not _lines(group)
+        # each segment's ends round to RESOLUTION_MM printed (whole user units here)
+        step = RESOLUTION_MM * _user_per_mm(root)
+        assert _polyline_length(group) == pytest.approx(want, rel=1e-6, abs=2 * step * len(e))
+    assert any(el.tag == SVG_NS + "rect" for el in root.find(SVG_NS + "defs").iter())
+    assert len(text) < 0.5 * len(pattern_svg(pattern, preset=OS))
 
 
 def test_svg_deterministic():
@@ -220,7 +261,10 @@ def test_svg_deterministic():
         ({"units": "furlong"}, "units must be one of"),
         ({"stroke_mm": 0.0}, "stroke_mm must be a positive"),
         ({"stroke_mm": float("nan")}, "stroke_mm must be a positive"),
-        ({"preset": "lazer"}, "unknown preset 'lazer': choose from origami-simulator, laser"),
+        (
+            {"preset": "lazer"},
+            "unknown preset 'lazer': choose from print, origami-simulator, laser",
+        ),
     ],
 )
 def test_svg_parameters_rejected(kw, match):

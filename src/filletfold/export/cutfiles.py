@@ -309,7 +309,7 @@ def cut_files(
         at a time); the pattern is still checked here, once.
     preset : str or Preset, optional
         Cutter preset of the SVG and DXF (:data:`~filletfold.export.presets.PRESETS`; default
-        ``origami-simulator``).
+        ``print``).
     fold_extra : mapping, optional
         More namespaced top-level keys of ``design.fold`` (``filletfold round`` adds the mesh's
         per-element data, :func:`~filletfold.export.outputs.mesh_fold_keys`).

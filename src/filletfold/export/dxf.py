@@ -1,8 +1,8 @@
 """DXF (R2010) cut file of the flat crease pattern, for laser cutters, plotters and CAD.
 
 Layers, colours, line weights and line styles come from a cutter preset
-(:mod:`filletfold.export.presets`). The default, ``origami-simulator``, has these layers and
-colours (ACI):
+(:mod:`filletfold.export.presets`). The default, ``print`` (as ``origami-simulator``), has these
+layers and colours (ACI):
 
 ===========  =========  =======================================================================
 layer        colour     content
@@ -105,7 +105,7 @@ def pattern_dxf(
         Also write the ``F`` edges, on the preset's flat layer (``FLAT``).
     preset : str or Preset, optional
         Cutter preset (:data:`~filletfold.export.presets.PRESETS`); default
-        ``origami-simulator``, whose layers are the table above.
+        ``print``, whose layers are the table above.
 
     Returns
     -------

@@ -519,7 +519,7 @@ def export_design(
         :func:`~filletfold.export.cutfiles.cut_files`).
     preset : str or Preset, optional
         Cutter preset of ``pattern.svg`` and ``pattern.dxf``
-        (:data:`~filletfold.export.presets.PRESETS`; default ``origami-simulator``).
+        (:data:`~filletfold.export.presets.PRESETS`; default ``print``).
     view : str or (2,) float, optional
         The direction ``preview.png`` is seen from (see
         :func:`~filletfold.export.cutfiles.cut_files`).

@@ -10,7 +10,14 @@ holds the named ones and :func:`get_preset` looks a name up.
 =====================  ===========================================================================
 preset                 what it is for
 =====================  ===========================================================================
-``origami-simulator``  the default of ``pattern.svg`` and ``pattern.dxf``: the colours Origami
+``print``              the default of ``pattern.svg`` and ``pattern.dxf``: a drawing to print
+                       and cut by hand or on a cutting machine that reads colours, in the
+                       conventional crease-pattern colours (cut black, mountain red, valley
+                       blue, tab hinge magenta dashed, labels grey, 0.3 mm), each layer's edges
+                       joined into paths, legend and scale bar; no facet lines (they are not
+                       cut or scored, and ``design.fold`` holds the triangulation); the DXF is
+                       that of ``origami-simulator``
+``origami-simulator``  the SVG as Origami Simulator imports it: the colours Origami
                        Simulator reads (mountain red, valley blue, cut black, facet yellow, hinge
                        magenta), ``stroke-opacity`` = |fold angle| / 180, facet (``F``)
                        lines; the DXF has layers ``CUT``/``MOUNTAIN``/``VALLEY``/``TAB``/
@@ -44,6 +51,7 @@ __all__ = [
     "DEFAULT_PRESET",
     "DXF_LINEWEIGHTS",
     "PRESETS",
+    "RESOLUTION_MM",
     "Pen",
     "Preset",
     "dxf_lineweight",
@@ -51,8 +59,12 @@ __all__ = [
     "hex_rgb",
 ]
 
+#: Finest printed length (mm) the coordinates of a cut file resolve (a preset's
+#: ``resolution_mm``): a micrometre, finer than any printer or cutter (a laser's spot is
+#: 0.1-0.2 mm); digits beyond it carry nothing.
+RESOLUTION_MM = 1e-3
 #: The preset of ``pattern.svg`` and ``pattern.dxf`` when none is given.
-DEFAULT_PRESET = "origami-simulator"
+DEFAULT_PRESET = "print"
 #: The line weights a DXF can carry (hundredths of a millimetre); 0 is the thinnest line.
 DXF_LINEWEIGHTS = (0, 5, 9, 13, 15, 18, 20, 25, 30, 35, 40, 50, 53, 60, 70, 80, 90, 100, 106)
 
@@ -175,6 +187,11 @@ class Preset:
         so that nothing is cut or engraved that is not the pattern.
     true_color : bool
         The DXF layers carry the pens' colours as true colours besides the ACI.
+    resolution_mm : float, optional
+        The finest printed length the SVG's coordinates resolve (:func:`~filletfold.export.svg.
+        svg_decimals`): a micrometre by default, finer than any printer or cutter; ``None``
+        keeps 8 significant digits of the drawing (``origami-simulator``, whose import and
+        tools compare the drawing with ``design.fold`` to 1e-6 of its size).
     """
 
     name: str
@@ -190,8 +207,14 @@ class Preset:
     join_lines: bool = True
     annotations: bool = False
     true_color: bool = True
+    resolution_mm: float | None = RESOLUTION_MM
 
     def __post_init__(self):
+        r = self.resolution_mm
+        if r is not None and not (isinstance(r, int | float) and math.isfinite(r) and r > 0):
+            raise ParameterError(
+                f"preset resolution_mm must be positive, got {r!r}", name="resolution_mm"
+            )
         layers = [p.layer for p in self.pens().values()]
         if len(set(layers)) != len(layers):
             raise ParameterError(f"preset {self.name!r}: two pens share a layer", name="layer")
@@ -201,9 +224,22 @@ class Preset:
         return {f: getattr(self, f) for f in ("cut", "mountain", "valley", "tab", "label", "flat")}
 
 
+_PRINT = Preset(
+    name="print",
+    description="to print and cut: cut black, mountain red, valley blue, tab hinge magenta "
+    "(default)",
+    cut=Pen("#000000", "CUT", 7, 0.3),
+    mountain=Pen("#ff0000", "MOUNTAIN", 1, 0.3),
+    valley=Pen("#0000ff", "VALLEY", 5, 0.3),
+    tab=Pen("#ff00ff", "TAB", 6, 0.3, dash_share=0.005),
+    label=Pen("#404040", "LABEL", 8, 0.3),
+    flat=Pen("#ffff00", "FLAT", 2, 0.1),
+    annotations=True,
+    true_color=False,
+)
 _OS = Preset(
     name="origami-simulator",
-    description="Origami Simulator's SVG colours and fold-angle opacities (default)",
+    description="Origami Simulator's SVG colours and fold-angle opacities",
     cut=Pen("#000000", "CUT", 7, 0.3),
     mountain=Pen("#ff0000", "MOUNTAIN", 1, 0.3),
     valley=Pen("#0000ff", "VALLEY", 5, 0.3),
@@ -215,6 +251,7 @@ _OS = Preset(
     join_lines=False,
     annotations=True,
     true_color=False,
+    resolution_mm=None,
 )
 _LASER = Preset(
     name="laser",
@@ -249,7 +286,7 @@ _CARD = Preset(
 )
 
 #: The named presets, the default first.
-PRESETS: dict[str, Preset] = {p.name: p for p in (_OS, _LASER, _PLOTTER, _CARD)}
+PRESETS: dict[str, Preset] = {p.name: p for p in (_PRINT, _OS, _LASER, _PLOTTER, _CARD)}
 
 
 def get_preset(preset: str | Preset | None = None) -> Preset:

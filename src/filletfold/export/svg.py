@@ -1,7 +1,13 @@
 """SVG drawing of the flat crease pattern, to print, cut, or load into Origami Simulator.
 
-The drawing follows a cutter preset (:mod:`filletfold.export.presets`); the default,
-``origami-simulator``, is a file Origami Simulator imports without a warning:
+The drawing follows a cutter preset (:mod:`filletfold.export.presets`). The default, ``print``,
+is the drawing to print and cut: each layer's edges joined end to end into ``<polyline>`` (or
+``<polygon>``) paths in the conventional colours (borders and cuts black, valley blue, mountain
+red, tab hinges magenta), labels as filled ``<text>``, the scale bar, legend and sheet outlines
+in ``<defs>``; the ``F`` edges (facets inside the curved patches, neither cut nor scored) are
+left out: ``design.fold`` holds them.
+
+``origami-simulator`` is a file Origami Simulator imports without a warning:
 
 * each edge is a ``<line>`` carrying its own ``stroke`` colour, in one group per assignment:
   facet ``#ffff00`` (``F`` edges, group ``flat``), border/cut ``#000000``, valley ``#0000ff``,
@@ -12,17 +18,19 @@ The drawing follows a cutter preset (:mod:`filletfold.export.presets`); the defa
 * the scale bar, legend and sheet outlines (groups ``scale-bar``, ``legend``, ``sheets``) sit in
   a ``<g id="annotation">`` inside ``<defs>``, drawn by a ``<use>``: the app removes ``<defs>``
   before it reads strokes, every other viewer shows them. Labels are filled ``<text>`` (group
-  ``labels``), which the app does not read;
-* the viewBox is in units of :math:`10^{-j}` mm (``width``/``height`` give the printed size),
-  ``j >= 0`` the smallest that puts the two closest drawn points at least
-  :data:`MIN_POINT_SPACING` user units apart (ten times the app's 3-unit vertex merge
-  tolerance), so no two vertices collapse on import.
+  ``labels``), which the app does not read.
 
-The cutter presets draw the edges of a layer joined end to end as ``<polyline>`` (or
-``<polygon>``) paths, their pens' widths and colours, dashed score lines as a
-``stroke-dasharray``, perforated ones as separate dash pieces, and no legend, scale bar or sheet
-outlines (nothing is cut or engraved that is not the pattern). The y axis is flipped so the
-drawing is not mirrored.
+In every preset the viewBox is in units of :math:`10^{-j}` mm (``width``/``height`` give the
+printed size), ``j >= 0`` the smallest that puts the two closest drawn points at least
+:data:`MIN_POINT_SPACING` user units apart (ten times the app's 3-unit vertex merge tolerance),
+so no two vertices collapse on import. Coordinates have at most 8 significant digits of the
+drawing, and in the cut-file presets no more than resolve :data:`RESOLUTION_MM` of the printed
+size (whole user units once ``j >= 3``); ``origami-simulator`` keeps the 8 digits.
+
+The cutter presets (``laser``, ``plotter``, ``card``) draw joined paths too, their pens' widths
+and colours, dashed score lines as a ``stroke-dasharray``, perforated ones as separate dash
+pieces, and no legend, scale bar or sheet outlines (nothing is cut or engraved that is not the
+pattern). The y axis is flipped so the drawing is not mirrored.
 """
 
 from __future__ import annotations
@@ -46,9 +54,16 @@ from .paths import (
     simplify_polyline,
     tab_cut_paths,
 )
-from .presets import Pen, Preset, get_preset
+from .presets import RESOLUTION_MM, Pen, Preset, get_preset
 
-__all__ = ["MIN_POINT_SPACING", "nice_length", "pattern_svg", "svg_user_per_mm"]
+__all__ = [
+    "MIN_POINT_SPACING",
+    "RESOLUTION_MM",
+    "nice_length",
+    "pattern_svg",
+    "svg_decimals",
+    "svg_user_per_mm",
+]
 
 #: Group id, assignment and legend label of each edge group, in drawing order (bottom first).
 _GROUPS = (
@@ -69,6 +84,8 @@ _SWATCH_MM = 8.0
 MIN_POINT_SPACING = 30.0
 #: Largest viewBox side (user units) the spacing rule may ask for.
 _MAX_USER_EXTENT = 1e7
+#: Decimals of a label's rotation (degrees).
+_ANGLE_DECIMALS = 2
 #: Points closer than this share of the drawing's size are one point (round-off).
 _SAME_POINT = 1e-9
 
@@ -138,8 +155,7 @@ def pattern_svg(
         or ``""`` (no physical unit: the larger side is printed 200 mm long). Sets the printed
         size (``width``/``height`` in mm) and the scale bar label.
     preset : str or Preset, optional
-        Cutter preset (:data:`~filletfold.export.presets.PRESETS`); default
-        ``origami-simulator``.
+        Cutter preset (:data:`~filletfold.export.presets.PRESETS`); default ``print``.
     stroke_mm : float, optional
         Printed width of every line in millimetres (default: the preset's pens).
     flat_edges : bool, optional
@@ -170,6 +186,30 @@ def pattern_svg(
         )
     validate_pattern(pattern)
     return _pattern_svg(pattern, units, preset, stroke_mm, flat_edges, angle_opacity)
+
+
+def svg_decimals(size: float, user: float, resolution_mm: float | None = RESOLUTION_MM) -> int:
+    """Decimals of the SVG's coordinates: the fewer of 8 significant digits of ``size`` (the
+    drawing's larger side in user units) and those that resolve ``resolution_mm`` at ``user``
+    user units per printed millimetre (``user`` a power of ten).
+
+    Parameters
+    ----------
+    size, user : float
+        Positive.
+    resolution_mm : float, optional
+        The finest printed length to resolve (a preset's
+        :attr:`~filletfold.export.presets.Preset.resolution_mm`); ``None``: the 8 digits alone.
+
+    Returns
+    -------
+    int
+        ``>= 0``.
+    """
+    digits = 8 - math.floor(math.log10(size))
+    if resolution_mm is not None:
+        digits = min(digits, math.ceil(-math.log10(resolution_mm * user) - 1e-9))
+    return max(0, digits)
 
 
 def svg_user_per_mm(points: np.ndarray, mm_per_unit: float, extent: float) -> float:
@@ -234,7 +274,7 @@ def _pattern_svg(
     k = mm_per_unit * user  # user units per pattern unit
     margin = _MARGIN_MM * user
     font = _FONT_MM * user
-    decimals = max(0, 8 - math.floor(math.log10(extent * k + 2 * margin)))
+    decimals = svg_decimals(extent * k + 2 * margin, user, preset.resolution_mm)
     fmt = _formatter(decimals)
     draw = _Drawing(lo, hi, k, margin, decimals, user, stroke_mm)
 
@@ -469,7 +509,7 @@ def _label_group(pattern, draw: _Drawing, color: str) -> list[str]:
     turned = np.flatnonzero(angle.astype(bool))  # the truth of each angle, as it is
     rot = [""] * len(labels)
     turns = _format_all(
-        np.array([-float(a) for a in angle[turned]], dtype=np.float64), draw.decimals
+        np.array([-float(a) for a in angle[turned]], dtype=np.float64), _ANGLE_DECIMALS
     )
     for i, r in zip(turned.tolist(), turns, strict=True):
         rot[i] = f' transform="rotate({r} {tx[i]} {ty[i]})"'
