@@ -31,7 +31,7 @@ from filletfold.export.fold import (
     design_counts,
     file_creator,
 )
-from filletfold.export.obj import obj_group_name
+from filletfold.export.obj import obj_decimals, obj_group_name, weld_vertices
 from filletfold.export.report import to_json_data
 from filletfold.surface.pattern import CreasePattern
 from filletfold.surface.validate import validated_faces
@@ -72,22 +72,28 @@ def ref_fold_json(doc) -> str:
 
 
 def ref_obj(pattern: CreasePattern) -> str:
+    v, inverse = weld_vertices(pattern.vertices_3d)
+    decimals = obj_decimals(v)
+
     def num(x):
-        s = f"{x:.12g}"
-        return "0" if s in ("-0", "0") else s
+        s = f"{x:.{decimals}f}"
+        if "." in s:
+            s = s.rstrip("0").rstrip(".")
+        return "0" if s in ("-0", "") else s
 
     lines = [
         "# header",
-        f"# {len(pattern.vertices_3d)} vertices, {len(pattern.faces)} faces, "
-        f"{len(set(pattern.face_patch))} patches",
+        f"# {len(v)} vertices, {len(pattern.faces)} faces, {len(set(pattern.face_patch))} patches",
     ]
-    lines.extend(f"v {num(a)} {num(b)} {num(c)}" for a, b, c in pattern.vertices_3d)
+    lines.extend(f"v {num(a)} {num(b)} {num(c)}" for a, b, c in v)
     groups: dict[str, list[int]] = {}
     for i, patch in enumerate(pattern.face_patch):
         groups.setdefault(obj_group_name(patch), []).append(i)
     for name, ids in groups.items():
         lines.append(f"g {name}")
-        lines.extend("f " + " ".join(str(int(k) + 1) for k in pattern.faces[i]) for i in ids)
+        lines.extend(
+            "f " + " ".join(str(int(inverse[k]) + 1) for k in pattern.faces[i]) for i in ids
+        )
     return "\n".join(lines) + "\n"
 
 

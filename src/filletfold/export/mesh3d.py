@@ -37,7 +37,7 @@ from ..surface.triangulate import triangulate_faces
 from ..surface.validate import validated_faces
 from ..units import MM_PER_UNIT, check_units
 from .dxf import check_scale
-from .obj import vertex_normal_3d
+from .obj import vertex_normal_3d, weld_vertices
 from .png import PATCH_COLOR
 
 __all__ = [
@@ -57,8 +57,6 @@ KIND_ORDER = ("cone", "cylinder", "fillet", "face")
 _OTHER_COLOR = (0.8, 0.8, 0.8)
 #: glTF is y-up: the design's (x, y, z) is written as (x, z, -y).
 Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
-#: Vertices closer than this share of the folded form's size are welded (PLY and STL).
-WELD_RTOL = 1e-9
 #: Millimetres per glTF length unit (the metre, by the glTF 2.0 specification).
 GLTF_MM_PER_UNIT = 1000.0
 
@@ -122,36 +120,6 @@ def folded_triangles(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
         The face each triangle comes from (non-decreasing).
     """
     return triangulate_faces(pattern.vertices_2d, pattern.faces)
-
-
-def weld_vertices(points: np.ndarray, rtol: float = WELD_RTOL) -> tuple[np.ndarray, np.ndarray]:
-    """Merge points that coincide up to ``rtol`` times the points' bounding-box diagonal.
-
-    Parameters
-    ----------
-    points : (n, 3) float
-    rtol : float
-
-    Returns
-    -------
-    unique : (u, 3) float
-        One point per group, the first of the group in input order, groups in order of their
-        first point.
-    inverse : (n,) int
-        The group of each input point: ``unique[inverse]`` is within the tolerance of
-        ``points``.
-    """
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    if len(p) == 0:
-        return p.copy(), np.zeros(0, dtype=np.int64)
-    size = float(np.linalg.norm(np.ptp(p, axis=0)))
-    step = rtol * size if size > 0 else 1.0
-    key = np.round((p - p.min(axis=0)) / step).astype(np.int64)
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    order = np.argsort(first, kind="stable")  # groups in order of their first point
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    return p[first[order]], rank[inverse.ravel()]
 
 
 def _kind_meshes(pattern: CreasePattern) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:

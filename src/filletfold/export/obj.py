@@ -2,16 +2,33 @@
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
 
-from ..surface.pattern import CreasePattern
+from ..surface.pattern import CreasePattern, FaceRows
 from ..surface.validate import validated_faces
 from ..tolerances import tol
 from .fold import face_arrays, file_creator
 
-__all__ = ["folded_obj", "obj_group_name", "vertex_normal_3d"]
+__all__ = [
+    "OBJ_RTOL",
+    "WELD_RTOL",
+    "folded_obj",
+    "obj_group_name",
+    "vertex_normal_3d",
+    "weld_vertices",
+]
+
+#: Vertices closer than this share of the folded form's size are welded (OBJ, PLY and STL).
+WELD_RTOL = 1e-9
+#: Decimals of a vertex normal's components (at least).
+_NORMAL_DECIMALS = 9
+#: The OBJ's coordinates are written to this share of the folded form's size (bounding-box
+#: diagonal), as fixed decimals: the weld tolerance; the folded form's own error (its chords'
+#: 2D - 3D mismatch, the solvers' tolerances) is larger.
+OBJ_RTOL = 1e-9
 
 
 def obj_group_name(patch: str) -> str:
@@ -32,6 +49,36 @@ def _group_names(patches: list[str]) -> list[str]:
         return list(map(obj_group_name, patches))
     names = _SPACES.sub("_", _SPACE_AROUND_NUL.sub("\0", joined).strip()).split("\0")
     return [name or "patch" for name in names]
+
+
+def weld_vertices(points: np.ndarray, rtol: float = WELD_RTOL) -> tuple[np.ndarray, np.ndarray]:
+    """Merge points that coincide up to ``rtol`` times the points' bounding-box diagonal.
+
+    Parameters
+    ----------
+    points : (n, 3) float
+    rtol : float
+
+    Returns
+    -------
+    unique : (u, 3) float
+        One point per group, the first of the group in input order, groups in order of their
+        first point.
+    inverse : (n,) int
+        The group of each input point: ``unique[inverse]`` is within the tolerance of
+        ``points``.
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(p) == 0:
+        return p.copy(), np.zeros(0, dtype=np.int64)
+    size = float(np.linalg.norm(np.ptp(p, axis=0)))
+    step = rtol * size if size > 0 else 1.0
+    key = np.round((p - p.min(axis=0)) / step).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")  # groups in order of their first point
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return p[first[order]], rank[inverse.ravel()]
 
 
 def vertex_normal_3d(vertices_3d: np.ndarray, faces: list) -> np.ndarray:
@@ -70,17 +117,21 @@ def vertex_normal_3d(vertices_3d: np.ndarray, faces: list) -> np.ndarray:
 def folded_obj(pattern: CreasePattern, *, vertex_normals: bool = False) -> str:
     """The folded form as a Wavefront OBJ document.
 
-    Vertices are written in pattern order (``v x y z``, 3D positions). Faces are polygons as in
-    the pattern (not triangulated), 1-based, grouped as ``g <patch>`` with one group per patch
-    name: groups in order of the patch's first face, faces in pattern order within a group.
+    The pattern's vertices that fold onto one point (within :data:`WELD_RTOL` of the folded
+    form's size: the two sides of every seam) are one OBJ vertex, so the surface is closed
+    where the pieces are glued (a viewer shades it smooth across the seams) and each point is
+    written once. Vertices are in order of their first pattern vertex (``v x y z``, 3D
+    positions to :data:`OBJ_RTOL` of the size). Faces are polygons as in the pattern (not
+    triangulated), 1-based, grouped as ``g <patch>`` with one group per patch name: groups in
+    order of the patch's first face, faces in pattern order within a group.
 
     Parameters
     ----------
     pattern : CreasePattern
         Checked with :func:`~filletfold.surface.validate.validate_pattern`.
     vertex_normals : bool
-        Also write ``vn`` lines (see :func:`vertex_normal_3d`), one per vertex, referenced as
-        ``f a//a b//b ...``.
+        Also write ``vn`` lines (see :func:`vertex_normal_3d`, of the welded surface), one per
+        vertex, referenced as ``f a//a b//b ...``.
 
     Returns
     -------
@@ -95,25 +146,52 @@ def folded_obj(pattern: CreasePattern, *, vertex_normals: bool = False) -> str:
     return _folded_obj(pattern, validated_faces(pattern), vertex_normals=vertex_normals)
 
 
-def _xyz_lines(tag: str, xyz: np.ndarray) -> str:
-    """``"<tag> x y z\\n"`` per row of ``xyz`` (n, 3), numbers with 12 significant digits
-    (``-0`` written as ``0``)."""
-    return (f"{tag} %.12g %.12g %.12g\n" * len(xyz)) % tuple((xyz + 0.0).ravel().tolist())
+def obj_decimals(points: np.ndarray) -> int:
+    """Decimals of the OBJ's coordinates: those that resolve :data:`OBJ_RTOL` of the points'
+    bounding-box diagonal (at least 0; 12 for a single point or none)."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    size = float(np.linalg.norm(np.ptp(p, axis=0))) if len(p) else 0.0
+    if not (size > 0 and math.isfinite(size)):
+        return 12
+    return max(0, math.ceil(-math.log10(OBJ_RTOL * size) - 1e-9))
+
+
+def _xyz_lines(tag: str, xyz: np.ndarray, decimals: int) -> str:
+    """``"<tag> x y z\\n"`` per row of ``xyz`` (n, 3), numbers with ``decimals`` fixed
+    decimals, trailing zeros stripped (``-0`` written as ``0``)."""
+    if not len(xyz):
+        return ""
+    text = (f"%.{decimals}f %.{decimals}f %.{decimals}f\n" * len(xyz)) % tuple(
+        (np.asarray(xyz, dtype=np.float64) + 0.0).ravel().tolist()
+    )
+    if decimals > 0:
+        text = _TRAILING_ZEROS.sub(r"\1", text)
+    text = _MINUS_ZERO.sub(r"\g<1>0", text)
+    return "".join(f"{tag} {line}\n" for line in text[:-1].split("\n"))
+
+
+#: Trailing zeros of a fixed-decimal number (and its point, when nothing is left after it).
+_TRAILING_ZEROS = re.compile(r"(\d)\.?0+(?=[ \n])")
+#: A negative zero after rounding: ``-0``, preceded by the start or a space.
+_MINUS_ZERO = re.compile(r"(^| )-0(?=[ \n])", re.MULTILINE)
 
 
 def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) -> str:
     """:func:`folded_obj` of a pattern already checked (``faces`` from
     :func:`~filletfold.surface.validate.validated_faces`)."""
-    v3 = pattern.vertices_3d
     flat, start = faces
+    v3, inverse = weld_vertices(pattern.vertices_3d)
+    flat = inverse[flat]
     patches = dict.fromkeys(pattern.face_patch)  # in order of their first face
     head = (
         f"# {file_creator()}: folded form\n"
         f"# {len(v3)} vertices, {len(pattern.faces)} faces, {len(patches)} patches\n"
     )
-    parts = [head, _xyz_lines("v", v3)]
+    decimals = obj_decimals(v3)
+    parts = [head, _xyz_lines("v", v3, decimals)]
     if vertex_normals:
-        parts.append(_xyz_lines("vn", vertex_normal_3d(v3, pattern.faces)))
+        normals = vertex_normal_3d(v3, FaceRows(flat, start))
+        parts.append(_xyz_lines("vn", normals, max(decimals, _NORMAL_DECIMALS)))
     # groups in order of their first face; faces in pattern order within a group
     group_id: dict[str, int] = {}
     for p, name in zip(patches, _group_names(list(patches)), strict=True):
