@@ -151,8 +151,14 @@ def run(mesh: Path, out: Path, timeout: float, extra: list[str]) -> dict:
         status=counts,
         certificate=None if cert is None else cert["ok"],
         failed=[] if cert is None else [k for k, v in cert["checks"].items() if not v["ok"]],
+        output_mb=output_bytes(out) / 1e6,
     )
     return row
+
+
+def output_bytes(folder: Path) -> int:
+    """Bytes of the files the default command wrote into ``folder``."""
+    return sum(f.stat().st_size for f in folder.iterdir() if f.is_file())
 
 
 RECHECK = "filletfold.testing.recheck"
@@ -213,6 +219,8 @@ def markdown_row(row: dict) -> str:
         f"{row['cones']}/{row['sharp']}" if row["outcome"] == "design" else DASH,
         f"{row['time']:.1f}",
         DASH if row.get("peak_mb") is None else f"{row['peak_mb']:.0f}",
+        DASH if row.get("output_mb") is None else f"{row['output_mb']:.1f}",
+        DASH if row.get("output_mb") is None else f"{1e3 * row['output_mb'] / row['vertices']:.1f}",
         certificate(row),
         fold if isinstance(fold, str) else (DASH if fold is None else f"{fold:.3g}"),
         mism if isinstance(mism, str) else (DASH if mism is None else f"{mism:.2e}"),
@@ -221,10 +229,20 @@ def markdown_row(row: dict) -> str:
 
 
 HEADER = (
-    "| mesh | collection | vertices | cones/sharp | seconds | peak MB | certificate "
-    "| worst facet fold (deg) | worst edge mismatch |\n"
-    "|---|---|--:|--:|--:|--:|---|--:|--:|"
+    "| mesh | collection | vertices | cones/sharp | seconds | peak MB | output MB "
+    "| output KB per vertex | certificate | worst facet fold (deg) | worst edge mismatch |\n"
+    "|---|---|--:|--:|--:|--:|--:|--:|---|--:|--:|"
 )
+
+
+def _kb_per_vertex(designs: list[dict]) -> str:
+    """Output KB per input vertex over ``designs``: overall, and the largest of one mesh."""
+    n = sum(r.get("vertices") or 0 for r in designs)
+    if not n:
+        return DASH
+    total = 1e3 * sum(r.get("output_mb") or 0 for r in designs) / n
+    worst = max(1e3 * (r.get("output_mb") or 0) / max(r.get("vertices") or 1, 1) for r in designs)
+    return f"{total:.1f}; largest {worst:.1f}"
 
 
 def summary(rows: list[dict]) -> list[str]:
@@ -245,7 +263,9 @@ def summary(rows: list[dict]) -> list[str]:
         )
         + f"; total {sum(r['time'] for r in rows):.0f} s wall, "
         f"{sum(r.get('vertices') or 0 for r in rows)} vertices, largest peak memory "
-        f"{max((r.get('peak_mb') or 0 for r in rows), default=0):.0f} MB"
+        f"{max((r.get('peak_mb') or 0 for r in rows), default=0):.0f} MB, output "
+        f"{sum(r.get('output_mb') or 0 for r in designs):.0f} MB "
+        f"({_kb_per_vertex(designs)} KB per input vertex)"
     ]
     for r in rows:
         name = f"{r['collection']}/{r['mesh']}"
