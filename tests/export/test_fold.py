@@ -305,19 +305,51 @@ def test_annotation_numbers_are_written_to_fold_digits(scale):
 
     lab = ann["labels"]
     assert ann["tabs"] == [as_written(t) for t in p.annotations.tabs]
-    assert ann["tab_hinges"] == [as_written(h) for h in p.annotations.tab_hinges]
+    # each hinge is two points of its tab's outline: written as their indices, once
+    assert ann["tab_hinges"] == [[3, 2]] * len(p.annotations.tab_hinges)
     assert lab["position"] == [as_written(lb.position) for lb in p.annotations.labels]
     assert lab["angle"] == [_round(lb.angle) for lb in p.annotations.labels]
     assert lab["height"] == [_round(lb.height) for lb in p.annotations.labels]
     assert ann["sheets"] == as_written(p.annotations.sheets)
-    for tab, hinge in zip(ann["tabs"], ann["tab_hinges"], strict=True):
-        assert hinge == [tab[3], tab[2]]  # a hinge is written as the very numbers of its tab's
+    for tab, hinge in zip(ann["tabs"], p.annotations.tab_hinges, strict=True):
+        assert [tab[3], tab[2]] == as_written(hinge)  # the very numbers of its tab's points
     assert lab["text"] == [lb.text for lb in p.annotations.labels]
     assert lab["kind"] == [lb.kind for lb in p.annotations.labels]
     side = json.loads(annotations_json(p))
     assert side.pop("design") == {"vertices": 4, "faces": 2, "pieces": 1}
     assert side.pop("file_creator").startswith("filletfold")
     assert side == ann
+
+
+def test_hinges_off_their_outline_are_written_as_points_and_read_back(tmp_path):
+    """A hinge whose ends are two points of its tab's outline is written as their indices; one
+    that is not (or has no tab) as its points; reading gives every hinge back bit for bit, and
+    an index its tab does not have is a one-line error."""
+    from filletfold.errors import MeshReadError
+    from filletfold.export.fold import _round, annotations_json, hinge_refs
+    from filletfold.export.fold_read import read_annotations
+
+    p = annotated_square(0.7, n=3)
+    ann = p.annotations
+    off = np.array([[0.1, 0.2], [0.3, 0.4]])
+    # tab 0: the usual hinge; tab 1: not on its outline; tab 2: another side; a 4th: no tab
+    ann.tab_hinges = [ann.tabs[0][[3, 2]], off, ann.tabs[2][[0, 1]], off]
+    refs = hinge_refs(np.concatenate(ann.tabs), np.array([4, 4, 4]), np.array(ann.tab_hinges))
+    assert refs.tolist() == [[3, 2], [-1, -1], [0, 1], [-1, -1]]
+    text = annotations_json(p)
+    items = json.loads(text)["tab_hinges"]
+    assert items[0] == [3, 2] and items[-1] == off.tolist()
+    path = tmp_path / "annotations.json"
+    path.write_text(text)
+    back = read_annotations(path, p)
+    assert len(back.tab_hinges) == len(ann.tab_hinges)
+    for got, exact in zip(back.tab_hinges, ann.tab_hinges, strict=True):
+        assert np.array_equal(got, np.vectorize(_round)(exact))  # as FOLD writes numbers
+    doc = json.loads(text)
+    doc["tab_hinges"][0] = [3, 9]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(MeshReadError, match="tab hinge 0 names points"):
+        read_annotations(path, p)
 
 
 def test_design_fold_leaves_the_annotations_to_their_own_file():

@@ -331,6 +331,52 @@ def _check_labels(numbers: dict) -> None:
             )
 
 
+def hinge_refs(tab_points: np.ndarray, tab_size: np.ndarray, hinges: np.ndarray) -> np.ndarray:
+    """For each hinge, the two points of its tab's outline it joins, when both are there.
+
+    Parameters
+    ----------
+    tab_points : (k, 2) float
+        The tab outlines' points, one outline after the other.
+    tab_size : (n_tabs,) int
+        Points of each outline.
+    hinges : (n_hinges, 2, 2) float
+        Hinge ``i`` belongs to tab ``i``.
+
+    Returns
+    -------
+    (n_hinges, 2) int
+        The index (within its outline) of the first outline point equal to each end of hinge
+        ``i`` (bit for bit), or ``-1`` when there is none (or no tab ``i``).
+    """
+    n = len(hinges)
+    out = np.full((n, 2), -1, dtype=np.int64)
+    m = min(n, len(tab_size))
+    if m == 0:
+        return out
+    size = np.asarray(tab_size[:m], dtype=np.int64)
+    first = np.concatenate([[0], np.cumsum(size)[:-1]])
+    owner = np.repeat(np.arange(m), size)
+    local = np.arange(int(size.sum())) - np.repeat(first, size)
+    pts = tab_points[: int(size.sum())]
+    for end in (0, 1):
+        hit = np.flatnonzero((pts == hinges[owner, end]).all(axis=1))
+        # the first hit of each tab: hits are in order, so the first of each owner
+        tab, at = np.unique(owner[hit], return_index=True)
+        out[tab, end] = local[hit[at]]
+    return out
+
+
+def _hinge_items(a: dict) -> list:
+    """``tab_hinges`` of the annotations' JSON: each hinge as ``[i, j]``, the indices of the
+    two points of its tab's outline it joins (the hinge is the outline's side on the piece's
+    border), or as its two points ``[[x, y], [x, y]]`` when they are not both on its
+    outline."""
+    refs = hinge_refs(a["tab_points"], a["tab_size"], a["hinges"])
+    found = (refs >= 0).all(axis=1)
+    return [refs[k].tolist() if found[k] else a["hinges"][k].tolist() for k in range(len(refs))]
+
+
 def annotations_document(annotations: Annotations) -> dict:
     """The JSON form of a pattern's annotations (the ``filletfold:annotations`` FOLD key).
 
@@ -341,12 +387,15 @@ def annotations_document(annotations: Annotations) -> dict:
     Returns
     -------
     dict
-        ``tabs``: list of tab outlines, each a list of ``[x, y]``; ``tab_hinges``: list of
-        ``[[x, y], [x, y]]``; ``labels``: the labels as parallel lists (one item per label),
-        ``{"position": [[x, y], ...], "text": [...], "angle": [...] (degrees), "height": [...],
-        "kind": [...]}``; ``sheets``: list of ``[xmin, ymin, xmax, ymax]``. All in pattern
-        coordinates (written by :func:`fold_json` to :data:`FOLD_DIGITS`, as the pattern's
-        points: a tab's base stays on its piece's border).
+        ``tabs``: list of tab outlines, each a list of ``[x, y]``; ``tab_hinges``: one item
+        per tab, ``[i, j]`` (the indices of the two points of the tab's outline the hinge
+        joins: the hinge is not written twice) or, for a hinge whose ends are not both points
+        of its outline, ``[[x, y], [x, y]]``; ``labels``: the labels as parallel lists (one
+        item per label), ``{"position": [[x, y], ...], "text": [...], "angle": [...]
+        (degrees), "height": [...], "kind": [...]}``; ``sheets``: list of
+        ``[xmin, ymin, xmax, ymax]``. All in pattern coordinates (written by
+        :func:`fold_json` to :data:`FOLD_DIGITS`, as the pattern's points: a tab's base stays
+        on its piece's border).
 
     Raises
     ------
@@ -362,7 +411,7 @@ def annotations_document(annotations: Annotations) -> dict:
     tabs = np.split(a["tab_points"], np.cumsum(sizes)[:-1]) if len(sizes) else []
     return {
         "tabs": [t.tolist() for t in tabs],
-        "tab_hinges": a["hinges"].tolist(),
+        "tab_hinges": _hinge_items(a),
         "labels": {
             "position": a["position"].tolist(),
             "text": [str(lb.text) for lb in labels],
@@ -391,7 +440,7 @@ def _annotations_data(annotations: Annotations) -> dict:
     tabs = "[" + ",".join(map(tab_template.__getitem__, sizes)) + "]"
     return {
         "tabs": _Raw(_fill(tabs, a["tab_points"])),
-        "tab_hinges": _Raw(_float_text(a["hinges"])),
+        "tab_hinges": _Raw(_hinges_text(a)),
         "labels": {
             "position": _Raw(_float_text(a["position"])),
             "text": _Raw(_strings_text(str(lb.text) for lb in labels)),
@@ -441,6 +490,17 @@ def design_counts(pattern: CreasePattern) -> dict:
         "faces": len(pattern.faces),
         "pieces": len(pattern.piece_vertex),
     }
+
+
+def _hinges_text(a: dict) -> str:
+    """Compact JSON of ``tab_hinges`` (see :func:`_hinge_items`), formatted in bulk."""
+    refs = hinge_refs(a["tab_points"], a["tab_size"], a["hinges"])
+    found = (refs >= 0).all(axis=1)
+    items = [f"[{i},{j}]" for i, j in refs.tolist()]
+    missing = np.flatnonzero(~found)
+    for k, text in zip(missing.tolist(), _item_texts(a["hinges"][missing]), strict=True):
+        items[k] = text
+    return "[" + ",".join(items) + "]"
 
 
 def _strings_text(items) -> str:

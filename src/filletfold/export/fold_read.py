@@ -237,12 +237,26 @@ def _annotations(data, where: str = NAMESPACE + "annotations") -> Annotations:
         raise MeshReadError(f"{where} must be an object")
     try:
         tabs = [np.asarray(t, dtype=np.float64).reshape(-1, 2) for t in data.get("tabs", [])]
-        hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in data.get("tab_hinges", [])]
+        hinges = _hinges(data.get("tab_hinges", []), tabs)
         labels = _labels(data.get("labels", []))
         sheets = np.asarray(data.get("sheets", []), dtype=np.float64).reshape(-1, 4)
     except (TypeError, ValueError, KeyError, AttributeError) as exc:
         raise MeshReadError(f"{where} is malformed ({exc!r})") from None
     return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)
+
+
+def _hinges(items, tabs: list) -> list[np.ndarray]:
+    """The tab hinges of ``tab_hinges``: each item ``[i, j]``, two points of its tab's outline
+    (by index), or ``[[x, y], [x, y]]`` (as files written before the indices)."""
+    out = []
+    for k, h in enumerate(items):
+        if isinstance(h, list) and len(h) == 2 and all(type(i) is int for i in h):
+            if k >= len(tabs) or not all(0 <= i < len(tabs[k]) for i in h):
+                raise ValueError(f"tab hinge {k} names points {h} its tab does not have")
+            out.append(tabs[k][h].copy())
+        else:
+            out.append(np.asarray(h, dtype=np.float64).reshape(2, 2))
+    return out
 
 
 def _labels(data) -> list[Label]:
