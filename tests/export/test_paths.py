@@ -18,6 +18,7 @@ from filletfold.export.paths import (
     chain_runs,
     edge_chains,
     simplify_polyline,
+    simplify_polylines,
     tab_cut_paths,
 )
 from filletfold.surface.pattern import Annotations
@@ -48,6 +49,76 @@ def test_edge_chains_mask_and_empty():
     assert edge_chains(edges, np.zeros(3, dtype=bool)) == []
     ((c, closed),) = edge_chains(edges, np.array([True, True, False]))
     assert c.tolist() == [0, 1, 2] and not closed
+
+
+def _chains_one_edge_at_a_time(edges, mask=None) -> list:
+    """The walk :func:`edge_chains` does, one edge per Python step: the reference for its
+    paths and their order (open paths from their lower end vertex, by vertex then edge; then
+    loops of degree-two vertices from their lowest-numbered edge)."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    ids = np.arange(len(edges)) if mask is None else np.flatnonzero(mask)
+    adjacency: dict[int, list[int]] = {}
+    for e in ids.tolist():
+        for v in edges[e].tolist():
+            adjacency.setdefault(v, []).append(e)
+    used: set = set()
+
+    def walk(start, e):
+        path, v = [start], start
+        while True:
+            used.add(e)
+            a, b = edges[e].tolist()
+            v = b if a == v else a
+            if v == start:
+                return path, True
+            path.append(v)
+            nxt = [f for f in adjacency[v] if f not in used]
+            if len(adjacency[v]) != 2 or not nxt:
+                return path, False
+            e = nxt[0]
+
+    out = []
+    for v in sorted(adjacency):
+        if len(adjacency[v]) != 2:
+            out += [walk(v, e) for e in adjacency[v] if e not in used]
+    out += [walk(int(edges[e, 0]), e) for e in ids.tolist() if e not in used]
+    return [(list(path), closed) for path, closed in out]
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(0, 9), st.integers(0, 9)), min_size=1, max_size=24),
+    st.lists(st.booleans(), min_size=24, max_size=24),
+)
+def test_edge_chains_walk_as_one_edge_at_a_time(pairs, keep):
+    """Random multigraphs (parallel edges, branches, loops through a branch vertex, rings):
+    the same paths in the same order as the edge-by-edge walk."""
+    edges = np.array([(a, b) for a, b in pairs if a != b], dtype=np.int64).reshape(-1, 2)
+    mask = np.array(keep[: len(edges)], dtype=bool)
+    for m in (None, mask):
+        got = [(c.tolist(), closed) for c, closed in edge_chains(edges, m)]
+        assert got == _chains_one_edge_at_a_time(edges, m)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(
+        st.tuples(
+            st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3)), min_size=1, max_size=8),
+            st.booleans(),
+        ),
+        min_size=1,
+        max_size=6,
+    )
+)
+def test_simplify_polylines_is_simplify_polyline_of_each(paths):
+    """On grid points (repeated points, straight runs, closing repeats) the batch gives the
+    arrays :func:`simplify_polyline` gives path by path."""
+    paths = [(np.array(q, dtype=float), closed) for q, closed in paths]
+    got = simplify_polylines(paths)
+    assert len(got) == len(paths)
+    for g, (q, closed) in zip(got, paths, strict=True):
+        assert np.array_equal(g, simplify_polyline(q, closed))
 
 
 def test_simplify_polyline_drops_collinear_points():

@@ -31,6 +31,7 @@ __all__ = [
     "point_rows",
     "polyline_length",
     "simplify_polyline",
+    "simplify_polylines",
     "tab_cut_paths",
 ]
 
@@ -79,6 +80,9 @@ def edge_chains(edges: np.ndarray, mask: np.ndarray | None = None) -> list[tuple
     closed paths. The order is deterministic: open paths start at their lowest end vertex (in
     order of that vertex, then of the first edge), closed ones at their lowest-numbered edge.
 
+    Every path is walked at once, one edge per step for all of them (numpy), so the time
+    grows with the edges and the longest path, not with one Python step per edge.
+
     Parameters
     ----------
     edges : (m, 2) int
@@ -96,41 +100,100 @@ def edge_chains(edges: np.ndarray, mask: np.ndarray | None = None) -> list[tuple
     ids = np.arange(len(edges)) if mask is None else np.flatnonzero(mask)
     if len(ids) == 0:
         return []
-    adjacency: dict[int, list[int]] = {}
-    for e in ids:
-        a, b = edges[e]
-        adjacency.setdefault(int(a), []).append(int(e))
-        adjacency.setdefault(int(b), []).append(int(e))
-    used = set()
-    chains = []
+    ends = edges[ids]  # the selected edges, numbered 0..m-1 in the order of their ids
+    m = len(ends)
+    # incidences (vertex, edge), sorted by vertex, then edge
+    inc_v = ends.ravel()
+    inc_e = np.repeat(np.arange(m), 2)
+    order = np.lexsort((inc_e, inc_v))
+    sv, se = inc_v[order], inc_e[order]
+    _, deg = np.unique(sv, return_counts=True)
+    deg_sorted = np.repeat(deg, deg)
+    # at a vertex of degree two, each of its two edges leads on to the other
+    pair = np.flatnonzero(deg_sorted == 2)
+    other_sorted = np.full(2 * m, -1, dtype=np.int64)
+    other_sorted[pair[0::2]], other_sorted[pair[1::2]] = se[pair[1::2]], se[pair[0::2]]
+    nxt = np.empty(2 * m, dtype=np.int64)  # per edge end: the edge after it, or -1
+    nxt[order] = other_sorted
+    nxt = nxt.reshape(m, 2)
 
-    def walk(start: int, first_edge: int) -> tuple[list[int], bool]:
-        path = [start]
-        v, e = start, first_edge
-        while True:
-            used.add(e)
-            a, b = edges[e]
-            v = int(b) if a == v else int(a)
-            if v == start:
-                return path, True
-            path.append(v)
-            nxt = [f for f in adjacency[v] if f not in used]
-            if len(adjacency[v]) != 2 or not nxt:
-                return path, False
-            e = nxt[0]
+    # open paths (and loops through a vertex of another degree): from every such incidence
+    start_inc = np.flatnonzero(deg_sorted != 2)
+    s_vertex, s_edge = sv[start_inc], se[start_inc]
+    paths, final, last, walk_of, walked = _walk_chains(ends, nxt, s_vertex, s_edge)
+    closed = final == s_vertex
+    # a path is walked from both of its ends: keep the walk from the lower one (from the
+    # lower-numbered edge of a loop through one vertex; a self-loop's two incidences once)
+    keep = (final > s_vertex) | (closed & (s_edge <= last))
+    keep[1:] &= (s_vertex[1:] != s_vertex[:-1]) | (s_edge[1:] != s_edge[:-1])
+    chains = [
+        (paths[k][:-1] if closed[k] else paths[k], bool(closed[k]))
+        for k in np.flatnonzero(keep).tolist()
+    ]
+    used = np.zeros(m, dtype=bool)
+    used[walked[keep[walk_of]]] = True
 
-    for v in sorted(adjacency):
-        if len(adjacency[v]) == 2:
-            continue
-        for e in adjacency[v]:
-            if e not in used:
-                path, closed = walk(v, e)
-                chains.append((np.array(path, dtype=np.int64), closed))
-    for e in ids:
-        if int(e) not in used:
-            path, closed = walk(int(edges[e, 0]), int(e))
-            chains.append((np.array(path, dtype=np.int64), closed))
+    # loops of degree-two vertices only: from their lowest-numbered edge, along it
+    rest = np.flatnonzero(~used)
+    if len(rest):
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        n_v = int(ends.max()) + 1
+        a, b = ends[rest, 0], ends[rest, 1]
+        graph = coo_matrix((np.ones(len(rest)), (a, b)), shape=(n_v, n_v))
+        _, label = connected_components(graph, directed=False)
+        _, first = np.unique(label[a], return_index=True)
+        e0 = np.sort(rest[first])  # ``rest`` ascends: a loop's first edge is its lowest
+        loops = _walk_chains(ends, nxt, ends[e0, 0], e0)[0]
+        chains.extend((q[:-1], True) for q in loops)
     return chains
+
+
+def _walk_chains(ends, nxt, start_vertex, start_edge):
+    """Walk from every ``start_vertex`` along ``start_edge`` through vertices of degree two
+    (``nxt``: the edge after each edge end, or -1), all walks one edge per step, until a
+    vertex of another degree or the start again.
+
+    Returns
+    -------
+    paths : list of (k,) int
+        The vertices of each walk, the start first (a walk back to its start ends with it).
+    final : (w,) int
+        The vertex each walk ends at.
+    last : (w,) int
+        The last edge of each walk.
+    walk_of, walked : (h,) int
+        Each edge walked (``walked``) and its walk (``walk_of``).
+    """
+    w = len(start_vertex)
+    start_vertex = np.asarray(start_vertex, dtype=np.int64)
+    cur_v = start_vertex.copy()
+    cur_e = np.asarray(start_edge, dtype=np.int64).copy()
+    last, final = cur_e.copy(), cur_v.copy()
+    active = np.arange(w)
+    rec_walk, rec_vertex, rec_edge = [active], [cur_v.copy()], []
+    for _ in range(len(ends) + 1):
+        if not len(active):
+            break
+        e = cur_e[active]
+        far = (ends[e, 0] == cur_v[active]).astype(np.int64)  # the end the walk arrives at
+        v = ends[e, far]
+        rec_walk.append(active)
+        rec_vertex.append(v)
+        rec_edge.append(e)
+        last[active], final[active] = e, v
+        on = nxt[e, far]
+        go = (v != start_vertex[active]) & (on >= 0)
+        active = active[go]
+        cur_v[active], cur_e[active] = v[go], on[go]
+    walk = np.concatenate(rec_walk)
+    by_walk = np.argsort(walk, kind="stable")  # each walk's vertices in the order visited
+    counts = np.bincount(walk, minlength=w)
+    paths = np.split(np.concatenate(rec_vertex)[by_walk], np.cumsum(counts)[:-1]) if w else []
+    walk_of = np.concatenate([np.zeros(0, dtype=np.int64), *rec_walk[1:]])
+    walked = np.concatenate([np.zeros(0, dtype=np.int64), *rec_edge])
+    return paths, final, last, walk_of, walked
 
 
 def polyline_length(points: np.ndarray, closed: bool = False) -> float:
@@ -224,6 +287,49 @@ def simplify_polyline(points: np.ndarray, closed: bool = False) -> np.ndarray:
         changed = bool(straight.any())
         p = p[~straight]
     return p
+
+
+def simplify_polylines(paths: list) -> list[np.ndarray]:
+    """:func:`simplify_polyline` of every ``(points, closed)`` of ``paths``, the common case
+    (no repeated point, no straight interior point: nothing to drop) found for all of them at
+    once; the others are simplified one by one. The same arrays as one by one.
+
+    Parameters
+    ----------
+    paths : list of ((k, 2) float, bool)
+
+    Returns
+    -------
+    list of (j, 2) float
+    """
+    if not paths:
+        return []
+    pts = [np.asarray(q, dtype=np.float64).reshape(-1, 2) for q, _ in paths]
+    size = np.fromiter(map(len, pts), dtype=np.int64, count=len(pts))
+    closed = np.fromiter((bool(c) for _, c in paths), dtype=bool, count=len(paths))
+    p = np.concatenate(pts)
+    first = np.concatenate([[0], np.cumsum(size)[:-1]])
+    owner = np.repeat(np.arange(len(pts)), size)
+    at = np.arange(len(p)) - first[owner]
+    # each point's neighbours along its path (cyclic, as simplify_polyline's np.roll)
+    prev = np.where(at == 0, first[owner] + size[owner] - 1, np.arange(len(p)) - 1)
+    nxt = np.where(at == size[owner] - 1, first[owner], np.arange(len(p)) + 1)
+    repeat = np.zeros(len(p), dtype=bool)
+    repeat[1:] = (at[1:] > 0) & np.all(p[1:] == p[:-1], axis=1)
+    a, b = p - p[prev], p[nxt] - p
+    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    dot = np.einsum("ij,ij->i", a, b)
+    straight = (np.abs(np.arctan2(cross, dot)) < _COLLINEAR_RAD) & (dot > 0)
+    straight &= closed[owner] | ((at > 0) & (at < size[owner] - 1))
+    straight &= size[owner] > np.where(closed[owner], 3, 2)
+    closing = closed & (size > 1)
+    closing[closing] = np.all(p[first[closing]] == p[(first + size - 1)[closing]], axis=1)
+    touched = np.bincount(owner, weights=repeat | straight, minlength=len(pts)) > 0
+    touched |= closing
+    return [
+        simplify_polyline(q, bool(c)) if touched[k] else q
+        for k, (q, c) in enumerate(zip(pts, closed, strict=True))
+    ]
 
 
 def chain_runs(points: np.ndarray, closed: bool = False) -> list[tuple[np.ndarray, bool, bool]]:

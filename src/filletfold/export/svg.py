@@ -51,7 +51,7 @@ from .paths import (
     edge_chains,
     label_positions,
     pattern_extent,
-    simplify_polyline,
+    simplify_polylines,
     tab_cut_paths,
 )
 from .presets import RESOLUTION_MM, Pen, Preset, get_preset
@@ -300,9 +300,10 @@ def _pattern_svg(
             body.append(draw.lines(v[edges[sel, 0]], v[edges[sel, 1]], pen.color, opacity))
         else:
             chains = edge_chains(edges, mask)
+            simple = simplify_polylines([(v[c], closed) for c, closed in chains])
             body.append(
                 draw.polylines(
-                    [(simplify_polyline(v[c], closed), closed) for c, closed in chains], pen.color
+                    [(q, closed) for q, (_, closed) in zip(simple, chains, strict=True)], pen.color
                 )
             )
         body.append("</g>")
