@@ -59,7 +59,7 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 
 from ..errors import ParameterError
-from ..surface.pattern import Annotations, CreasePattern, Label
+from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows
 from ..surface.validate import validated_faces
 from ..units import check_units, sheet_size_mm
 from .dxf import check_scale, pattern_dxf
@@ -194,6 +194,13 @@ def output_names(formats: Iterable[str]) -> tuple[str, ...]:
     return tuple(name for f in formats for name in FORMAT_FILES[f])
 
 
+def _scaled_rows(rows, scale: float):
+    """Tab outlines or hinges times ``scale``: a :class:`PointRows` as one, else a list."""
+    if isinstance(rows, PointRows):
+        return PointRows(rows.points * scale, rows.start)
+    return [np.asarray(r, dtype=np.float64) * scale for r in rows]
+
+
 def scaled_pattern(pattern: CreasePattern, scale: float) -> CreasePattern:
     """A copy of ``pattern`` whose flat layout and annotations are multiplied by ``scale``.
 
@@ -213,22 +220,20 @@ def scaled_pattern(pattern: CreasePattern, scale: float) -> CreasePattern:
     if scale == 1.0:
         return pattern
     ann = pattern.annotations
+    labels = LabelRows.of(ann.labels)
     return dataclasses.replace(
         pattern,
         vertices_2d=pattern.vertices_2d * scale,
         annotations=Annotations(
-            tabs=[np.asarray(t, dtype=np.float64) * scale for t in ann.tabs],
-            tab_hinges=[np.asarray(h, dtype=np.float64) * scale for h in ann.tab_hinges],
-            labels=[
-                Label(
-                    position=np.asarray(lb.position, dtype=np.float64) * scale,
-                    text=lb.text,
-                    angle=lb.angle,
-                    height=lb.height * scale,
-                    kind=lb.kind,
-                )
-                for lb in ann.labels
-            ],
+            tabs=_scaled_rows(ann.tabs, scale),
+            tab_hinges=_scaled_rows(ann.tab_hinges, scale),
+            labels=LabelRows(
+                labels.position * scale,
+                labels.text,
+                labels.angle,
+                labels.height * scale,
+                labels.kind,
+            ),
             sheets=np.asarray(ann.sheets, dtype=np.float64) * scale,
         ),
     )

@@ -13,16 +13,15 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import operator
 from collections.abc import Mapping
 from json.encoder import encode_basestring_ascii as _quote
 
 import numpy as np
 
 from ..errors import ExportError, ParameterError
-from ..surface.pattern import Annotations, CreasePattern, face_arrays
+from ..surface.pattern import Annotations, CreasePattern, LabelRows, face_arrays
 from ..surface.validate import validated_faces
-from .paths import label_positions, point_rows
+from .paths import point_rows
 from .report import python_scalar
 
 __all__ = [
@@ -294,24 +293,22 @@ def _annotation_arrays(annotations: Annotations) -> dict:
         When a value is malformed (a hinge that is not 2 points, a label angle that is not a
         number, ...).
     """
-    labels = annotations.labels
-    n = len(labels)
+    labels = LabelRows.of(annotations.labels)
     tab_points, tab_size = point_rows(annotations.tabs)
     hinge_points, hinge_size = point_rows(annotations.tab_hinges)
     if (hinge_size != 2).any():  # each hinge is read as reshape(2, 2): its error
         for h in annotations.tab_hinges:
             np.asarray(h, dtype=np.float64).reshape(2, 2)
-    position = label_positions(labels)
-    angle = np.fromiter(map(float, map(operator.attrgetter("angle"), labels)), np.float64, n)
-    height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
     sheets = np.asarray(annotations.sheets, dtype=np.float64).reshape(-1, 4)
     return {
         "tab_points": tab_points,
         "tab_size": tab_size,
         "hinges": hinge_points.reshape(-1, 2, 2),
-        "position": position,
-        "angle": angle,
-        "height": height,
+        "position": labels.position,
+        "angle": labels.angle,
+        "height": labels.height,
+        "text": list(map(str, labels.text)),
+        "kind": list(map(str, labels.kind)),
         "sheets": sheets,
     }
 
@@ -406,7 +403,6 @@ def annotations_document(annotations: Annotations) -> dict:
     """
     a = _annotation_arrays(annotations)
     _check_labels(a)
-    labels = annotations.labels
     sizes = a["tab_size"]
     tabs = np.split(a["tab_points"], np.cumsum(sizes)[:-1]) if len(sizes) else []
     return {
@@ -414,10 +410,10 @@ def annotations_document(annotations: Annotations) -> dict:
         "tab_hinges": _hinge_items(a),
         "labels": {
             "position": a["position"].tolist(),
-            "text": [str(lb.text) for lb in labels],
+            "text": a["text"],
             "angle": a["angle"].tolist(),
             "height": a["height"].tolist(),
-            "kind": [str(lb.kind) for lb in labels],
+            "kind": a["kind"],
         },
         "sheets": a["sheets"].tolist(),
     }
@@ -434,7 +430,6 @@ def _annotations_data(annotations: Annotations) -> dict:
     numbers = ("tab_points", "hinges", "position", "angle", "height", "sheets")
     if not all(np.isfinite(a[k]).all() for k in numbers):
         return annotations_document(annotations)
-    labels = annotations.labels
     sizes = a["tab_size"].tolist()
     tab_template = {k: _template((k, 2)) for k in set(sizes)}
     tabs = "[" + ",".join(map(tab_template.__getitem__, sizes)) + "]"
@@ -443,10 +438,10 @@ def _annotations_data(annotations: Annotations) -> dict:
         "tab_hinges": _Raw(_hinges_text(a)),
         "labels": {
             "position": _Raw(_float_text(a["position"])),
-            "text": _Raw(_strings_text(str(lb.text) for lb in labels)),
+            "text": _Raw(_strings_text(a["text"])),
             "angle": _Raw(_float_text(a["angle"])),
             "height": _Raw(_float_text(a["height"])),
-            "kind": _Raw(_strings_text(str(lb.kind) for lb in labels)),
+            "kind": _Raw(_strings_text(a["kind"])),
         },
         "sheets": _Raw(_float_text(a["sheets"])),
     }

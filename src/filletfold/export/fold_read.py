@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ExportError, MeshReadError
-from ..surface.pattern import Annotations, CreasePattern, Label
+from ..surface.pattern import Annotations, CreasePattern, Label, LabelRows
 from ..surface.validate import validate_pattern
 from .fold import ANNOTATIONS_FILE, NAMESPACE, design_counts
 
@@ -259,7 +259,7 @@ def _hinges(items, tabs: list) -> list[np.ndarray]:
     return out
 
 
-def _labels(data) -> list[Label]:
+def _labels(data) -> LabelRows | list[Label]:
     """The labels of ``filletfold:annotations``: parallel lists ``{"position": [[x, y], ...],
     "text": [...], "angle": [...], "height": [...], "kind": [...]}`` (``angle``, ``height`` and
     ``kind`` optional), or, as files written before those, a list of records ``{"position",
@@ -278,16 +278,7 @@ def _labels(data) -> list[Label]:
         sizes = {len(text), len(angle), len(height), len(kind)}
         if sizes != {n}:
             raise ValueError(f"labels' lists have lengths {sorted(sizes | {n})}, not one length")
-        return [
-            Label(
-                position=position[i].copy(),
-                text=text[i],
-                angle=angle[i],
-                height=height[i],
-                kind=kind[i],
-            )
-            for i in range(n)
-        ]
+        return LabelRows(position, text, angle, height, kind)
     return [
         Label(
             position=np.asarray(lb["position"], dtype=np.float64).reshape(2),

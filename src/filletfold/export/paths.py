@@ -10,11 +10,10 @@ cut (all of it except the hinge it shares with its piece).
 from __future__ import annotations
 
 import itertools
-import operator
 
 import numpy as np
 
-from ..surface.pattern import Annotations, CreasePattern
+from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows
 
 __all__ = [
     "SPLINE_MAX_SPACING_RATIO",
@@ -603,6 +602,8 @@ def point_rows(rows: list) -> tuple[np.ndarray, np.ndarray]:
     sizes : (n,) int
         The number of points of each row.
     """
+    if isinstance(rows, PointRows):
+        return rows.points, np.diff(rows.start)
     try:
         flat = np.concatenate(rows) if rows else np.zeros((0, 2))
     except ValueError:  # rows of several dimensions
@@ -616,14 +617,7 @@ def point_rows(rows: list) -> tuple[np.ndarray, np.ndarray]:
 
 def label_positions(labels: list) -> np.ndarray:
     """(n, 2) float: the position of every label (each read as ``reshape(2)``)."""
-    try:
-        position = np.array([lb.position for lb in labels], dtype=np.float64)
-    except ValueError:  # positions of several shapes
-        position = None
-    if position is None or position.shape != (len(labels), 2):
-        rows = [np.asarray(lb.position, dtype=np.float64).reshape(2) for lb in labels]
-        position = np.array(rows, dtype=np.float64).reshape(-1, 2)
-    return position
+    return LabelRows.of(labels).position
 
 
 def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
@@ -636,11 +630,9 @@ def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
     lo, hi : (2,) float
         ``(0, 0)`` and ``(1, 1)`` for an empty pattern.
     """
-    labels = pattern.annotations.labels
-    centre = label_positions(labels)
-    n = len(labels)
-    height = np.fromiter(map(float, map(operator.attrgetter("height"), labels)), np.float64, n)
-    chars = np.fromiter(map(len, map(operator.attrgetter("text"), labels)), np.int64, n)
+    labels = LabelRows.of(pattern.annotations.labels)
+    centre, height = labels.position, labels.height
+    chars = np.fromiter(map(len, labels.text), np.int64, len(labels))
     half = (0.5 * height * np.maximum(chars, 1).astype(np.float64) * 0.6)[:, None]
     pts = [
         np.asarray(pattern.vertices_2d, dtype=np.float64).reshape(-1, 2),

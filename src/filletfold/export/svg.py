@@ -42,14 +42,13 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from ..errors import ParameterError
-from ..surface.pattern import CreasePattern
+from ..surface.pattern import CreasePattern, LabelRows
 from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units
 from .palette import SHEET_COLOR
 from .paths import (
     dash_polylines,
     edge_chains,
-    label_positions,
     pattern_extent,
     simplify_polylines,
     tab_cut_paths,
@@ -500,22 +499,17 @@ def _label_group(pattern, draw: _Drawing, color: str) -> list[str]:
         f'<g id="labels" font-family="sans-serif" fill="{color}" stroke="none" '
         'text-anchor="middle" dominant-baseline="central">'
     ]
-    position = label_positions(labels)
-    tx = draw.x(position[:, 0])
-    ty = draw.y(position[:, 1])
-    size = _format_all(
-        np.array([float(lb.height) for lb in labels], dtype=np.float64) * draw.k, draw.decimals
-    )
-    angle = np.array([lb.angle for lb in labels], dtype=object)
-    turned = np.flatnonzero(angle.astype(bool))  # the truth of each angle, as it is
-    rot = [""] * len(labels)
-    turns = _format_all(
-        np.array([-float(a) for a in angle[turned]], dtype=np.float64), _ANGLE_DECIMALS
-    )
+    rows = LabelRows.of(labels)
+    tx = draw.x(rows.position[:, 0])
+    ty = draw.y(rows.position[:, 1])
+    size = _format_all(rows.height * draw.k, draw.decimals)
+    turned = np.flatnonzero(rows.angle != 0)
+    rot = [""] * len(rows)
+    turns = _format_all(-rows.angle[turned], _ANGLE_DECIMALS)
     for i, r in zip(turned.tolist(), turns, strict=True):
         rot[i] = f' transform="rotate({r} {tx[i]} {ty[i]})"'
-    kinds = [str(lb.kind) for lb in labels]
-    texts = [str(lb.text) for lb in labels]
+    kinds = list(map(str, rows.kind))
+    texts = list(map(str, rows.text))
     escaped = {t: escape(t) for t in {*kinds, *texts}}
     out.extend(
         f'<text x="{x}" y="{y}" font-size="{h}" class="{escaped[k]}"{r}>{escaped[t]}</text>'

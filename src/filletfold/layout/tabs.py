@@ -16,6 +16,7 @@ few others, as it decided every pair one at a time before. The same tabs, to the
 from __future__ import annotations
 
 import gc
+from collections.abc import Sequence
 from contextlib import contextmanager
 
 import numpy as np
@@ -23,7 +24,7 @@ import shapely
 from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
-from ..surface.pattern import Annotations, CreasePattern, Label, face_arrays
+from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows, face_arrays
 from .convex import (
     BoxGrid,
     abs_max,
@@ -655,31 +656,25 @@ def _tabs_and_labels(p, tab_height, part_names):
     n_runs = len(ends)
     names = part_names or [f"P{k + 1}" for k in range(p.n_pieces)]
     stats = {"cut_borders": n_runs, "tabs": 0, "tabs_reduced": 0, "untabbed": n_runs}
-    seams = []
+    seams = Seams([], np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64))
     if n_runs:
         run, level, side, quads, hinges = _choose(faces, ends, normal, tab_height)
         stats["tabs"] = len(run)
         stats["tabs_reduced"] = int(np.count_nonzero(level > 0))
         stats["untabbed"] = n_runs - len(run)
-        ann.tabs.extend(list(quads))
-        ann.tab_hinges.extend(list(hinges))
+        ann.tabs = PointRows.of_blocks(quads)
+        ann.tab_hinges = PointRows.of_blocks(hinges)
         tab_on = np.full(n_runs, -1)
         tab_on[run] = side
-        a = [names[k] for k in _piece_of(p, first_a).tolist()]
-        b = [names[k] for k in _piece_of(p, first_b).tolist()]
-        for n, (pa, pb, on) in enumerate(zip(a, b, tab_on.tolist(), strict=True)):
-            tab = None if on < 0 else (pa, pb)[on]
-            seams.append({"label": n + 1, "pieces": [pa, pb], "tab_on": tab})
+        pieces = np.stack([_piece_of(p, first_a), _piece_of(p, first_b)], axis=1)
+        seams = Seams(names, pieces, tab_on)
         d = ends[:, :, 1] - ends[:, :, 0]
         pos = (ends[:, :, 0] + ends[:, :, 1]) / 2 - 0.9 * label_h * normal
         angle = _readable(np.degrees(np.arctan2(d[..., 1], d[..., 0])))
         text = [""] * (2 * n_runs)
         text[::2] = text[1::2] = list(map(str, range(1, n_runs + 1)))
-        ann.labels.extend(
-            Label(xy, t, a, label_h, "tab")
-            for xy, t, a in zip(pos.reshape(-1, 2), text, angle.ravel(), strict=True)
-        )
-    ann.labels.extend(_part_labels(p, faces, names, label_h))
+        ann.labels = LabelRows(pos.reshape(-1, 2), text, angle.ravel(), label_h, "tab")
+    ann.labels = LabelRows.of(ann.labels) + _part_labels(p, faces, names, label_h)
     p.annotations = ann
     stats["seams"] = seams
     return stats
@@ -711,7 +706,7 @@ def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list
     piece = p.face_piece
     inside = np.flatnonzero((piece >= 0) & (piece < p.n_pieces))
     if not len(inside):
-        return []
+        return LabelRows(np.zeros((0, 2)), [], 0.0, 0.0, "part")
     area = faces.areas()
     best = np.full(p.n_pieces, -np.inf)
     np.maximum.at(best, piece[inside], area[inside])
@@ -724,10 +719,7 @@ def _part_labels(p: CreasePattern, faces: _Faces, names, label_h: float) -> list
     order = close[np.lexsort((close, -exact[close], piece[close]))]
     first = order[np.r_[True, piece[order][1:] != piece[order][:-1]]]
     where = shapely.get_coordinates(shapely.point_on_surface(faces.polygons(first)))
-    return [
-        Label(xy.copy(), names[k], 0.0, 2 * label_h, "part")
-        for k, xy in zip(piece[first].tolist(), where, strict=True)
-    ]
+    return LabelRows(where, [names[k] for k in piece[first].tolist()], 0.0, 2 * label_h, "part")
 
 
 def _candidates(ends, normal, tab_height, cand):
@@ -974,8 +966,59 @@ class _Greedy:
         return self.choice[self.choice >= 0]
 
 
-def assembly_text(seams: list[dict]) -> str:
-    """The assembly sheet: which piece each numbered cut border joins, and where the tab is."""
+class Seams(Sequence):
+    """The numbered cut borders of a design, as arrays: seam ``k`` (label ``k + 1``) joins
+    pieces ``pieces[k]`` and carries its tab on side ``tab_on[k]`` (0, 1; -1: no tab). Read
+    one by one, each is ``{"label", "pieces": [name, name], "tab_on": name or None}``.
+
+    Parameters
+    ----------
+    names : list of str
+        Piece names.
+    pieces : (n, 2) int
+    tab_on : (n,) int
+    """
+
+    __slots__ = ("names", "pieces", "tab_on")
+
+    def __init__(self, names, pieces, tab_on):
+        self.names = list(names)
+        self.pieces = np.asarray(pieces, dtype=np.int64).reshape(-1, 2)
+        self.tab_on = np.asarray(tab_on, dtype=np.int64).reshape(-1)
+
+    def __len__(self) -> int:
+        return len(self.tab_on)
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(len(self)))]
+        n = len(self)
+        if not -n <= k < n:
+            raise IndexError(f"seam {k} out of range ({n} seams)")
+        k = int(k) % n
+        pa, pb = (self.names[i] for i in self.pieces[k].tolist())
+        on = int(self.tab_on[k])
+        return {"label": k + 1, "pieces": [pa, pb], "tab_on": None if on < 0 else (pa, pb)[on]}
+
+    def __iter__(self):
+        return map(self.__getitem__, range(len(self)))
+
+    def __eq__(self, other) -> bool:
+        """Equal to a sequence of the same seams (as dicts)."""
+        if not isinstance(other, Sequence) or isinstance(other, str):
+            return NotImplemented
+        return len(self) == len(other) and all(a == b for a, b in zip(self, other, strict=True))
+
+    __hash__ = None
+
+
+def assembly_text(seams) -> str:
+    """The assembly sheet: which piece each numbered cut border joins, and where the tab is.
+
+    Parameters
+    ----------
+    seams : Seams, or sequence of ``{"label", "pieces", "tab_on"}``
+    """
     lines = [
         "# filletfold assembly: glue each numbered border to the border with the same number",
         "label\tpieces\ttab on",

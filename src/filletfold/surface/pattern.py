@@ -66,6 +66,121 @@ class FaceRows(FlatFaces):
         return iter(np.split(self.flat, self.start[1:-1]) if len(self) else [])
 
 
+class PointRows(Sequence):
+    """Point lists (glue-tab outlines, tab hinges) held as one (k, 2) array and offsets: no
+    object per row until one is asked for (a design of modules has one tab per cut border,
+    tens of thousands: as a list of arrays they cost ten times their numbers).
+
+    Parameters
+    ----------
+    points : (k, 2) float
+        Every row's points, one row after the other.
+    start : (n_rows + 1,) int
+        Row ``i`` is ``points[start[i]:start[i + 1]]`` (a view).
+    """
+
+    __slots__ = ("points", "start")
+
+    def __init__(self, points: np.ndarray, start: np.ndarray):
+        self.points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        self.start = np.asarray(start, dtype=np.int64)
+
+    @classmethod
+    def of_blocks(cls, blocks: np.ndarray):
+        """The rows of a (n, k, 2) array, ``k`` points each."""
+        blocks = np.asarray(blocks, dtype=np.float64)
+        n, k = blocks.shape[:2]
+        return cls(blocks.reshape(-1, 2), np.arange(n + 1, dtype=np.int64) * k)
+
+    def __len__(self) -> int:
+        return len(self.start) - 1
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"row {i} out of range ({n} rows)")
+        i = int(i) % n
+        return self.points[self.start[i] : self.start[i + 1]]
+
+    def __iter__(self):
+        return iter(np.split(self.points, self.start[1:-1]) if len(self) else [])
+
+
+class LabelRows(Sequence):
+    """Labels held as parallel arrays (positions, angles, heights) and lists (texts, kinds):
+    a :class:`Label` is made when one is asked for.
+
+    Parameters
+    ----------
+    position : (n, 2) float
+    text, kind : sequence of str
+    angle, height : (n,) float
+    """
+
+    __slots__ = ("angle", "height", "kind", "position", "text")
+
+    def __init__(self, position, text, angle, height, kind):
+        self.position = np.asarray(position, dtype=np.float64).reshape(-1, 2)
+        n = len(self.position)
+        self.text = list(text)
+        self.angle = np.broadcast_to(np.asarray(angle, dtype=np.float64), (n,)).copy()
+        self.height = np.broadcast_to(np.asarray(height, dtype=np.float64), (n,)).copy()
+        self.kind = list(kind) if not isinstance(kind, str) else [kind] * n
+        if len(self.text) != n or len(self.kind) != n:
+            raise ValueError(
+                f"labels: {n} positions, {len(self.text)} texts, {len(self.kind)} kinds"
+            )
+
+    @classmethod
+    def of(cls, labels) -> LabelRows:
+        """The rows of a sequence of :class:`Label` (or a :class:`LabelRows`, as it is)."""
+        if isinstance(labels, LabelRows):
+            return labels
+        labels = list(labels)
+        return cls(
+            np.array(
+                [np.asarray(lb.position, dtype=np.float64).reshape(2) for lb in labels]
+            ).reshape(-1, 2),
+            [lb.text for lb in labels],
+            [float(lb.angle) for lb in labels],
+            [float(lb.height) for lb in labels],
+            [lb.kind for lb in labels],
+        )
+
+    def __add__(self, other) -> LabelRows:
+        other = LabelRows.of(other)
+        return LabelRows(
+            np.concatenate([self.position, other.position]),
+            self.text + other.text,
+            np.concatenate([self.angle, other.angle]),
+            np.concatenate([self.height, other.height]),
+            self.kind + other.kind,
+        )
+
+    def __len__(self) -> int:
+        return len(self.position)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"label {i} out of range ({n} labels)")
+        i = int(i) % n
+        return Label(
+            self.position[i].copy(),
+            self.text[i],
+            float(self.angle[i]),
+            float(self.height[i]),
+            self.kind[i],
+        )
+
+    def __iter__(self):
+        return map(self.__getitem__, range(len(self)))
+
+
 def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
     """Faces as one flat index array and their offsets.
 
@@ -123,12 +238,12 @@ class Annotations:
 
     Attributes
     ----------
-    tabs : list of (k, 2) float
+    tabs : list of (k, 2) float, or PointRows
         Glue-tab outlines (closed polygons, counter-clockwise) in pattern coordinates; each is
         cut along its outline except the side it shares with its piece, which is folded.
-    tab_hinges : list of (2, 2) float
+    tab_hinges : list of (2, 2) float, or PointRows
         For each tab, the segment it shares with its piece (folded, not cut).
-    labels : list of Label
+    labels : list of Label, or LabelRows
     sheets : (n_sheets, 4) float
         ``(xmin, ymin, xmax, ymax)`` of each sheet of material, in pattern coordinates (empty
         when the pieces were not placed on sheets).
