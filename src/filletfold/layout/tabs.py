@@ -54,6 +54,9 @@ LEVELS = ((1.0, None), (0.5, None), (0.5, 0), (0.5, 1), (0.25, 0), (0.25, 1))
 #: A tab is tested shrunk by this share of the full tab height (touching is not overlapping).
 SHRINK = 1e-9
 
+#: Tabs tested against the faces at a time (:meth:`_Faces.clear`), and pairs of tabs tested
+#: at a time (:func:`conflicts`): bounds the temporaries (some 2 KB per tab).
+CLEAR_CHUNK = 8192
 #: Overlap area (a share of the tab's area) above which a tab overlaps a face.
 OVERLAP = 1e-12
 
@@ -402,6 +405,20 @@ class _Faces:
         return area
 
     def clear(self, quads, area, hint=None) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`clear_block` of at most :data:`CLEAR_CHUNK` tabs at a time (each tab is
+        tested on its own: the same answers, with the pairs of one block in memory)."""
+        n = len(quads)
+        if n <= CLEAR_CHUNK:
+            return self.clear_block(quads, area, hint)
+        blocker = np.full(n, -1, dtype=np.int64)
+        wide = np.zeros(n, dtype=bool)
+        for lo in range(0, n, CLEAR_CHUNK):
+            hi = min(n, lo + CLEAR_CHUNK)
+            part = None if hint is None else hint[lo:hi]
+            blocker[lo:hi], wide[lo:hi] = self.clear_block(quads[lo:hi], area[lo:hi], part)
+        return blocker, wide
+
+    def clear_block(self, quads, area, hint=None) -> tuple[np.ndarray, np.ndarray]:
         """Tabs that overlap no face: shapely's verdict on each, had it been asked.
 
         Parameters
@@ -579,6 +596,12 @@ def conflicts(
     -------
     (n,) bool
     """
+    if len(later) > CLEAR_CHUNK:  # each pair on its own: in blocks, to bound the temporaries
+        out = np.zeros(len(later), dtype=bool)
+        for lo in range(0, len(later), CLEAR_CHUNK):
+            hi = lo + CLEAR_CHUNK
+            out[lo:hi] = conflicts(earlier[lo:hi], later[lo:hi], shrink, exact=exact)
+        return out
     if not len(later):
         return np.zeros(0, dtype=bool)
     origin = later[:, :1]
@@ -790,11 +813,11 @@ def _choose(faces: _Faces, ends, normal, tab_height):
     n = len(ends)
     s = SHRINK * tab_height
     n_cand = 2 * len(LEVELS)  # candidate c of border r: r * n_cand + 2 * level + side
-    quads = np.empty((n * n_cand, 4, 2))  # filled as they are made, at row(c)
-    hinge = np.empty((n * n_cand, 2, 2))
 
-    def row(c):  # a round's candidates together
-        return (c % n_cand) * n + c // n_cand
+    def quads_of(c):
+        """The outlines of candidates ``c``, made again where they are needed (the same
+        numbers each time: a table of all of them would take 1 KB per border)."""
+        return _candidates(ends, normal, tab_height, c)[0]
 
     # where any candidate of a border's side may lie: the rectangle of the full height on
     # the border (per side 2 * border + A or B)
@@ -807,8 +830,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
     undecided = np.arange(n)
     for ks in ROUNDS:
         c = tried = (undecided[:, None] * n_cand + np.asarray(ks)).ravel()
-        q, hinge[row(c)], ok, height = _candidates(ends, normal, tab_height, c)
-        quads[row(c)] = q
+        q, _, ok, height = _candidates(ends, normal, tab_height, c)
         c, q, height = c[ok], np.compress(ok, q, axis=0), height[ok]
         area, least = polygon_area(q), LEAST_TAB * height**2
         valid = surely_valid(q)
@@ -838,7 +860,7 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
         # the sides of other borders near the new candidates
-        i, j = sides.query(*boxes(take_rows(quads, row(c))))
+        i, j = sides.query(*boxes(quads_of(c)))
         pc, ps = c[i], j
         other = ps // 2 != pc // n_cand
         pc, ps = pc[other], ps[other]
@@ -847,15 +869,13 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         # border's tab the quarter-height one)
         lo = np.flatnonzero(ps // 2 < pc // n_cand)
         lo = lo[state.undecided[ps[lo] // 2]]
-        lo = lo[
-            conflicts(take_rows(envelope, ps[lo]), take_rows(quads, row(pc[lo])), s, exact=False)
-        ]
+        lo = lo[conflicts(take_rows(envelope, ps[lo]), quads_of(pc[lo]), s, exact=False)]
         a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
         holder = np.asarray(COVER)[b % n_cand]
         cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
         key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
         held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
-        maybe = conflicts(held, take_rows(quads, row(key // (n * n_cand))), s, exact=False) | ~fits
+        maybe = conflicts(held, quads_of(key // (n * n_cand)), s, exact=False) | ~fits
         state.might_meet(a[maybe[inv]], b[maybe[inv]])
         # the tested candidates of those sides: which tabs intersect which
         rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
@@ -864,17 +884,17 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
         later = np.where(a // n_cand > b // n_cand, a, b)
         earlier = a + b - later
-        hit = conflicts(take_rows(quads, row(earlier)), take_rows(quads, row(later)), s)
+        hit = conflicts(quads_of(earlier), quads_of(later), s)
         state.meets(later[hit], earlier[hit])
         undecided = state.run(undecided, good, tested=ks[-1] + 1)
         if not len(undecided):
             break
     picked = state.picked()
-    out = quads[row(picked)]
+    out, hinges, _, _ = _candidates(ends, normal, tab_height, picked)
     ccw = np.sum(cross(out - out[:, :1], np.roll(out - out[:, :1], -1, axis=1)), axis=1) > 0
     out[~ccw] = out[~ccw, ::-1]  # far above round-off: shapely's orientation, had it been asked
     local = picked % n_cand
-    return picked // n_cand, local // 2, local % 2, out, hinge[row(picked)]
+    return picked // n_cand, local // 2, local % 2, out, hinges
 
 
 class _Greedy:
