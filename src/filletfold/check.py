@@ -61,6 +61,7 @@ from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
 from .export.fold_read import _edge_faces, read_fold_document
+from .layout.convex import BoxGrid
 from .surface.pattern import CreasePattern, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
@@ -129,8 +130,8 @@ FAILING_NAMED = 5
 SAT_CORNERS = 8
 #: Face pairs separated per numpy block.
 PAIR_CHUNK = 1 << 18
-#: Faces whose neighbours are asked of the tree at once (bounds the pairs held).
-QUERY_CHUNK = 1 << 16
+#: Faces whose neighbours are asked of the grid at once (bounds the pairs held).
+QUERY_CHUNK = 1 << 13
 
 _CONE, _CYLINDER, _FACE, _FILLET = 0, 1, 2, 3
 _KINDS = {"cone": _CONE, "cylinder": _CYLINDER, "face": _FACE, "fillet": _FILLET}
@@ -1025,14 +1026,14 @@ def _overlap(g: _Data) -> list[Check]:
     orient = Check(
         "face orientation", n_cw == 0, float(area[k] / scale), 0.0, detail, ">", {"pattern_face": k}
     )
-    # overlap: the pairs of faces whose bounding boxes meet (from the tree, a block of faces at
-    # a time), told apart in numpy when both are convex (:class:`_Separator`), their shared area
-    # measured by shapely otherwise; only the faces measured, and those that are not convex
-    # (checked to be simple polygons), are made shapely polygons
+    # overlap: the pairs of faces whose bounding boxes meet (closed; from a grid of the boxes,
+    # a block of faces at a time, each block's pairs in order), told apart in numpy when both
+    # are convex (:class:`_Separator`), their shared area measured by shapely otherwise; only
+    # the faces measured, and those that are not convex (checked to be simple polygons), are
+    # made shapely polygons (a shapely box per face would take some 400 bytes each)
     p = g.v2[g.flat]
     lo, hi = np.minimum.reduceat(p, g.start[:-1]), np.maximum.reduceat(p, g.start[:-1])
-    boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
-    tree = shapely.STRtree(boxes)
+    grid = BoxGrid(lo, hi)
     convex = _convex_faces(g, area)
     separator = _Separator(g, convex)
     polys = np.full(n_faces, None, dtype=object)
@@ -1043,10 +1044,12 @@ def _overlap(g: _Data) -> list[Check]:
     value, value_limit, worst_pair = 0.0, OVERLAP_TOL, None
     perimeter = np.add.reduceat(np.linalg.norm(g.v2[g.flat[g.nxt]] - p, axis=1), g.start[:-1])
     for first in range(0, n_faces, QUERY_CHUNK):
-        i, j = tree.query(boxes[first : first + QUERY_CHUNK])
+        i, j = grid.query(lo[first : first + QUERY_CHUNK], hi[first : first + QUERY_CHUNK])
         i += first
         keep = i < j
         i, j = i[keep], j[keep]
+        order = np.lexsort((j, i))
+        i, j = i[order], j[order]
         n_pairs += len(i)
         both = convex[i] & convex[j]
         separated = np.zeros(len(i), dtype=bool)
