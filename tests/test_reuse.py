@@ -11,6 +11,37 @@ import filletfold.design as design_module
 from filletfold.mesh import example_mesh
 
 
+def test_without_stages_the_pieces_go_before_the_glue_tabs(monkeypatch):
+    """keep_stages=False: once the pattern is assembled, the modules' pieces go (the pattern
+    holds their points again), before the glue tabs and the certificate; with the stages they
+    stay in ``design.pieces``."""
+    import gc
+    import weakref
+
+    from filletfold.layout import arrange as arrange_module
+
+    refs, alive_at_tabs = [], []
+    assemble, add_tabs = arrange_module.assemble_pattern, arrange_module.add_tabs_and_labels
+
+    def spy_assemble(pieces, offsets):
+        refs.append(weakref.ref(pieces[0]))
+        return assemble(pieces, offsets)
+
+    def spy_tabs(pattern, tab_h, **kwargs):
+        gc.collect()
+        alive_at_tabs.append(refs[-1]() is not None)
+        return add_tabs(pattern, tab_h, **kwargs)
+
+    monkeypatch.setattr(arrange_module, "assemble_pattern", spy_assemble)
+    monkeypatch.setattr(arrange_module, "add_tabs_and_labels", spy_tabs)
+    kept = filletfold.round_mesh("cube")
+    lean = filletfold.round_mesh("cube", keep_stages=False)
+    assert alive_at_tabs == [True, False]
+    assert len(kept.pieces) > 0 and lean.pieces == []
+    np.testing.assert_array_equal(kept.pattern.vertices_2d, lean.pattern.vertices_2d)
+    assert kept.pattern.annotations.labels.text == lean.pattern.annotations.labels.text
+
+
 @pytest.fixture
 def solved_vertices(monkeypatch):
     """Record which vertices every ``solve_apices`` call was asked to solve."""

@@ -44,6 +44,7 @@ def arrange(
     nest: str = "shelf",
     stage=lambda name: None,
     timings: dict | None = None,
+    release_pieces: bool = False,
 ):
     """The crease pattern of the vertex modules' pieces, laid out.
 
@@ -75,6 +76,9 @@ def arrange(
     timings : dict, optional
         Gets ``"tabs"``: the seconds the glue tabs took (when ``tabs``), and ``"nest"``: the
         seconds the placement on sheets took (with a sheet).
+    release_pieces : bool
+        Empty ``pieces`` (the caller's list) once the pattern is assembled, so that the glue
+        tabs run without them in memory (the pattern holds their points again).
 
     Returns
     -------
@@ -84,6 +88,7 @@ def arrange(
     fabrication : dict
         Cut borders, tabs and sheet figures (the report's ``fabrication``).
     """
+    given = pieces  # the caller's list (``pieces`` may be rebound to laid-out copies)
     ref = pm.mean_edge_length
     layout_used, layout_note = "modules", ""
     eps = tol.relative * ref
@@ -152,6 +157,9 @@ def arrange(
         }
     else:
         pattern = assemble_pattern(pieces, shelf_offsets(pieces, gap))
+    if release_pieces:
+        given.clear()
+        pieces = None
     fab = {"cut_borders": 0, "tabs": 0, "tabs_reduced": 0, "untabbed": 0}
     if tabs:
         stage("glue tabs")
