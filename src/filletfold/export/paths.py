@@ -289,9 +289,9 @@ def simplify_polyline(points: np.ndarray, closed: bool = False) -> np.ndarray:
 
 
 def simplify_polylines(paths: list) -> list[np.ndarray]:
-    """:func:`simplify_polyline` of every ``(points, closed)`` of ``paths``, the common case
-    (no repeated point, no straight interior point: nothing to drop) found for all of them at
-    once; the others are simplified one by one. The same arrays as one by one.
+    """:func:`simplify_polyline` of every ``(points, closed)`` of ``paths``, all paths at once:
+    each round drops, on every path that still changes, the points it would drop in that
+    round (the same arrays as one by one).
 
     Parameters
     ----------
@@ -304,31 +304,51 @@ def simplify_polylines(paths: list) -> list[np.ndarray]:
     if not paths:
         return []
     pts = [np.asarray(q, dtype=np.float64).reshape(-1, 2) for q, _ in paths]
-    size = np.fromiter(map(len, pts), dtype=np.int64, count=len(pts))
-    closed = np.fromiter((bool(c) for _, c in paths), dtype=bool, count=len(paths))
+    n = len(pts)
+    size = np.fromiter(map(len, pts), dtype=np.int64, count=n)
+    closed = np.fromiter((bool(c) for _, c in paths), dtype=bool, count=n)
     p = np.concatenate(pts)
-    first = np.concatenate([[0], np.cumsum(size)[:-1]])
-    owner = np.repeat(np.arange(len(pts)), size)
-    at = np.arange(len(p)) - first[owner]
-    # each point's neighbours along its path (cyclic, as simplify_polyline's np.roll)
-    prev = np.where(at == 0, first[owner] + size[owner] - 1, np.arange(len(p)) - 1)
-    nxt = np.where(at == size[owner] - 1, first[owner], np.arange(len(p)) + 1)
-    repeat = np.zeros(len(p), dtype=bool)
-    repeat[1:] = (at[1:] > 0) & np.all(p[1:] == p[:-1], axis=1)
-    a, b = p - p[prev], p[nxt] - p
-    cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    dot = np.einsum("ij,ij->i", a, b)
-    straight = (np.abs(np.arctan2(cross, dot)) < _COLLINEAR_RAD) & (dot > 0)
-    straight &= closed[owner] | ((at > 0) & (at < size[owner] - 1))
-    straight &= size[owner] > np.where(closed[owner], 3, 2)
-    closing = closed & (size > 1)
-    closing[closing] = np.all(p[first[closing]] == p[(first + size - 1)[closing]], axis=1)
-    touched = np.bincount(owner, weights=repeat | straight, minlength=len(pts)) > 0
-    touched |= closing
-    return [
-        simplify_polyline(q, bool(c)) if touched[k] else q
-        for k, (q, c) in enumerate(zip(pts, closed, strict=True))
-    ]
+    owner = np.repeat(np.arange(n), size)
+    # repeated points go, and a closed path's last point where it repeats the first
+    keep = np.ones(len(p), dtype=bool)
+    keep[1:] = (owner[1:] != owner[:-1]) | np.any(p[1:] != p[:-1], axis=1)
+    p, owner = p[keep], owner[keep]
+    size = np.bincount(owner, minlength=n)
+    end = np.cumsum(size) - 1
+    again = closed & (size > 1)
+    again[again] = np.all(p[end[again] - size[again] + 1] == p[end[again]], axis=1)
+    if again.any():
+        keep = np.ones(len(p), dtype=bool)
+        keep[end[again]] = False
+        p, owner = p[keep], owner[keep]
+        size = np.bincount(owner, minlength=n)
+    least = np.where(closed, 3, 2)
+    active = size > least
+    while active.any():
+        first = np.cumsum(size) - size
+        at = np.arange(len(p)) - first[owner]
+        on = active[owner]
+        k = np.flatnonzero(on)
+        o = owner[k]
+        prev = np.where(at[k] == 0, k + size[o] - 1, k - 1)
+        nxt = np.where(at[k] == size[o] - 1, k - size[o] + 1, k + 1)
+        a, b = p[k] - p[prev], p[nxt] - p[k]
+        cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        dot = np.einsum("ij,ij->i", a, b)
+        straight = (np.abs(np.arctan2(cross, dot)) < _COLLINEAR_RAD) & (dot > 0)
+        straight &= closed[o] | ((at[k] > 0) & (at[k] < size[o] - 1))
+        # never two neighbours at once: a point goes only if the one before it (on its path,
+        # in the path's order) does not
+        before = np.zeros(len(k), dtype=bool)
+        before[1:] = straight[:-1] & (o[1:] == o[:-1])
+        straight &= ~before
+        changed = np.bincount(o[straight], minlength=n) > 0
+        drop = np.zeros(len(p), dtype=bool)
+        drop[k[straight]] = True
+        p, owner = p[~drop], owner[~drop]
+        size = np.bincount(owner, minlength=n)
+        active &= changed & (size > least)
+    return np.split(p, np.cumsum(size)[:-1])
 
 
 def chain_runs(points: np.ndarray, closed: bool = False) -> list[tuple[np.ndarray, bool, bool]]:
