@@ -232,7 +232,10 @@ def svg_user_per_mm(points: np.ndarray, mm_per_unit: float, extent: float) -> fl
     """
     from scipy.spatial import cKDTree
 
-    p = np.unique(np.asarray(points, dtype=np.float64).reshape(-1, 2), axis=0)
+    # the distinct points: sorted as complex numbers (x, y), twice as fast as rows
+    xy = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    z = np.unique(xy.view(np.complex128).ravel())
+    p = np.stack([z.real, z.imag], axis=1)
     j = 0
     if len(p) > 1:
         d, _ = cKDTree(p).query(p, k=2)
