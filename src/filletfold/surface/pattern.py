@@ -15,7 +15,7 @@ import numpy as np
 from ..tolerances import tol
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
-NORMAL_CHUNK = 100_000
+NORMAL_CHUNK = 16_384
 
 
 class FlatFaces(Sequence):
