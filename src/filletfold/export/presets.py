@@ -224,28 +224,28 @@ class Preset:
         return {f: getattr(self, f) for f in ("cut", "mountain", "valley", "tab", "label", "flat")}
 
 
+#: The pens of ``print`` and ``origami-simulator``: Origami Simulator's colours (the
+#: conventional crease-pattern colours), DXF layers in ACI colours.
+_SIMULATOR_PENS = {
+    "cut": Pen("#000000", "CUT", 7, 0.3),
+    "mountain": Pen("#ff0000", "MOUNTAIN", 1, 0.3),
+    "valley": Pen("#0000ff", "VALLEY", 5, 0.3),
+    "tab": Pen("#ff00ff", "TAB", 6, 0.3, dash_share=0.005),
+    "label": Pen("#404040", "LABEL", 8, 0.3),
+    "flat": Pen("#ffff00", "FLAT", 2, 0.1),
+}
 _PRINT = Preset(
     name="print",
     description="to print and cut: cut black, mountain red, valley blue, tab hinge magenta "
     "(default)",
-    cut=Pen("#000000", "CUT", 7, 0.3),
-    mountain=Pen("#ff0000", "MOUNTAIN", 1, 0.3),
-    valley=Pen("#0000ff", "VALLEY", 5, 0.3),
-    tab=Pen("#ff00ff", "TAB", 6, 0.3, dash_share=0.005),
-    label=Pen("#404040", "LABEL", 8, 0.3),
-    flat=Pen("#ffff00", "FLAT", 2, 0.1),
+    **_SIMULATOR_PENS,
     annotations=True,
     true_color=False,
 )
 _OS = Preset(
     name="origami-simulator",
     description="Origami Simulator's SVG colours and fold-angle opacities",
-    cut=Pen("#000000", "CUT", 7, 0.3),
-    mountain=Pen("#ff0000", "MOUNTAIN", 1, 0.3),
-    valley=Pen("#0000ff", "VALLEY", 5, 0.3),
-    tab=Pen("#ff00ff", "TAB", 6, 0.3, dash_share=0.005),
-    label=Pen("#404040", "LABEL", 8, 0.3),
-    flat=Pen("#ffff00", "FLAT", 2, 0.1),
+    **_SIMULATOR_PENS,
     flat_edges=True,
     angle_opacity=True,
     join_lines=False,

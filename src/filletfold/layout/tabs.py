@@ -24,7 +24,14 @@ import shapely
 from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
-from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows, face_arrays
+from ..surface.pattern import (
+    Annotations,
+    CreasePattern,
+    LabelRows,
+    PointRows,
+    face_arrays,
+    row_index,
+)
 from .convex import (
     BoxGrid,
     abs_max,
@@ -1012,10 +1019,7 @@ class Seams(Sequence):
     def __getitem__(self, k):
         if isinstance(k, slice):
             return [self[i] for i in range(*k.indices(len(self)))]
-        n = len(self)
-        if not -n <= k < n:
-            raise IndexError(f"seam {k} out of range ({n} seams)")
-        k = int(k) % n
+        k = row_index(k, len(self), "seam")
         pa, pb = (self.names[i] for i in self.pieces[k].tolist())
         on = int(self.tab_on[k])
         return {"label": k + 1, "pieces": [pa, pb], "tab_on": None if on < 0 else (pa, pb)[on]}

@@ -18,6 +18,14 @@ from ..tolerances import tol
 NORMAL_CHUNK = 16_384
 
 
+def row_index(i, n: int, what: str) -> int:
+    """``i`` (an int, negative from the end) as an index into ``n`` rows, or an IndexError
+    naming ``what`` (``"face"``: "face 7 out of range (5 faces)")."""
+    if not -n <= i < n:
+        raise IndexError(f"{what} {i} out of range ({n} {what}s)")
+    return int(i) % n
+
+
 class FlatFaces(Sequence):
     """Polygons held as one flat index array and their offsets: no object per face until one
     is asked for. The base of :class:`FaceRows` (faces read as (k,) int64 arrays) and
@@ -56,10 +64,7 @@ class FaceRows(FlatFaces):
     def __getitem__(self, i):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
-        n = len(self)
-        if not -n <= i < n:
-            raise IndexError(f"face {i} out of range ({n} faces)")
-        i = int(i) % n
+        i = row_index(i, len(self), "face")
         return self.flat[self.start[i] : self.start[i + 1]]
 
     def __iter__(self):
@@ -98,10 +103,7 @@ class PointRows(Sequence):
     def __getitem__(self, i):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
-        n = len(self)
-        if not -n <= i < n:
-            raise IndexError(f"row {i} out of range ({n} rows)")
-        i = int(i) % n
+        i = row_index(i, len(self), "row")
         return self.points[self.start[i] : self.start[i + 1]]
 
     def __iter__(self):
@@ -165,10 +167,7 @@ class LabelRows(Sequence):
     def __getitem__(self, i):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(len(self)))]
-        n = len(self)
-        if not -n <= i < n:
-            raise IndexError(f"label {i} out of range ({n} labels)")
-        i = int(i) % n
+        i = row_index(i, len(self), "label")
         return Label(
             self.position[i].copy(),
             self.text[i],
