@@ -11,6 +11,7 @@ from ..surface.pattern import CreasePattern, FaceRows
 from ..surface.validate import validated_faces
 from ..tolerances import tol
 from .fold import face_arrays, file_creator
+from .svg import _format_all
 
 __all__ = [
     "OBJ_RTOL",
@@ -158,22 +159,11 @@ def obj_decimals(points: np.ndarray) -> int:
 
 def _xyz_lines(tag: str, xyz: np.ndarray, decimals: int) -> str:
     """``"<tag> x y z\\n"`` per row of ``xyz`` (n, 3), numbers with ``decimals`` fixed
-    decimals, trailing zeros stripped (``-0`` written as ``0``)."""
-    if not len(xyz):
-        return ""
-    text = (f"%.{decimals}f %.{decimals}f %.{decimals}f\n" * len(xyz)) % tuple(
-        (np.asarray(xyz, dtype=np.float64) + 0.0).ravel().tolist()
-    )
-    if decimals > 0:
-        text = _TRAILING_ZEROS.sub(r"\1", text)
-    text = _MINUS_ZERO.sub(r"\g<1>0", text)
-    return "".join(f"{tag} {line}\n" for line in text[:-1].split("\n"))
-
-
-#: Trailing zeros of a fixed-decimal number (and its point, when nothing is left after it).
-_TRAILING_ZEROS = re.compile(r"(\d)\.?0+(?=[ \n])")
-#: A negative zero after rounding: ``-0``, preceded by the start or a space.
-_MINUS_ZERO = re.compile(r"(^| )-0(?=[ \n])", re.MULTILINE)
+    decimals, trailing zeros stripped (``-0`` written as ``0``), as the SVG writes its
+    numbers (:func:`~filletfold.export.svg._format_all`)."""
+    xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    cols = [_format_all(xyz[:, k], decimals) for k in range(3)]
+    return "".join(f"{tag} {x} {y} {z}\n" for x, y, z in zip(*cols, strict=True))
 
 
 def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) -> str:
