@@ -132,6 +132,25 @@ def _logical_lines(text: str):
             yield start, tokens
 
 
+def _vertex_xyz(tokens: list[str], name: str, number: int, *, exact: bool) -> tuple:
+    """``(x, y, z)`` of a vertex line split into ``tokens`` (its keyword first: OBJ's ``v``,
+    STL's ``vertex``), or a one-line error naming the file and ``number``, the line.
+
+    ``exact``: exactly three coordinates (STL); else at least three (OBJ: an optional ``w``
+    or colour follows).
+    """
+    if len(tokens) < 4 or (exact and len(tokens) != 4):
+        raise MeshReadError(
+            f"{name}: line {number}: vertex needs 3 coordinates, got {len(tokens) - 1}"
+        )
+    try:
+        return float(tokens[1]), float(tokens[2]), float(tokens[3])
+    except ValueError as exc:
+        raise MeshReadError(
+            f"{name}: line {number}: cannot parse vertex coordinates {' '.join(tokens[1:4])!r}"
+        ) from exc
+
+
 def _parse_obj(text: str, name: str) -> tuple[np.ndarray, list[np.ndarray]]:
     vertices: list[tuple[float, float, float]] = []
     faces: list[np.ndarray] = []
@@ -139,17 +158,7 @@ def _parse_obj(text: str, name: str) -> tuple[np.ndarray, list[np.ndarray]]:
     for number, tokens in _logical_lines(text):
         key = tokens[0]
         if key == "v":
-            if len(tokens) < 4:
-                raise MeshReadError(
-                    f"{name}: line {number}: vertex needs 3 coordinates, got {len(tokens) - 1}"
-                )
-            try:
-                vertices.append((float(tokens[1]), float(tokens[2]), float(tokens[3])))
-            except ValueError as exc:
-                raise MeshReadError(
-                    f"{name}: line {number}: cannot parse vertex coordinates "
-                    f"{' '.join(tokens[1:4])!r}"
-                ) from exc
+            vertices.append(_vertex_xyz(tokens, name, number, exact=False))
         elif key == "f":
             if len(tokens) < 4:
                 raise MeshReadError(
@@ -306,17 +315,7 @@ def _parse_stl_ascii(data: bytes, name: str) -> tuple[np.ndarray, list[np.ndarra
         if key == "vertex":
             if not in_loop:
                 raise MeshReadError(f"{name}: line {number}: vertex outside an 'outer loop'")
-            if len(tokens) != 4:
-                raise MeshReadError(
-                    f"{name}: line {number}: vertex needs 3 coordinates, got {len(tokens) - 1}"
-                )
-            try:
-                coords.append((float(tokens[1]), float(tokens[2]), float(tokens[3])))
-            except ValueError as exc:
-                raise MeshReadError(
-                    f"{name}: line {number}: cannot parse vertex coordinates "
-                    f"{' '.join(tokens[1:])!r}"
-                ) from exc
+            coords.append(_vertex_xyz(tokens, name, number, exact=True))
             sizes[-1] += 1
         elif key == "outer":
             if in_loop:
