@@ -29,8 +29,8 @@ from ..surface.pattern import (
     CreasePattern,
     LabelRows,
     PointRows,
+    Rows,
     face_arrays,
-    row_index,
 )
 from .convex import (
     BoxGrid,
@@ -993,7 +993,7 @@ class _Greedy:
         return self.choice[self.choice >= 0]
 
 
-class Seams(Sequence):
+class Seams(Rows):
     """The numbered cut borders of a design, as arrays: seam ``k`` (label ``k + 1``) joins
     pieces ``pieces[k]`` and carries its tab on side ``tab_on[k]`` (0, 1; -1: no tab). Read
     one by one, each is ``{"label", "pieces": [name, name], "tab_on": name or None}``.
@@ -1007,6 +1007,7 @@ class Seams(Sequence):
     """
 
     __slots__ = ("names", "pieces", "tab_on")
+    _what = "seam"
 
     def __init__(self, names, pieces, tab_on):
         self.names = list(names)
@@ -1016,16 +1017,13 @@ class Seams(Sequence):
     def __len__(self) -> int:
         return len(self.tab_on)
 
-    def __getitem__(self, k):
-        if isinstance(k, slice):
-            return [self[i] for i in range(*k.indices(len(self)))]
-        k = row_index(k, len(self), "seam")
+    def _row(self, k: int):
         pa, pb = (self.names[i] for i in self.pieces[k].tolist())
         on = int(self.tab_on[k])
         return {"label": k + 1, "pieces": [pa, pb], "tab_on": None if on < 0 else (pa, pb)[on]}
 
     def __iter__(self):
-        return map(self.__getitem__, range(len(self)))
+        return map(self._row, range(len(self)))
 
     def __eq__(self, other) -> bool:
         """Equal to a sequence of the same seams (as dicts)."""

@@ -18,12 +18,27 @@ from ..tolerances import tol
 NORMAL_CHUNK = 16_384
 
 
-def row_index(i, n: int, what: str) -> int:
-    """``i`` (an int, negative from the end) as an index into ``n`` rows, or an IndexError
-    naming ``what`` (``"face"``: "face 7 out of range (5 faces)")."""
-    if not -n <= i < n:
-        raise IndexError(f"{what} {i} out of range ({n} {what}s)")
-    return int(i) % n
+class Rows(Sequence):
+    """A sequence whose items are made from arrays when asked for (:class:`FaceRows`,
+    :class:`PointRows`, :class:`LabelRows`, :class:`~filletfold.layout.tabs.Seams`): an int
+    (negative from the end) gives :meth:`_row` of it, a slice a list, an index out of range an
+    IndexError naming :attr:`_what` ("face 7 out of range (5 faces)")."""
+
+    __slots__ = ()
+    #: What a row is called in the IndexError.
+    _what = "row"
+
+    def _row(self, i: int):
+        """Row ``i`` (``0 <= i < len(self)``)."""
+        raise NotImplementedError
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self._row(k) for k in range(*i.indices(len(self)))]
+        n = len(self)
+        if not -n <= i < n:
+            raise IndexError(f"{self._what} {i} out of range ({n} {self._what}s)")
+        return self._row(int(i) % n)
 
 
 class FlatFaces(Sequence):
@@ -55,23 +70,21 @@ class FlatFaces(Sequence):
         return len(self.start) - 1
 
 
-class FaceRows(FlatFaces):
+class FaceRows(Rows, FlatFaces):
     """:class:`FlatFaces` read as (k,) int64 arrays (views of ``flat``): what
     :func:`~filletfold.surface.assemble.assemble_pattern` gives a pattern."""
 
     __slots__ = ()
+    _what = "face"
 
-    def __getitem__(self, i):
-        if isinstance(i, slice):
-            return [self[k] for k in range(*i.indices(len(self)))]
-        i = row_index(i, len(self), "face")
+    def _row(self, i: int):
         return self.flat[self.start[i] : self.start[i + 1]]
 
     def __iter__(self):
         return iter(np.split(self.flat, self.start[1:-1]) if len(self) else [])
 
 
-class PointRows(Sequence):
+class PointRows(Rows):
     """Point lists (glue-tab outlines, tab hinges) held as one (k, 2) array and offsets: no
     object per row until one is asked for (a design of modules has one tab per cut border,
     tens of thousands: as a list of arrays they cost ten times their numbers).
@@ -100,17 +113,14 @@ class PointRows(Sequence):
     def __len__(self) -> int:
         return len(self.start) - 1
 
-    def __getitem__(self, i):
-        if isinstance(i, slice):
-            return [self[k] for k in range(*i.indices(len(self)))]
-        i = row_index(i, len(self), "row")
+    def _row(self, i: int):
         return self.points[self.start[i] : self.start[i + 1]]
 
     def __iter__(self):
         return iter(np.split(self.points, self.start[1:-1]) if len(self) else [])
 
 
-class LabelRows(Sequence):
+class LabelRows(Rows):
     """Labels held as parallel arrays (positions, angles, heights) and lists (texts, kinds):
     a :class:`Label` is made when one is asked for.
 
@@ -122,6 +132,7 @@ class LabelRows(Sequence):
     """
 
     __slots__ = ("angle", "height", "kind", "position", "text")
+    _what = "label"
 
     def __init__(self, position, text, angle, height, kind):
         self.position = np.asarray(position, dtype=np.float64).reshape(-1, 2)
@@ -164,10 +175,7 @@ class LabelRows(Sequence):
     def __len__(self) -> int:
         return len(self.position)
 
-    def __getitem__(self, i):
-        if isinstance(i, slice):
-            return [self[k] for k in range(*i.indices(len(self)))]
-        i = row_index(i, len(self), "label")
+    def _row(self, i: int):
         return Label(
             self.position[i].copy(),
             self.text[i],
@@ -177,7 +185,7 @@ class LabelRows(Sequence):
         )
 
     def __iter__(self):
-        return map(self.__getitem__, range(len(self)))
+        return map(self._row, range(len(self)))
 
 
 def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
