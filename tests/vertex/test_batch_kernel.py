@@ -283,22 +283,48 @@ def test_a_warm_kernel_leaves_small_batches_to_numpy(monkeypatch):
 
 
 def test_a_large_design_reports_the_kernel_loading(monkeypatch):
-    """The first large design with the kernel wanted but not loaded says so in its progress
-    (its first load compiles it, about 15 s); a small one does not load it."""
-    from filletfold.vertex.solve import KERNEL_STAGE
+    """The first large design with the kernel wanted but not loaded says so in its progress:
+    "compiling" only when numba's cache has no kernel (that first load takes about 15 s),
+    "loading" when it has one; a small one does not load it."""
+    from filletfold.vertex.solve import KERNEL_COMPILE_STAGE, KERNEL_STAGE
 
     monkeypatch.setattr(batch, "USE_KERNEL", True)
-    for name, n_min, expected in (("icosahedron", 256, False), ("icosahedron", 5, True)):
+    cases = ((256, True, None), (5, True, KERNEL_STAGE), (5, False, KERNEL_COMPILE_STAGE))
+    for n_min, cached, expected in cases:
         monkeypatch.setattr(batch, "_kernel_loaded", False)
         monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", n_min)
+        monkeypatch.setattr(batch, "kernel_cached", lambda cached=cached: cached)
         stages = []
 
         def progress(stage, done, total, stages=stages):
             stages.append(stage)
 
-        filletfold.round_mesh(name, tabs=False, progress=progress)
-        assert (KERNEL_STAGE in stages) == expected
-        assert batch._kernel_loaded == expected
+        filletfold.round_mesh("icosahedron", tabs=False, progress=progress)
+        shown = {KERNEL_STAGE, KERNEL_COMPILE_STAGE} & set(stages)
+        assert shown == ({expected} if expected else set())
+        assert batch._kernel_loaded == (expected is not None)
+
+
+def test_the_kernel_cache_is_found_where_numba_writes_it(tmp_path, monkeypatch):
+    """``kernel_cached`` sees an index file of the kernel's entry point under
+    ``NUMBA_CACHE_DIR`` and nothing in an empty one (the source's own ``__pycache__`` moved
+    aside by pointing the package lookup at a copy without one)."""
+    import importlib.util
+    import shutil
+
+    source = importlib.util.find_spec("filletfold.vertex.batch_kernel").origin
+    copy = tmp_path / "pkg" / "batch_kernel.py"
+    copy.parent.mkdir()
+    shutil.copy(source, copy)
+    spec = importlib.util.spec_from_file_location("filletfold.vertex.batch_kernel", copy)
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: spec)
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(cache))
+    assert not batch.kernel_cached()
+    (cache / "x").mkdir()
+    (cache / "x" / "batch_kernel._kernel-204.py311.nbi").write_bytes(b"")
+    assert batch.kernel_cached()
 
 
 def test_a_kernel_that_cannot_load_falls_back_to_numpy(monkeypatch):

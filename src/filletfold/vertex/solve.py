@@ -345,8 +345,10 @@ THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
 #: samples (a cutting plane), this many times per attempt, before the next attempt.
 CUT_ROUNDS = 2
 
-#: The progress stage shown while the numba kernel loads (compiles on its first use, ~15 s).
-KERNEL_STAGE = "loading the compiled solver (first use compiles it, about 15 s)"
+#: The progress stage shown while the numba kernel loads from numba's cache (about 0.3-1 s).
+KERNEL_STAGE = "loading the compiled solver"
+#: The progress stage shown instead when numba's cache has no kernel: its first use compiles it.
+KERNEL_COMPILE_STAGE = "compiling the solver (first use only, about 15 s)"
 
 #: Starts of the feasibility phase: ``U + t L D`` for these ``t`` (``L`` the mean incident
 #: edge length).
@@ -541,10 +543,11 @@ def solve_apices(
     out = dict.fromkeys(vertices, (None, None))
     pending = _set_up(frames, depths, res, vertices, size)
     if progress is not None and batch.kernel_pending(len(pending)):
-        # the first large design after installing numba compiles the kernel: say so
-        progress(KERNEL_STAGE, 0, 1)
+        # the first design after installing numba compiles the kernel: say so, and only then
+        stage = KERNEL_STAGE if batch.kernel_cached() else KERNEL_COMPILE_STAGE
+        progress(stage, 0, 1)
         batch.warm_kernel()
-        progress(KERNEL_STAGE, 1, 1)
+        progress(stage, 1, 1)
     total = len(pending)
     while pending:  # one attempt per vertex and round, ROUND_SLICE vertices at a time
         order = list(pending)
