@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 import filletfold
 from filletfold.layout import arrange, tabs
 from filletfold.layout.tabs import add_tabs_and_labels, assembly_text
+from filletfold.surface.pattern import LabelRows
 
 from ..reference import tabs as tabs_reference
 
@@ -103,12 +104,14 @@ def untabbed(request):
 
 def test_the_tabs_are_those_of_the_reference_to_the_bit(untabbed):
     """The array version places the tabs of the one-geometry-at-a-time version: the same
-    tabs, hinges, labels and seams, bit for bit (so the same files)."""
+    tabs, hinges, labels (with the digits of :func:`~filletfold.layout.tabs.label_digits`)
+    and seams, bit for bit (so the same files)."""
     p, h = untabbed
     old, new = copy.deepcopy(p), copy.deepcopy(p)
     want, got = tabs_reference.add_tabs_and_labels(old, h), add_tabs_and_labels(new, h)
     assert got == want
     a, b = old.annotations, new.annotations
+    a.labels = tabs.label_digits(LabelRows.of(a.labels), old.vertices_2d)
     for name in ("tabs", "tab_hinges"):
         x, y = getattr(a, name), getattr(b, name)
         assert len(x) == len(y) and all(np.array_equal(u, v) for u, v in zip(x, y, strict=True))
@@ -116,6 +119,43 @@ def test_the_tabs_are_those_of_the_reference_to_the_bit(untabbed):
     for u, v in zip(a.labels, b.labels, strict=True):
         assert np.array_equal(u.position, v.position)
         assert (u.text, u.angle, u.height, u.kind) == (v.text, v.angle, v.height, v.kind)
+
+
+def test_labels_carry_the_digits_of_their_placement_and_no_more():
+    """Label positions land on a power-of-ten grid of at most 1e-6 of the pattern's extent,
+    angles on 0.01 degree, heights on 3 significant digits: each moves by at most half its
+    step, and the JSON of the design's labels has no number longer than its grid needs."""
+    rng = np.random.default_rng(5)
+    points = rng.uniform(-3.0, 4.0, (50, 2))  # extent 7: a grid of 1e-6
+    pos = rng.uniform(-3.0, 4.0, (40, 2))
+    angle = rng.uniform(-90.0, 90.0, 40)
+    rows = LabelRows(pos, [str(k) for k in range(40)], angle, 0.000661234, "tab")
+    got = tabs.label_digits(rows, points)
+    step = 10.0 ** np.floor(np.log10(1e-6 * np.ptp(points, axis=0).max()))
+    assert step == 1e-6
+    assert np.abs(got.position - pos).max() <= step / 2 + 1e-15
+    assert np.allclose(got.position / step, np.round(got.position / step), atol=1e-6)
+    assert np.abs(got.angle - angle).max() <= 0.005 + 1e-12
+    assert np.all(got.height == 0.000661)
+    assert got.text == rows.text and got.kind == rows.kind
+    assert all(len(repr(x)) <= 10 for x in got.position.ravel().tolist())
+    # a pattern without extent keeps its positions
+    same = tabs.label_digits(rows, np.zeros((3, 2)))
+    assert np.array_equal(same.position, pos)
+
+
+def test_a_designs_labels_are_written_short(tmp_path):
+    """``annotations.json`` of a design with tabs writes each label number with the digits
+    of its grid (the 12 significant digits of before made them 2-3x longer)."""
+    import json
+
+    design = filletfold.round_mesh("blob")
+    design.export(tmp_path)
+    labels = json.loads((tmp_path / "annotations.json").read_text())["labels"]
+    assert len(labels["angle"]) > 100
+    assert max(len(str(a)) for a in labels["angle"]) <= 6
+    assert max(len(repr(h)) for h in labels["height"]) <= 8
+    assert max(len(repr(x)) for xy in labels["position"] for x in xy) <= 12
 
 
 def test_the_segments_are_those_of_the_reference(untabbed):
