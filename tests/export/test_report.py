@@ -386,8 +386,10 @@ def test_svg_annotations_are_the_patterns(name):
     assert len(cuts) == sum(len(q) > 1 for q, _ in tab_cut_paths(ann))  # empty ones: none
     hinges = groups.get("tab-hinge", [])
     assert len(hinges) == len(ann.tab_hinges)
-    texts = groups.get("labels", [])
-    assert [t.text or "" for t in texts] == [str(lb.text) for lb in ann.labels]
+    # the labels sit in one group per run of one kind and size, which carries both
+    texts = [(t, run.get("class")) for run in groups.get("labels", []) for t in run]
+    assert [(t.text or "", c) for t, c in texts] == [(str(lb.text), lb.kind) for lb in ann.labels]
+    assert all(t.get("font-size") is None and t.get("class") is None for t, _ in texts)
     if len(hinges):
         want = np.array(
             [np.linalg.norm(np.subtract(*np.reshape(h, (2, 2)))) for h in ann.tab_hinges]

@@ -299,8 +299,11 @@ def test_svg_draws_annotations():
     assert len(list(groups["sheets"])) == 1
     (defs,) = root.findall(SVG_NS + "defs")
     assert groups["sheets"] in list(defs.iter())
-    texts = {t.text: t for t in groups["labels"]}
+    texts = {t.text: t for t in groups["labels"].iter(f"{SVG_NS}text")}
     assert set(texts) == {"P1", "7"}
+    runs = list(groups["labels"])  # one group per run of labels of one kind and size
+    assert all(r.tag == f"{SVG_NS}g" and r.get("class") and r.get("font-size") for r in runs)
+    assert sum(len(r) for r in runs) == 2
     assert texts["7"].get("transform").startswith("rotate(-30 ")
     assert texts["P1"].get("transform") is None
 

@@ -494,7 +494,8 @@ def _rows(template: str, columns) -> str:
 
 
 def _label_group(pattern, draw: _Drawing, color: str) -> list[str]:
-    """The ``labels`` group: filled text, centred on each anchor, rotated (empty when none)."""
+    """The ``labels`` group: filled text, centred on each anchor, rotated (empty when none),
+    in one ``<g class="KIND" font-size="SIZE">`` per run of labels of one kind and size."""
     labels = pattern.annotations.labels
     if not labels:
         return []
@@ -514,9 +515,17 @@ def _label_group(pattern, draw: _Drawing, color: str) -> list[str]:
     kinds = list(map(str, rows.kind))
     texts = list(map(str, rows.text))
     escaped = {t: escape(t) for t in {*kinds, *texts}}
-    out.extend(
-        f'<text x="{x}" y="{y}" font-size="{h}" class="{escaped[k]}"{r}>{escaped[t]}</text>'
-        for x, y, h, k, r, t in zip(tx, ty, size, kinds, rot, texts, strict=True)
-    )
+    # a run of labels of one kind and size shares one group: its class and font size are
+    # written once, not on each of the tens of thousands of labels of a large design
+    style = list(zip(kinds, size, strict=True))
+    starts = [i for i in range(len(style)) if i == 0 or style[i] != style[i - 1]]
+    for lo, hi in zip(starts, [*starts[1:], len(style)], strict=True):
+        k, h = style[lo]
+        out.append(f'<g class="{escaped[k]}" font-size="{h}">')
+        out.extend(
+            f'<text x="{tx[i]}" y="{ty[i]}"{rot[i]}>{escaped[texts[i]]}</text>'
+            for i in range(lo, hi)
+        )
+        out.append("</g>")
     out.append("</g>")
     return out
