@@ -318,3 +318,26 @@ def test_cone_rulings_are_unit():
     R, rho = cone_rulings(C, S)
     assert_allclose(rho, [3.0, 1.0])
     assert_allclose(R, [[0, 0, 1], [0, 0, 1]])
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), m=st.integers(1, 40))
+def test_the_sector_apex_is_the_image_of_s_at_the_start_of_the_arc(seed, m):
+    """``q = (0, -|C(0) - S|)`` of :func:`fillet_chart` is the distance from ``S`` to the base
+    curve's point at ``s = 0`` as :func:`arc_points` gives it, to the bit (it is taken from
+    ``O + kappa r N0`` without the sines and cosines of ``s = 0``)."""
+    rng = np.random.default_rng(seed)
+    N0 = rng.normal(size=(m, 3))
+    N0 /= np.linalg.norm(N0, axis=1)[:, None]
+    B = np.cross(N0, rng.normal(size=(m, 3)))
+    B /= np.linalg.norm(B, axis=1)[:, None]
+    B[rng.random(m) < 0.3, 0] = 0.0  # exact zeros and
+    N0[rng.random(m) < 0.3, 1] = -0.0  # negative zeros in the frames
+    O = rng.normal(size=(m, 3))
+    kappa = rng.choice([-1.0, 1.0], m)
+    radius = rng.uniform(0.01, 2.0, m)
+    S = O + rng.normal(size=(m, 3)) * 3.0
+    s = rng.uniform(-1.0, 1.0, m) * radius
+    q = fillet_chart(O, N0, B, kappa, radius, S, s, theta=np.zeros(m))[4]
+    C0 = arc_points(O, N0, B, kappa, radius, np.zeros(m))[0]
+    assert np.array_equal(q[:, 1], -cone_rulings(C0, S)[1]) and not q[:, 0].any()

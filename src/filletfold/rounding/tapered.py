@@ -247,8 +247,9 @@ def fillet_chart(
     """
     C, _ = arc_points(O, N0, B, kappa, radius, s)
     R, rho = cone_rulings(C, S)
-    C0, _ = arc_points(O, N0, B, kappa, radius, np.zeros_like(np.asarray(s, dtype=float)))
-    rho0 = cone_rulings(C0, S)[1]
+    # C(0) = O + kappa r N0 (arc_points at s = 0 to the bit, but for the signs of zeros)
+    k_r = np.asarray(kappa, dtype=float) * np.asarray(radius, dtype=float)
+    rho0 = cone_rulings(O + k_r[..., None] * N0, S)[1]
     if theta is None:
         theta = developed_angles(O, N0, B, kappa, radius, S, s, nodes, fillet)
     r = np.stack([np.sin(theta), np.cos(theta)], axis=-1)
