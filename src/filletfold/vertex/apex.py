@@ -240,7 +240,7 @@ def build_constraints_many(
         shift = (np.cumsum(n_x) - n_x)[sv]  # extra samples of the vertices before
         first, last = first + shift, last + shift
     if cone.any():  # a fillet's surface normal is the cone's, not the cylinder's
-        N = sa.surface_normal(side, s)
+        N = sa.surface_normal(side, s, N=N)
     m = np.bincount(sv[side], minlength=n)  # samples per vertex
     mo, mv = np.cumsum(m) - m, np.repeat(np.arange(n), m)  # first sample, vertex of each
     margin = np.asarray(margins, dtype=float).reshape(n)
@@ -617,12 +617,13 @@ def validate_apices(
     vi = chart_apex(sa.Q, sa.t, v)  # developed apex in each cylinder's chart
     d = V[side] - C
     if sa.conical.any():  # a fillet's chart turns with s: eq. (1) row by row, dn varies
-        Q_s, t_s, R_s, M_s = sa.row_maps(side, s)
+        chart = sa.cone_chart(side, s)  # the fillets' charts, once for both below
+        Q_s, t_s, R_s, M_s = sa.row_maps(side, s, cone_chart=chart)
         vi_s = chart_apex(Q_s, t_s, v[side])
         num = crease_numerator(V[side], vi_s, s, C)
         dn_s = crease_denominator(V[side], vi_s, M_s, R_s)
         dn = np.minimum.reduceat(dn_s, first)
-        N = sa.surface_normal(side, s)
+        N = sa.surface_normal(side, s, cone_chart=chart, N=N)
     else:
         num = crease_numerator(V[side], vi[side], s, C)
         dn = crease_denominator(V, vi, sa.M, sa.R)

@@ -254,7 +254,16 @@ class SideArrays:
             self.__dict__["_angle_series"] = series
         return series
 
-    def row_maps(self, i: np.ndarray, s: np.ndarray):
+    def cone_chart(self, i: np.ndarray, s: np.ndarray):
+        """:meth:`chart` of the rows on conical sides only (``None`` when there are none):
+        what :meth:`row_maps` and :meth:`surface_normal` share when given the same rows."""
+        i = np.asarray(i, dtype=np.int64)
+        cone = self.conical[i]
+        if not cone.any():
+            return None
+        return self.chart(i[cone], np.asarray(s, dtype=float)[cone])
+
+    def row_maps(self, i: np.ndarray, s: np.ndarray, cone_chart=None):
         """Per-row charts in which every side reads as a cylinder, for eq. (1) as written.
 
         On a conical side the chart at ``s`` is turned and moved so that ``c(s)`` lands on
@@ -270,12 +279,14 @@ class SideArrays:
         t : (m, 2) float
             The map from the common frame into each row's chart.
         R, M : (m, 3) float
+
+        ``cone_chart`` is :meth:`cone_chart` of the same rows, when the caller has it.
         """
         i, s = np.asarray(i, dtype=np.int64), np.asarray(s, dtype=float)
         Q, t, R, M = self.Q[i], self.t[i], self.R[i], self.M[i]  # copies (fancy indexing)
         cone = self.conical[i]
         if cone.any():
-            C, Rc, c, r = self.chart(i[cone], s[cone])
+            C, Rc, c, r = self.chart(i[cone], s[cone]) if cone_chart is None else cone_chart
             # the turn taking r = (sin th, cos th) to (0, 1)
             rot = np.stack([np.stack([r[:, 1], -r[:, 0]], -1), np.stack([r[:, 0], r[:, 1]], -1)], 1)
             Q[cone] = rot @ Q[cone]
@@ -284,15 +295,18 @@ class SideArrays:
             R[cone], M[cone] = Rc, C
         return Q, t, R, M
 
-    def surface_normal(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+    def surface_normal(self, i: np.ndarray, s: np.ndarray, cone_chart=None, N=None) -> np.ndarray:
         """(m, 3) front normals of the sides' surfaces along their base curves: ``N(s)`` on a
         cylinder, ``unit(C'(s) x R(s))`` on a conical fillet (the faces' normals at the
-        ends)."""
-        N = self.normal(i, s)
+        ends). ``cone_chart`` (:meth:`cone_chart` of the same rows) and ``N``
+        (:meth:`normal` of them), when the caller has them, are not computed again."""
+        N = self.normal(i, s) if N is None else N.copy()
         cone = self.conical[np.asarray(i, dtype=np.int64)]
         if cone.any():
             k = np.asarray(i, dtype=np.int64)[cone]
-            _, Rc, _, _ = self.chart(k, np.asarray(s, dtype=float)[cone])
+            if cone_chart is None:
+                cone_chart = self.chart(k, np.asarray(s, dtype=float)[cone])
+            Rc = cone_chart[1]
             n = np.cross(self.tangent(k, np.asarray(s, dtype=float)[cone]), Rc)
             N[cone] = n / np.linalg.norm(n, axis=1)[:, None]
         return N
