@@ -364,3 +364,22 @@ def test_conical_fillets_are_sampled_by_their_normal_too():
     assert any(p.startswith("fillet ") for p in d.pattern.face_patch)
     assert d.certificate["facet folds"].ok, d.certificate["facet folds"].line()
     assert d.certificate["facet folds"].value <= 10.0
+
+
+def test_the_reports_fitting_counts_its_lists_and_lists_them_with_the_tables(tmp_path):
+    """``report.json`` is a summary: ``fitting`` has the counts of the rescued and sharp
+    elements, and their lists only with the per-element tables (``tables=True``)."""
+    import json
+
+    d = filletfold.round_mesh("cube", radius=0.45)
+    d.export(tmp_path / "summary")
+    d.export(tmp_path / "tables", tables=True)
+    short = json.loads((tmp_path / "summary" / "report.json").read_text())["fitting"]
+    full = json.loads((tmp_path / "tables" / "report.json").read_text())["fitting"]
+    lists = ("reduced", "sharp", "rescued", "sharpened")
+    assert not set(lists) & set(short)
+    assert {k: v for k, v in full.items() if k not in lists} == short
+    assert short["vertices_rescued"] == len(full["rescued"]) == 8
+    assert short["edges_sharp"] == len(full["sharp"])
+    assert short["vertices_sharpened"] == len(full["sharpened"])
+    assert short["radii_reduced"] == len(full["reduced"])
