@@ -215,6 +215,10 @@ class Stages:
         ``(input key, cleaned mesh, clean log, shift)`` of a :class:`PolyMesh` input (see
         :func:`_input_key`): a later call on the same input takes the cleaned mesh over instead
         of cleaning it again (None for other inputs: a file may change between calls).
+    cuts : dict or None
+        The samples each vertex's solves added where its solution dipped between the samples
+        (:func:`~filletfold.vertex.solve.solve_apices`): a kept vertex solved again later
+        starts with them, as it would in a fresh design.
     """
 
     key: tuple
@@ -231,6 +235,7 @@ class Stages:
     samples: np.ndarray
     modules: list
     cleaned: tuple | None = None
+    cuts: dict | None = None
 
 
 def _input_key(mesh, coplanar_deg, strict) -> tuple | None:
@@ -652,6 +657,7 @@ def round_mesh(
     # the shortest chord an arc is sampled at: no pattern edge under the certificate's limit
     min_chord = 0.0 if strict else 2 * tol.ruling * size
     needs: dict = {}  # each cone's sampling needs, measured once (apex stage, then surface)
+    cuts: dict = {}  # the samples each vertex's solves added (solve_apices), solve to solve
     frames, classified, rounding, centres, solved, kept, rescue = _apices(
         pm,
         rounding,
@@ -672,6 +678,7 @@ def round_mesh(
         arc_step=float(arc_step),
         min_chord=min_chord,
         needs=needs,
+        cuts=cuts,
     )
     timings["apices"] = time.perf_counter() - t
 
@@ -712,6 +719,7 @@ def round_mesh(
             samples=points,
             modules=modules,
             cleaned=None if input_key is None else (input_key, pm, clean_log, shift),
+            cuts=cuts,
         )
     )
     pieces = [piece for module in modules for piece in module]
@@ -803,6 +811,7 @@ def _apices(
     arc_step=0.0,
     min_chord=0.0,
     needs=None,
+    cuts=None,
 ):
     """The apex stage of :func:`round_mesh`: every pending vertex's apex (those of a reused
     design's vertices whose depth did not change are kept), then the rescue of the infeasible
@@ -838,6 +847,7 @@ def _apices(
             min_width=min_width,
             classified=classified,
             sharp=_sharp_frames(frames),
+            cuts=cuts,
             **options,
         )
 
@@ -851,13 +861,15 @@ def _apices(
         kept = {u for u in range(pm.n_vertices) if st.depths[u] == depths[u]}
         res.take(st.vertices, sorted(kept))
         pending = [u for u in pending if u not in kept]
+        if cuts is not None and st.cuts:  # a kept vertex solved again starts as in a fresh one
+            cuts.update({u: st.cuts[u] for u in sorted(kept) if u in st.cuts})
     _stage("apices")
     # thorough even with the rescue to come: a quick solve calls vertices infeasible that are
     # not, and the rescue would shrink their radii for nothing; but without the linear
     # programmes when the rescue follows (they pay for themselves only there)
     rescue_follows = fit_vertices and not material_loss
     apices = _solve_apices(
-        frames, depths, res, centres, progress, pending, size, lp=not rescue_follows
+        frames, depths, res, centres, progress, pending, size, lp=not rescue_follows, cuts=cuts
     )
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
@@ -879,6 +891,7 @@ def _apices(
             classified=classified,
             vertices=pending,
             sharp=_sharp_frames(frames),
+            cuts=cuts,
         )
         kept -= rescue.resolved
     check = set(apices)  # the cones solved here (those kept from ``st`` were checked then)
@@ -1016,7 +1029,16 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
 
 
 def _solve_apices(
-    frames, depths, res: VertexResult, centres, progress, pending, size, thorough=True, lp=True
+    frames,
+    depths,
+    res: VertexResult,
+    centres,
+    progress,
+    pending,
+    size,
+    thorough=True,
+    lp=True,
+    cuts=None,
 ) -> dict:
     """:func:`solve_apices` of the vertices ``pending``; when it fails unforeseen, the
     vertices are solved one by one and a vertex whose solve fails is infeasible, with the
@@ -1024,7 +1046,7 @@ def _solve_apices(
     try:
         return solve_apices(
             frames, depths, res, centres, progress, vertices=pending, size=size,
-            thorough=thorough, lp=lp,
+            thorough=thorough, lp=lp, cuts=cuts,
         )  # fmt: skip
     except FilletfoldError:
         raise
@@ -1045,6 +1067,7 @@ def _solve_apices(
                         size=size,
                         thorough=thorough,
                         lp=lp,
+                        cuts=cuts,
                     )
                 )
             except FilletfoldError:

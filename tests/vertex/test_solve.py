@@ -233,3 +233,62 @@ def test_crease_through_T_gives_a_clean_module():
     assert np.all([q.is_valid for q in polys]) and min(q.area for q in polys) > 1e-6
     used = {i for f in pieces[0].faces for i in f}
     assert used == set(range(len(p2)))
+
+
+def test_cut_samples_come_back_on_the_same_sides_when_the_radii_change():
+    """The samples a vertex's solves added, kept per mesh edge as fractions of the arc, land
+    on the same sides of a frame with other radii, at the same fraction of each arc; a
+    side that is flat there (radius 0) or missing gets none."""
+    from filletfold.vertex.solve import cut_fractions, cut_samples
+
+    m = load_mesh("icosahedron")[0]
+    u = 0
+    big = vertex_frame(m, round_edges(m, 0.2), u)
+    small_r = np.full(m.n_edges, 0.2)
+    ring = big.ring.edges
+    small_r[ring[1]] *= 0.5
+    small_r[ring[2]] = 0.0
+    small = vertex_frame(m, round_edges(m, small_r), u)
+    arc = big.arrays.arc
+    extra = np.array([[0, 0.25 * arc[0]], [1, 0.5 * arc[1]], [2, 0.75 * arc[2]]])
+    frac = cut_fractions(big, extra)
+    assert_allclose(frac, [[ring[0], 0.25], [ring[1], 0.5], [ring[2], 0.75]])
+    assert_allclose(cut_samples(big, frac), extra)
+    again = cut_samples(small, frac)  # side 2 is flat now: its sample is left out
+    assert_allclose(again, [[0, 0.25 * small.arrays.arc[0]], [1, 0.5 * small.arrays.arc[1]]])
+    assert_allclose(small.arrays.arc[1], 0.5 * arc[1])
+    assert cut_samples(small, np.array([[10**6, 0.5]])).shape == (0, 2)  # not its edge
+
+
+def test_a_vertex_solved_again_starts_with_the_samples_its_solve_added(monkeypatch):
+    """``solve_apices(cuts=)`` notes the samples each vertex ended with; solving the same
+    vertices again from the dict needs no cut round (fewer problems) and gives apices that
+    pass the same validation."""
+    import filletfold.vertex.solve as solve
+
+    d = filletfold.round_mesh("blob", tabs=False, certify=False)
+    frames, res0 = d.stages.frames, d.stages.classified
+    todo = [u for u in range(len(frames)) if res0.status[u] == "" and not frames[u].sharp]
+    counted = []
+    real = solve.solve_apex_batch
+
+    def counting(problems, *a, **k):
+        counted[-1] += len(problems)
+        return real(problems, *a, **k)
+
+    monkeypatch.setattr(solve, "solve_apex_batch", counting)
+    runs = []
+    cuts: dict = {}  # filled by the first solve, read (and filled again) by the second
+    for _ in range(2):
+        res = solve.VertexResult.empty(len(frames))
+        res.take(res0, range(len(frames)))
+        counted.append(0)
+        solve.solve_apices(frames, d.stages.depths, res, d.stages.centres, vertices=todo, cuts=cuts)
+        runs.append(res)
+    res1, res2 = runs
+    assert set(cuts) == set(todo)
+    added = sum(len(c) for c in cuts.values())
+    assert added > 0  # blob's solves add samples: the test sees the hints at work
+    assert counted[1] < counted[0]
+    assert [res1.status[u] for u in todo] == [res2.status[u] for u in todo]
+    assert all(res2.status[u] != "ok" or res2.margin[u] > -1e-9 for u in todo)

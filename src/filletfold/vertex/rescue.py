@@ -73,6 +73,7 @@ def rescue_vertices(
     classified: VertexResult | None = None,
     vertices=None,
     sharp: np.ndarray | None = None,
+    cuts: dict | None = None,
 ) -> tuple[EdgeRounding, np.ndarray, Rescue]:
     """Try smaller radii on the edges of every infeasible cone vertex.
 
@@ -105,6 +106,9 @@ def rescue_vertices(
     sharp : (n_vertices,) bool, optional
         Sharp vertices (:mod:`~filletfold.vertex.sharpen`): the frames built again keep their
         neighbours' sides conical, and they keep their status and reason.
+    cuts : dict, optional
+        The samples earlier solves added (:func:`~filletfold.vertex.solve.solve_apices`):
+        each vertex solved again starts with its own, and the dict is updated.
 
     Returns
     -------
@@ -136,7 +140,7 @@ def rescue_vertices(
             probed.update(new)
             jump = _probe(
                 mesh, radius, rounding.half_angle, frames, depths, face_centres, new,
-                flat_deg, floor, min_width, sharp,
+                flat_deg, floor, min_width, sharp, cuts,
             )  # fmt: skip
         scale = np.ones(len(radius))
         for u in bad:
@@ -177,6 +181,7 @@ def rescue_vertices(
             vertices=todo,
             thorough=max(tries[u] for u in bad) >= ROUNDS,  # the fallbacks at the last factor
             size=mesh_size(mesh),
+            cuts=cuts,
         )
         if apply:
             out.resolved.update(affected.tolist())
@@ -236,6 +241,7 @@ def _probe(
     floor,
     min_width,
     sharp,
+    cuts=None,
 ) -> dict:
     """How many halvings of its edges' radii (1 to :data:`ROUNDS`) each of ``vertices`` needs
     for a feasible cone, found on a copy: ``vertices`` alone are classified and solved again
@@ -264,6 +270,7 @@ def _probe(
             vertices=[u for u in todo if trial.status[u] == ""],
             thorough=False,
             size=mesh_size(mesh),
+            cuts=cuts,
         )
         for u in todo:
             if trial.status[u] == "ok":

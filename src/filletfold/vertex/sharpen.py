@@ -136,6 +136,7 @@ def sharpen_vertices(
     classified: VertexResult | None = None,
     sharp: np.ndarray | None = None,
     solve: bool = True,
+    cuts: dict | None = None,
 ) -> tuple[EdgeRounding, np.ndarray, Sharpening]:
     """Make the cone-less vertices of ``kinds`` sharp and solve their neighbours again.
 
@@ -171,6 +172,8 @@ def sharpen_vertices(
         False: only classify the neighbours again, with their sides toward the sharp vertices
         conical, and leave their apices to the caller (status ``""``): the saddles, known
         before any apex, are made sharp so, and their neighbours are solved once.
+    cuts : dict, optional
+        The samples earlier solves added (:func:`~filletfold.vertex.solve.solve_apices`).
 
     Returns
     -------
@@ -232,8 +235,9 @@ def sharpen_vertices(
             apices.pop(u, None)
         if todo and solve:
             solved = solve_apices(
-                {u: frames[u] for u in todo}, depths, res, centres, progress, todo, size=size
-            )
+                {u: frames[u] for u in todo}, depths, res, centres, progress, todo, size=size,
+                cuts=cuts,
+            )  # fmt: skip
             apices.update(solved)
         out.resolved.update(int(u) for u in again)
     for u in np.flatnonzero(sharp & ~initial).tolist():

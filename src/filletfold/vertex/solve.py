@@ -392,10 +392,13 @@ def apex_problems(mesh: PolyMesh, rounding: EdgeRounding, depths: np.ndarray) ->
     return list(_set_up(frames, depths, res, vertices, mesh_size(mesh)).values())
 
 
-def _set_up(frames, depths, res: VertexResult, vertices, size: float | None = None) -> dict:
+def _set_up(
+    frames, depths, res: VertexResult, vertices, size: float | None = None, cuts=None
+) -> dict:
     """The apex problems of ``vertices`` (vertex -> ApexProblem; those without one are
     marked in ``res`` and left out): :func:`apex_problem` of every vertex, computed together
-    (each vertex's arithmetic is the one of :func:`apex_problem`)."""
+    (each vertex's arithmetic is the one of :func:`apex_problem`); with ``cuts`` (see
+    :func:`solve_apices`), a vertex in it starts with those samples added."""
     vertices = [int(u) for u in vertices]
     if not vertices:
         return {}
@@ -479,7 +482,36 @@ def _set_up(frames, depths, res: VertexResult, vertices, size: float | None = No
             extra=np.zeros((0, 2)),
             cut_rounds=0,
         )
+        if cuts and u in cuts:
+            problems[u].extra = cut_samples(fr[j], cuts[u])
     return problems
+
+
+def cut_fractions(frame: VertexFrame, extra: np.ndarray) -> np.ndarray:
+    """(m, 2) float: the added samples ``extra`` ((side, s) rows) of a vertex's problem as
+    (mesh edge, fraction of its side's arc): what :func:`cut_samples` reads on the vertex's
+    frame after its radii changed (a side keeps its edge; its arc scales with its radius)."""
+    extra = np.asarray(extra, dtype=float).reshape(-1, 2)
+    if not len(extra):
+        return np.zeros((0, 2))
+    side = extra[:, 0].astype(np.int64)
+    arc = frame.arrays.arc[side]
+    frac = np.where(arc > 0, extra[:, 1] / np.where(arc > 0, arc, 1.0), 0.0)
+    return np.stack([frame.ring.edges[side].astype(float), frac], axis=1)
+
+
+def cut_samples(frame: VertexFrame, fractions: np.ndarray) -> np.ndarray:
+    """(m, 2) float (side, s): the samples of :func:`cut_fractions` on ``frame``, those on a
+    side it no longer has or whose arc is now flat left out."""
+    fractions = np.asarray(fractions, dtype=float).reshape(-1, 2)
+    edges = np.asarray(frame.ring.edges, dtype=np.int64)
+    order = np.argsort(edges, kind="stable")
+    at = np.searchsorted(edges[order], fractions[:, 0].astype(np.int64))
+    at = np.minimum(at, len(edges) - 1)
+    side = order[at]
+    arc = frame.arrays.arc[side]
+    keep = (edges[side] == fractions[:, 0].astype(np.int64)) & (arc > 0)
+    return np.stack([side[keep].astype(float), fractions[keep, 1] * arc[keep]], axis=1)
 
 
 def solve_apices(
@@ -492,6 +524,7 @@ def solve_apices(
     thorough: bool = True,
     size: float | None = None,
     lp: bool = True,
+    cuts: dict | None = None,
 ) -> dict:
     """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
 
@@ -530,6 +563,12 @@ def solve_apices(
         The mesh's size (:func:`mesh_size`): every crease stays ``tol.ruling`` of it above its
         base curve (or a quarter of the vertex's shortest ``l_max``), so that no cylinder
         ruling of the pattern is a sliver edge. Default: no such floor.
+    cuts : dict, optional
+        Vertex -> the samples an earlier solve of it added where its solution dipped between
+        the samples (:func:`cut_fractions`: per edge, as fractions of the arc). A vertex in it
+        starts with them (after a change of radii its dips are mostly where they were, and
+        each would otherwise cost a solve again); every vertex settled here is set to those
+        it ended with. The vertex rescue passes one dict from solve to solve.
 
     Returns
     -------
@@ -541,7 +580,7 @@ def solve_apices(
         vertices = [u for u in range(len(res.status)) if res.status[u] == ""]
     vertices = list(vertices)
     out = dict.fromkeys(vertices, (None, None))
-    pending = _set_up(frames, depths, res, vertices, size)
+    pending = _set_up(frames, depths, res, vertices, size, cuts)
     if progress is not None and batch.kernel_pending(len(pending)):
         # the first design after installing numba compiles the kernel: say so, and only then
         stage = KERNEL_STAGE if batch.kernel_cached() else KERNEL_COMPILE_STAGE
@@ -554,7 +593,8 @@ def solve_apices(
         slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
         # the slices are independent (each settles its own vertices): in threads
         for _ in thread_map(
-            lambda part: _solve_round(part, pending, res, out, centres, thorough, lp), slices
+            lambda part: _solve_round(part, pending, res, out, centres, thorough, lp, cuts),
+            slices,
         ):
             if progress is not None:
                 progress("apices", total - len(pending), total)
@@ -600,9 +640,11 @@ def _solve_round(
     centres,
     thorough: bool = True,
     lp: bool = True,
+    cuts: dict | None = None,
 ) -> None:
     """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
-    solved ones at once, and settle every vertex that is done (ok, or out of attempts)."""
+    solved ones at once, and settle every vertex that is done (ok, or out of attempts; its
+    added samples noted in ``cuts``)."""
     tries = [pending[u].attempts.pop(0) for u in order]
     args = [pending[u].constraint_args(*t) for u, t in zip(order, tries, strict=True)]
     cons = build_constraints_many(*map(list, zip(*args, strict=True)))
@@ -643,6 +685,8 @@ def _solve_round(
                 res.margin[u] = check.margin
                 res.solver[u] = sol.solver
                 out[u] = (sol.apex, v_sol)
+                if cuts is not None:
+                    cuts[u] = cut_fractions(p.frame, p.extra)
                 del pending[u]
                 continue
             p.failing = check.failing
@@ -653,4 +697,6 @@ def _solve_round(
             res.reason[u] = "no apex meets every constraint: " + "; ".join(p.failing[:6])
             if len(p.failing) > 6:
                 res.reason[u] += f"; and {len(p.failing) - 6} more"
+            if cuts is not None:
+                cuts[u] = cut_fractions(p.frame, p.extra)
             del pending[u]
