@@ -38,6 +38,7 @@ from .repair import (
     plane_axes,
     polygon_normal,
     split_face_loops,
+    split_faces,
     split_non_manifold,
     triangulate_faces,
     triangulate_polygon,
@@ -458,7 +459,7 @@ class _Flat:
         return cls(index, start, size, face, nxt, prv)
 
     def split(self, values: np.ndarray) -> list[np.ndarray]:
-        return np.split(values, self.start[1:-1])
+        return split_faces(values, self.start)
 
 
 def _face_newell(fl: _Flat, v: np.ndarray) -> np.ndarray:
