@@ -161,3 +161,20 @@ def test_lowest_linked_matches_the_connected_components():
         low = np.full(group.max() + 1, n)
         np.minimum.at(low, group, np.arange(n))
         assert np.array_equal(lowest_linked(pairs, n), low[group])
+
+
+def test_a_faces_area_is_polygon_area2_to_the_bit():
+    """``Piece.face`` measures each polygon with Python floats: the same sums in the same
+    order as :func:`~filletfold.surface.faces.polygon_area2`, bit for bit."""
+    import numpy as np
+
+    from filletfold.surface.faces import polygon_area2
+    from filletfold.surface.piece import _area2
+
+    rng = np.random.default_rng(3)
+    for k in (3, 4, 5, 9):
+        xy = rng.normal(size=(200, k, 2)) * rng.choice([1e-6, 1.0, 1e4], (200, 1, 1))
+        want = polygon_area2(xy)
+        for j in range(len(xy)):
+            pts = list(xy[j])
+            assert _area2(pts, list(range(k))) == want[j]
