@@ -18,6 +18,7 @@ from json.encoder import encode_basestring_ascii as _quote
 
 import numpy as np
 
+from ..arrays import split_runs
 from ..errors import ExportError, ParameterError
 from ..surface.pattern import Annotations, CreasePattern, LabelRows, face_arrays
 from ..surface.validate import validated_faces
@@ -404,7 +405,7 @@ def annotations_document(annotations: Annotations) -> dict:
     a = _annotation_arrays(annotations)
     _check_labels(a)
     sizes = a["tab_size"]
-    tabs = np.split(a["tab_points"], np.cumsum(sizes)[:-1]) if len(sizes) else []
+    tabs = split_runs(a["tab_points"], np.cumsum(sizes)[:-1]) if len(sizes) else []
     return {
         "tabs": [t.tolist() for t in tabs],
         "tab_hinges": _hinge_items(a),

@@ -13,6 +13,7 @@ import itertools
 
 import numpy as np
 
+from ..arrays import split_runs
 from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows
 
 __all__ = [
@@ -189,7 +190,7 @@ def _walk_chains(ends, nxt, start_vertex, start_edge):
     walk = np.concatenate(rec_walk)
     by_walk = np.argsort(walk, kind="stable")  # each walk's vertices in the order visited
     counts = np.bincount(walk, minlength=w)
-    paths = np.split(np.concatenate(rec_vertex)[by_walk], np.cumsum(counts)[:-1]) if w else []
+    paths = split_runs(np.concatenate(rec_vertex)[by_walk], np.cumsum(counts)[:-1]) if w else []
     walk_of = np.concatenate([np.zeros(0, dtype=np.int64), *rec_walk[1:]])
     walked = np.concatenate([np.zeros(0, dtype=np.int64), *rec_edge])
     return paths, final, last, walk_of, walked
@@ -348,7 +349,7 @@ def simplify_polylines(paths: list) -> list[np.ndarray]:
         p, owner = p[~drop], owner[~drop]
         size = np.bincount(owner, minlength=n)
         active &= changed & (size > least)
-    return np.split(p, np.cumsum(size)[:-1])
+    return split_runs(p, np.cumsum(size)[:-1])
 
 
 def chain_runs(points: np.ndarray, closed: bool = False) -> list[tuple[np.ndarray, bool, bool]]:

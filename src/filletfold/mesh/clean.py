@@ -24,6 +24,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from ..arrays import split_runs
 from ..errors import MeshError
 from ..tolerances import tol
 from .polymesh import PolyMesh
@@ -38,7 +39,6 @@ from .repair import (
     plane_axes,
     polygon_normal,
     split_face_loops,
-    split_faces,
     split_non_manifold,
     triangulate_faces,
     triangulate_polygon,
@@ -459,7 +459,7 @@ class _Flat:
         return cls(index, start, size, face, nxt, prv)
 
     def split(self, values: np.ndarray) -> list[np.ndarray]:
-        return split_faces(values, self.start)
+        return split_runs(values, self.start[1:-1])
 
 
 def _face_newell(fl: _Flat, v: np.ndarray) -> np.ndarray:

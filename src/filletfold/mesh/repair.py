@@ -31,7 +31,6 @@ cuts open the edges where a surface cannot be oriented or where two faces lie ba
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -39,6 +38,7 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ..arrays import split_runs
 from ..errors import MeshError
 
 #: Added to the diagonal of planarize's normal equations (``A A^T``), which are singular when
@@ -621,22 +621,8 @@ def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=(), why
     corner_vertex = new_index[fan_of]
     v2 = np.concatenate([v, v[fan_vertex[extra]]])
     vorig2 = np.concatenate([vorig, vorig[fan_vertex[extra]]])
-    out = split_faces(corner_vertex, start)
+    out = split_runs(corner_vertex, start[1:-1])
     return out, v2, vorig2
-
-
-def split_faces(values: np.ndarray, start: np.ndarray) -> list[np.ndarray]:
-    """``np.split(values, start[1:-1])``: the corner values of each face (views, face ``i``
-    from ``start[i]`` to ``start[i + 1]``, ``start`` from 0 to ``len(values)``); one reshape
-    when every face has as many corners (a triangle mesh: np.split's slicing took 0.6 s on
-    100k faces), slices otherwise."""
-    cuts = np.asarray(start, dtype=np.int64)[1:-1]
-    bounds = np.concatenate([[0], cuts, [len(values)]])  # np.split's pieces
-    size = np.diff(bounds)
-    n = len(size)
-    if size[0] > 0 and (size == size[0]).all():
-        return list(values.reshape(n, int(size[0]), *values.shape[1:]))
-    return [values[x:y] for x, y in itertools.pairwise(bounds.tolist())]
 
 
 def detach_faces(faces, origin, v, vorig, he, log: RepairLog):

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..arrays import split_runs
 from ..mesh.polymesh import PolyMesh
 from ..parallel import thread_map
 from ..rounding.tapered import perpendiculars, ruled_gluing_maps
@@ -647,7 +648,7 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
     pb = lay.first.tolist()
     count = runs[:, 2] - runs[:, 1] + 1
     sector = face_share - (np.cumsum(count) - count)[face_run]  # the share within its run
-    sectors = np.split(sector, fb[1:-1])
+    sectors = split_runs(sector, fb[1:-1])
     pieces = []
     for r, v in enumerate(lay.vertex.tolist()):
         a, b, fa, fz = pb[r], pb[r + 1], fb[r], fb[r + 1]

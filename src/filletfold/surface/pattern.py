@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..arrays import split_runs
 from ..tolerances import tol
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
@@ -81,7 +82,7 @@ class FaceRows(Rows, FlatFaces):
         return self.flat[self.start[i] : self.start[i + 1]]
 
     def __iter__(self):
-        return iter(np.split(self.flat, self.start[1:-1]) if len(self) else [])
+        return iter(split_runs(self.flat, self.start[1:-1]) if len(self) else [])
 
 
 class PointRows(Rows):
@@ -117,7 +118,7 @@ class PointRows(Rows):
         return self.points[self.start[i] : self.start[i + 1]]
 
     def __iter__(self):
-        return iter(np.split(self.points, self.start[1:-1]) if len(self) else [])
+        return iter(split_runs(self.points, self.start[1:-1]) if len(self) else [])
 
 
 class LabelRows(Rows):

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import split_runs
 from ..rounding.tapered import arc_points, cone_rulings, developed_angles
 from ..vertex.frame import VertexFrame, to_chart
 from .piece import Piece
@@ -69,7 +70,7 @@ def _side_points(frames: list, conical, n_samples) -> list[list[tuple]]:
     theta = developed_angles(O, N0, B, kappa, radius, S, s, fillet=which)
     bounds = np.cumsum(count)[:-1]
     for (k, i, _), c, r, th in zip(
-        rows, np.split(C, bounds), np.split(rho, bounds), np.split(theta, bounds), strict=True
+        rows, split_runs(C, bounds), split_runs(rho, bounds), split_runs(theta, bounds), strict=True
     ):
         out[k][i] = (c, r, th)
     return out
