@@ -481,10 +481,14 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     """
     flat, size = point_rows(annotations.tabs)
     n = len(size)
-    hinges = list(annotations.tab_hinges)[:n]
-    hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in hinges]
     if n == 0:
         return []
+    rows = annotations.tab_hinges
+    if isinstance(rows, PointRows) and (np.diff(rows.start) == 2).all():
+        hinges = rows.points.reshape(-1, 2, 2)[:n]  # one array, no object per tab
+    else:
+        hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in list(rows)[:n]]
+        hinges = np.array(hinges).reshape(-1, 2, 2)
     first = np.concatenate([[0], np.cumsum(size)[:-1]])
     # a closing point that repeats the first is dropped
     repeat = size > 1
@@ -495,7 +499,7 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     for k in np.unique(size[hinged]).tolist():
         ids = hinged[size[hinged] == k]
         pts = flat[first[ids, None] + np.arange(k)]  # (m, k, 2)
-        hinge = np.array([hinges[i] for i in ids.tolist()])  # (m, 2, 2)
+        hinge = hinges[ids]  # (m, 2, 2)
         eps = _HINGE_RTOL * np.maximum(np.ptp(pts, axis=1).max(axis=1), 1.0)
         on_hinge, unsure = _on_segments(pts, hinge, eps)
         for j in np.flatnonzero(unsure).tolist():  # a point at the tolerance: as before
