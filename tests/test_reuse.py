@@ -118,7 +118,16 @@ def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
         refs.append(weakref.ref(frames[0]))
         return frames
 
+    alive_at_layout = []
+    arrange = design_module.arrange
+
+    def layout_spy(*args, **kwargs):
+        gc.collect()
+        alive_at_layout.append(refs[-1]() is not None)
+        return arrange(*args, **kwargs)
+
     monkeypatch.setattr(design_module, "classify_vertices", spy)
+    monkeypatch.setattr(design_module, "arrange", layout_spy)
     kept = filletfold.round_mesh("icosahedron", tabs=False)
     lean = filletfold.round_mesh("icosahedron", tabs=False, keep_stages=False)
     assert kept.stages is not None and lean.stages is None
@@ -126,6 +135,8 @@ def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
     gc.collect()
     assert refs[0]() is not None  # held by kept.stages
     assert refs[1]() is None
+    # and already when the layout starts (the cones' sampling cache held them until then)
+    assert alive_at_layout == [True, False]
 
 
 @pytest.fixture

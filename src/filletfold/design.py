@@ -695,6 +695,7 @@ def round_mesh(
     points = np.maximum(
         points, cone_sample_counts(solved, centres, pm.n_edges, float(arc_step), needs)
     )
+    needs.clear()  # its last use: it holds every cone's frame, which the layout may not need
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [st.modules[u] if same_samples and u in kept else None for u in range(len(solved))]
     todo = [u for u, module in enumerate(modules) if module is None]
