@@ -329,31 +329,29 @@ def label_digits(labels: LabelRows, points: np.ndarray) -> LabelRows:
     extent = float(np.ptp(pts, axis=0).max()) if len(pts) else 0.0
     position = labels.position
     if extent > 0 and np.isfinite(extent):
-        k = int(np.floor(np.log10(LABEL_GRID * extent)))
-        # divided by an exact power of ten: the double nearest each decimal (short to print)
-        position = (
-            np.round(position * 10.0**-k) / 10.0**-k
-            if k < 0
-            else np.round(position / 10.0**k) * 10.0**k
-        ) + 0.0  # + 0.0: no -0.0
+        position = _to_decimals(position, -np.floor(np.log10(LABEL_GRID * extent))) + 0.0
+    height = np.asarray(labels.height, dtype=np.float64)
+    ok = np.isfinite(height) & (height != 0)  # 0 and non-finite heights as they are
+    height = height.copy()
+    height[ok] = _to_decimals(
+        height[ok], LABEL_HEIGHT_DIGITS - 1 - np.floor(np.log10(np.abs(height[ok])))
+    )
     return LabelRows(
         position,
         labels.text,
-        np.round(labels.angle, LABEL_ANGLE_DECIMALS) + 0.0,
-        _significant(labels.height, LABEL_HEIGHT_DIGITS),
+        np.round(labels.angle, LABEL_ANGLE_DECIMALS) + 0.0,  # + 0.0: no -0.0
+        height,
         labels.kind,
     )
 
 
-def _significant(x: np.ndarray, digits: int) -> np.ndarray:
-    """``x`` rounded to ``digits`` significant digits (0 and non-finite values as they are)."""
-    x = np.asarray(x, dtype=np.float64)
-    out = x.copy()
-    ok = np.isfinite(x) & (x != 0)
-    k = digits - 1 - np.floor(np.log10(np.abs(x[ok])))
-    up = 10.0 ** np.abs(k)  # exact powers of ten: the double nearest each decimal
-    out[ok] = np.where(k >= 0, np.round(x[ok] * up) / up, np.round(x[ok] / up) * up)
-    return out
+def _to_decimals(x: np.ndarray, decimals) -> np.ndarray:
+    """``x`` rounded to ``decimals`` (per value or for all; negative: to tens, hundreds...),
+    through exact powers of ten: each result is the double nearest its decimal (short to
+    print), not a multiple of an inexact ``10**-d``."""
+    d = np.asarray(decimals, dtype=np.float64)
+    up = 10.0 ** np.abs(d)
+    return np.where(d >= 0, np.round(x * up) / up, np.round(x / up) * up)
 
 
 def _readable(angle: np.ndarray) -> np.ndarray:
