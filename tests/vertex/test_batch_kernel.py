@@ -307,8 +307,8 @@ def test_a_large_design_reports_the_kernel_loading(monkeypatch):
 
 def test_the_kernel_cache_is_found_where_numba_writes_it(tmp_path, monkeypatch):
     """``kernel_cached`` sees an index file of the kernel's entry point under
-    ``NUMBA_CACHE_DIR`` and nothing in an empty one (the source's own ``__pycache__`` moved
-    aside by pointing the package lookup at a copy without one)."""
+    ``NUMBA_CACHE_DIR`` or numba's user-wide cache, and nothing in empty ones (the source's
+    own ``__pycache__`` moved aside by pointing the package lookup at a copy without one)."""
     import importlib.util
     import shutil
 
@@ -321,9 +321,17 @@ def test_the_kernel_cache_is_found_where_numba_writes_it(tmp_path, monkeypatch):
     cache = tmp_path / "cache"
     cache.mkdir()
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(cache))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "user"))
     assert not batch.kernel_cached()
     (cache / "x").mkdir()
     (cache / "x" / "batch_kernel._kernel-204.py311.nbi").write_bytes(b"")
+    assert batch.kernel_cached()
+    # numba's user-wide cache (the source's folder read-only): $XDG_CACHE_HOME/numba/...
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
+    assert not batch.kernel_cached()
+    user = tmp_path / "user" / "numba" / "site-packages_filletfold_vertex"
+    user.mkdir(parents=True)
+    (user / "batch_kernel._kernel-204.py311.nbi").write_bytes(b"")
     assert batch.kernel_cached()
 
 

@@ -268,16 +268,18 @@ def kernel_pending(n_problems: int) -> bool:
 
 def kernel_cached() -> bool:
     """Whether numba's on-disk cache holds a compiled kernel (its index file for the kernel's
-    entry point, beside the source or under ``NUMBA_CACHE_DIR``): then loading it takes about
+    entry point, in one of the places numba caches to: ``NUMBA_CACHE_DIR``, beside the source,
+    or the user's cache folder when the source's is read-only): then loading it takes about
     0.3-1 s; without it the first use compiles it (about 15 s). Looked up without importing
     numba."""
     spec = importlib.util.find_spec(f"{__package__}.batch_kernel")
     if spec is None or spec.origin is None:
         return False
     pattern = "batch_kernel._kernel-*.nbi"
-    places = [Path(spec.origin).parent / "__pycache__"]
+    user = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    places = [Path(spec.origin).parent / "__pycache__", Path(user) / "numba"]
     if os.environ.get("NUMBA_CACHE_DIR"):
-        places.append(Path(os.environ["NUMBA_CACHE_DIR"]))
+        places.insert(0, Path(os.environ["NUMBA_CACHE_DIR"]))
     return any(next(p.rglob(pattern), None) is not None for p in places if p.is_dir())
 
 
