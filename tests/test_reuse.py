@@ -78,8 +78,14 @@ def test_one_vertex_depth_resolves_only_that_vertex(solved_vertices):
 
 def test_global_depth_reuses_rounding_and_normals(solved_vertices):
     first = filletfold.round_mesh("dodecahedron", depth="30%")
+    frames, status = list(first.stages.frames), list(first.stages.classified.status)
     again = filletfold.round_mesh("dodecahedron", depth="40%", reuse=first)
-    assert again.stages.frames is first.stages.frames
+    # the earlier design's stages are left as they were (the new one has lists of its own)
+    assert again.stages.frames is not first.stages.frames
+    assert all(a is b for a, b in zip(first.stages.frames, frames, strict=True))
+    assert list(first.stages.classified.status) == status
+    # the same frames (not classified again), in a list of the new design's own
+    assert all(a is b for a, b in zip(again.stages.frames, first.stages.frames, strict=True))
     assert len(solved_vertices[-1]) == first.mesh.n_vertices
     same_design(again, filletfold.round_mesh("dodecahedron", depth="40%"))
 
@@ -87,7 +93,7 @@ def test_global_depth_reuses_rounding_and_normals(solved_vertices):
 def test_a_new_radius_recomputes_everything():
     first = filletfold.round_mesh("cube", radius="10%")
     again = filletfold.round_mesh("cube", radius="12%", reuse=first)
-    assert again.stages.frames is not first.stages.frames
+    assert not any(a is b for a, b in zip(again.stages.frames, first.stages.frames, strict=True))
     same_design(again, filletfold.round_mesh("cube", radius="12%"))
 
 

@@ -644,7 +644,9 @@ def round_mesh(
     t = time.perf_counter()
     _stage("vertex normals")
     if st is not None:
-        frames, classified = st.frames, st.classified  # read-only: res is a copy
+        # the earlier design's stages stay as they were: the apex stage replaces the frames
+        # and classification of the vertices it classifies again in lists of this design's
+        frames, classified = list(st.frames), copy.deepcopy(st.classified)
     else:
         classified = VertexResult.empty(pm.n_vertices)
         frames = classify_vertices(pm, rounding, classified)
@@ -822,16 +824,15 @@ def _apices(
     ``arc_step`` (degrees) with chords of at least ``min_chord`` can follow
     (:func:`~filletfold.surface.sampling.unsampled_cones`) is infeasible too, and made sharp;
     up to :data:`SAMPLING_ROUNDS` times, as its neighbours' new cones may be so in turn.
+    ``frames`` and ``classified`` are this design's own and updated in place (the old frame
+    of a vertex classified again is freed at once: a scan's frames take hundreds of MB).
     Returns the frames, classification, rounding and face-piece centres afterwards (the
     rescue may change them), ``solved`` (frame, apex, developed apex) per vertex, the vertices
     kept from ``st`` and the :class:`~filletfold.vertex.rescue.Rescue`."""
 
     def sharpen(kinds, apices, **options):
         """:func:`sharpen_vertices` of ``kinds`` on this stage's state (frames and the
-        classification copied first); the new rounding, centres and Sharpening."""
-        nonlocal frames, classified
-        frames = list(frames)
-        classified = copy.deepcopy(classified)
+        classification updated in place); the new rounding, centres and Sharpening."""
         _stage("sharp vertices")
         return sharpen_vertices(
             pm,
@@ -874,8 +875,6 @@ def _apices(
     )
     rescue = Rescue()
     if not material_loss and any(res.status[u] == "infeasible" for u in pending):
-        frames = list(frames)  # the rescue replaces the frames of the vertices it re-solves
-        classified = copy.deepcopy(classified)
         rounding, centres, rescue = rescue_vertices(
             pm,
             rounding,
