@@ -71,7 +71,8 @@ def test_write_outputs_replaces_and_keeps_others(existing):
 
 def test_write_outputs_bad_value_midway_changes_nothing(existing):
     before = _snapshot(existing.parent)
-    with pytest.raises(ExportError, match=r"'b\.txt': contents must be str or bytes, not int"):
+    match = r"'b\.txt': contents must be str, bytes or an iterator of str, not int"
+    with pytest.raises(ExportError, match=match):
         write_outputs(existing, {"a.txt": "new a", "b.txt": 123, "c.txt": "new c"})
     assert _snapshot(existing.parent) == before
 
@@ -95,7 +96,7 @@ def test_write_outputs_new_file_removed_on_failure(existing, monkeypatch):
 
 def test_write_outputs_created_folder_removed_on_failure(tmp_path):
     folder = tmp_path / "x" / "y"
-    with pytest.raises(ExportError, match="must be str or bytes"):
+    with pytest.raises(ExportError, match="must be str, bytes or an iterator of str"):
         write_outputs(folder, {"a.txt": "a", "b.txt": None})
     assert list(tmp_path.iterdir()) == []
 
@@ -169,7 +170,7 @@ def test_write_file_atomic_failure_keeps_old(tmp_path, monkeypatch):
 
 
 def test_write_file_atomic_rejects(tmp_path):
-    with pytest.raises(ExportError, match="must be str or bytes, not list"):
+    with pytest.raises(ExportError, match="must be str, bytes or an iterator of str, not list"):
         write_file_atomic(tmp_path / "x", [1])
     (tmp_path / "d").mkdir()
     with pytest.raises(ExportError, match="it is a folder"):
@@ -210,3 +211,31 @@ def test_text_is_encoded_a_chunk_at_a_time(tmp_path, monkeypatch):
     assert (tmp_path / "out" / "b.bin").read_bytes() == b"\x00\xff"
     write_file_atomic(tmp_path / "one.txt", text)
     assert (tmp_path / "one.txt").read_bytes() == text.encode("utf-8")
+
+
+def test_text_chunks_are_written_as_they_come_and_a_bad_one_writes_nothing(existing):
+    """An iterator of text is written a chunk at a time (each made only when its turn comes);
+    one that fails, or yields something that is not text, leaves the folder as it was."""
+    made = []
+
+    def chunks(n, bad=None):
+        for i in range(n):
+            if i == bad:
+                yield b"not text"
+            made.append(i)
+            yield f"part {i}\n"
+
+    write_outputs(existing, {"a.txt": chunks(3)})
+    assert (existing / "a.txt").read_text() == "part 0\npart 1\npart 2\n" and made == [0, 1, 2]
+    before = _snapshot(existing.parent)
+    with pytest.raises(ExportError, match="a text chunk must be str, not bytes"):
+        write_outputs(existing, {"c.txt": "new c", "a.txt": chunks(3, bad=1)})
+    assert _snapshot(existing.parent) == before
+
+    def broken():
+        yield "half"
+        raise ValueError("boom")
+
+    with pytest.raises(ExportError, match="boom"):
+        write_outputs(existing, {"a.txt": broken()})
+    assert _snapshot(existing.parent) == before

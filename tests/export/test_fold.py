@@ -230,6 +230,39 @@ def test_fold_json_same_pattern_same_bytes():
     assert a == b
 
 
+def test_fold_json_chunks_are_its_text_a_key_at_a_time():
+    """The text (as written before it came in chunks, pinned here) is the chunks joined: the
+    opening brace, then one chunk per top-level key, each value converted only when its key's
+    turn comes (a bad value raises after the keys before it have been written)."""
+    from filletfold.export import fold_json_chunks
+
+    doc = {
+        "file_spec": 1.2,
+        "a": [0.5, -0.0],
+        "frames": [{"k": 1, "v": np.array([[1.0, 2.0]])}, {"k": 2}],
+        "m": {"x": {"y": []}},
+        "e": {},
+        "s": "t",
+    }
+    expected = (
+        '{\n  "file_spec": 1.2,\n  "a": [0.5,0.0],\n  "frames": [\n    {\n      "k": 1,\n'
+        '      "v": [[1.0,2.0]]\n    },\n    {\n      "k": 2\n    }\n  ],\n  "m": {\n'
+        '    "x": {\n      "y": []\n    }\n  },\n  "e": {},\n  "s": "t"\n}\n'
+    )
+    chunks = list(fold_json_chunks(doc))
+    assert "".join(chunks) == fold_json(doc) == expected
+    assert len(chunks) == 1 + len(doc) and chunks[0] == "{\n"
+    entries = [c[:-2] if c.endswith(",\n") else c.removesuffix("\n}\n") for c in chunks[1:]]
+    assert [json.loads("{" + c + "}") for c in entries] == [
+        {k: v} for k, v in json.loads(expected).items()
+    ]
+    assert fold_json({}) == "".join(fold_json_chunks({})) == "{}\n"
+    lazy = fold_json_chunks({"a": 1.0, "b": [float("nan")], "c": 2.0})
+    assert next(lazy) == "{\n" and next(lazy) == '  "a": 1.0,\n'
+    with pytest.raises(ExportError, match=r"b\[0\] is not finite"):
+        next(lazy)
+
+
 @pytest.mark.parametrize(
     ("doc", "match"),
     [

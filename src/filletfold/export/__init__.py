@@ -9,7 +9,7 @@ from ..surface.validate import validate_pattern
 from .atomic import write_file_atomic, write_outputs
 from .cutfiles import cut_files, parse_formats
 from .dxf import pattern_dxf
-from .fold import fold_document, fold_json
+from .fold import fold_document, fold_json, fold_json_chunks
 from .fold_read import read_fold
 from .obj import folded_obj
 from .pdf import pattern_pdf
@@ -21,6 +21,7 @@ __all__ = [
     "cut_files",
     "fold_document",
     "fold_json",
+    "fold_json_chunks",
     "folded_obj",
     "parse_formats",
     "pattern_dxf",

@@ -16,7 +16,7 @@ import errno
 import os
 import shutil
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 from ..errors import ExportError
@@ -24,15 +24,19 @@ from ..errors import ExportError
 __all__ = ["write_file_atomic", "write_outputs"]
 
 
-def _encode(name: str, data) -> str | bytes:
+def _encode(name: str, data) -> str | bytes | Iterator[str]:
     """``data`` ready for :func:`_write_all`: ``str`` as it is (encoded as UTF-8 while it is
-    written), bytes-like values as bytes."""
+    written), bytes-like values as bytes, an iterator of ``str`` chunks as it is (each chunk
+    written as it comes)."""
     if isinstance(data, str):
         return data
     if isinstance(data, bytes | bytearray | memoryview):
         return bytes(data)
+    if isinstance(data, Iterator):
+        return data
     raise ExportError(
-        f"cannot write {name!r}: contents must be str or bytes, not {type(data).__name__}"
+        f"cannot write {name!r}: contents must be str, bytes or an iterator of str, "
+        f"not {type(data).__name__}"
     )
 
 
@@ -41,13 +45,17 @@ def _encode(name: str, data) -> str | bytes:
 ENCODE_CHUNK = 1 << 24
 
 
-def _write_all(fh, data: str | bytes) -> None:
-    """Write ``data`` to the binary file ``fh``, a ``str`` as UTF-8 a chunk at a time."""
+def _write_all(fh, data: str | bytes | Iterator[str]) -> None:
+    """Write ``data`` to the binary file ``fh``: a ``str`` (or each ``str`` of an iterator)
+    as UTF-8, :data:`ENCODE_CHUNK` characters at a time."""
     if isinstance(data, bytes):
         fh.write(data)
         return
-    for i in range(0, len(data), ENCODE_CHUNK):
-        fh.write(data[i : i + ENCODE_CHUNK].encode("utf-8"))
+    for text in (data,) if isinstance(data, str) else data:
+        if not isinstance(text, str):
+            raise ExportError(f"a text chunk must be str, not {type(text).__name__}")
+        for i in range(0, len(text), ENCODE_CHUNK):
+            fh.write(text[i : i + ENCODE_CHUNK].encode("utf-8"))
 
 
 def _os_message(exc: OSError, what: str) -> str:
@@ -107,7 +115,7 @@ def _remove_dirs(created: list[Path]) -> None:
             break
 
 
-def _write_synced(path: Path, data: str | bytes) -> None:
+def _write_synced(path: Path, data: str | bytes | Iterator[str]) -> None:
     """Write ``data`` to a new file ``path`` and fsync it."""
     with open(path, "xb") as fh:
         _write_all(fh, data)
@@ -147,11 +155,12 @@ def write_outputs(folder, files: Mapping[str, str | bytes]) -> list[Path]:
     ----------
     folder : str or os.PathLike
         Destination folder; created, with its parents, when missing.
-    files : mapping of str to str, bytes or callable
+    files : mapping of str to str, bytes, iterator of str, or callable
         File name (a plain name, no directory part) to contents, or to a function without
         arguments that returns them (called just before its file is written, so only one
         file's contents need to be in memory at a time). ``str`` contents are written as UTF-8
-        without newline translation.
+        without newline translation; an iterator's chunks are written as they come (a file
+        made a part at a time is never whole in memory).
 
     Returns
     -------

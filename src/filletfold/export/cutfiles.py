@@ -63,7 +63,7 @@ from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows
 from ..surface.validate import validated_faces
 from ..units import check_units, sheet_size_mm
 from .dxf import check_scale, pattern_dxf
-from .fold import ANNOTATIONS_FILE, _fold_document, annotations_json, fold_json
+from .fold import ANNOTATIONS_FILE, _fold_document, annotations_json, fold_json_chunks
 from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
@@ -311,7 +311,8 @@ def cut_files(
     lazy : bool
         Return, for each file, a function without arguments that builds its contents (for
         :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
-        at a time); the pattern is still checked here, once.
+        at a time; the FOLD files' are iterators of text chunks, written as they come, so
+        not even a whole file is); the pattern is still checked here, once.
     preset : str or Preset, optional
         Cutter preset of the SVG and DXF (:data:`~filletfold.export.presets.PRESETS`; default
         ``print``).
@@ -321,7 +322,8 @@ def cut_files(
 
     Returns
     -------
-    dict of str to str or bytes (or to callables, with ``lazy``)
+    dict of str to str or bytes (or to callables, with ``lazy``: of those, or of iterators of
+    str)
         File name to contents, in the order of :func:`output_names`. Text formats are ``str``,
         PDF, PNG, 3DM, GLB, PLY and STL ``bytes``.
 
@@ -362,7 +364,7 @@ def cut_files(
             arrays=True,
             annotations=False,
         )
-        return fold_json(doc)
+        return fold_json_chunks(doc)  # written a key at a time (lazy)
 
     @functools.cache
     def coarse():
@@ -383,7 +385,7 @@ def cut_files(
             arrays=True,
             annotations=False,
         )
-        return fold_json(doc)
+        return fold_json_chunks(doc)  # written a key at a time (lazy)
 
     def simulator_svg():
         from .simulator import simulator_svg_pattern
@@ -430,4 +432,11 @@ def cut_files(
         "stl": {"folded.stl": lambda: _folded_stl(pattern, length_factor(units, scale))},
     }
     out = {name: build for fmt in formats for name, build in builders[fmt].items()}
-    return out if lazy else {name: build() for name, build in out.items()}
+    if lazy:
+        return out
+    return {name: _whole(build()) for name, build in out.items()}
+
+
+def _whole(data):
+    """The contents of one file: text made in chunks joined."""
+    return data if isinstance(data, str | bytes) else "".join(data)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import itertools
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from json.encoder import encode_basestring_ascii as _quote
 
 import numpy as np
@@ -39,6 +39,7 @@ __all__ = [
     "file_creator",
     "fold_document",
     "fold_json",
+    "fold_json_chunks",
     "has_annotations",
 ]
 
@@ -726,7 +727,8 @@ def fold_json(doc: Mapping, *, root: str = "") -> str:
     are rounded to 12 significant digits (``-0`` written as ``0.0``; :func:`fold_document` has
     rounded its facets' fold angles further); numpy arrays and scalars
     become JSON arrays and numbers. Each top-level key (and each key of a frame) is on its own
-    line, arrays are compact. Output is ASCII and ends with a newline.
+    line, arrays are compact. Output is ASCII and ends with a newline: the text of
+    :func:`fold_json_chunks`, joined.
 
     Parameters
     ----------
@@ -745,8 +747,33 @@ def fold_json(doc: Mapping, *, root: str = "") -> str:
     ExportError
         When a value is not finite, not JSON data, or a key is not a string.
     """
+    return "".join(fold_json_chunks(doc, root=root))
+
+
+def fold_json_chunks(doc: Mapping, *, root: str = "") -> Iterator[str]:
+    """:func:`fold_json`'s text one top-level key at a time, each key's value converted only
+    when its turn comes: written as it comes
+    (:func:`~filletfold.export.atomic.write_outputs`), a large design's file is never whole
+    in memory, only its largest array's text (the design of a 100k-face scan writes a
+    ``design.fold`` of about 300 MB).
+
+    Parameters and errors as :func:`fold_json`; an error is raised when the bad value's turn
+    comes, after the keys before it.
+
+    Yields
+    ------
+    str
+    """
     if not isinstance(doc, Mapping):
         raise ExportError(f"a FOLD document must be a mapping, got {type(doc).__name__}")
-    parts = _dump(_plain(doc, root), 0, [])
-    parts.append("\n")
-    return "".join(parts)
+    if not doc:
+        yield _compact(_plain(doc, root)) + "\n"
+        return
+    yield "{\n"
+    last = len(doc) - 1
+    for i, (k, v) in enumerate(doc.items()):
+        if not isinstance(k, str):
+            raise ExportError(f"FOLD keys must be strings, got {k!r} at {root}")
+        parts = _dump(_plain(v, f"{root}.{k}" if root else k), 1, ["  ", json.dumps(k), ": "])
+        parts.append(",\n" if i < last else "\n}\n")
+        yield "".join(parts)
