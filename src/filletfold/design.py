@@ -52,12 +52,21 @@ from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
     SHARP_KINDS,
+    kept_sharp,
     parse_sharp,
     set_treatments,
     sharp_kind,
     sharpen_vertices,
+    unround_between,
 )
-from .vertex.solve import STATUSES, VertexResult, classify_vertices, solve_apices
+from .vertex.solve import (
+    STATUSES,
+    VertexResult,
+    classify_vertices,
+    saddle_reason,
+    saddle_vertices,
+    solve_apices,
+)
 
 
 def parse_length(value, reference: float, name: str, *, count: int | None = None) -> np.ndarray:
@@ -643,16 +652,34 @@ def round_mesh(
 
     t = time.perf_counter()
     _stage("vertex normals")
+    saddles = None  # (n_vertices,) bool, when saddles are made sharp before the frames
     if st is not None:
         # the earlier design's stages stay as they were: the apex stage replaces the frames
         # and classification of the vertices it classifies again in lists of this design's
         frames, classified = list(st.frames), copy.deepcopy(st.classified)
     else:
         classified = VertexResult.empty(pm.n_vertices)
-        frames = classify_vertices(pm, rounding, classified)
+        if "saddle" in kinds:
+            saddles = saddle_vertices(pm, rounding)
+        if saddles is not None and saddles.any():
+            # saddles are known before any frame: sharp from the start, so that every frame
+            # is built once, the neighbours' sides toward them conical
+            rounding, centres, _ = unround_between(
+                pm, rounding, centres, saddles, face_piece_centres, coplanar_deg, floor, min_width
+            )
+        else:
+            saddles = None
+        frames = classify_vertices(pm, rounding, classified, sharp=saddles)
+        for u in [] if saddles is None else np.flatnonzero(saddles).tolist():
+            # a saddle stays one, though its edges may all be unrounded now
+            classified.kind[u] = classified.status[u] = "saddle"
+            classified.reason[u] = saddle_reason(classified.normal_bound[u])
         if conical:
             use_cone_axes(pm, frames, classified)
     res = copy.deepcopy(classified)
+    if saddles is not None:
+        for u in np.flatnonzero(saddles).tolist():
+            res.reason[u] = kept_sharp(res.reason[u])
     timings["normals"] = time.perf_counter() - t
 
     t = time.perf_counter()
@@ -853,10 +880,6 @@ def _apices(
             **options,
         )
 
-    if st is None and "saddle" in sharp_kinds and "saddle" in res.status:
-        # saddles are known before any apex: sharp first, so that their neighbours are solved
-        # once, with their sides toward them conical (a reused design's frames are so already)
-        rounding, centres, _ = sharpen({"saddle"}, {}, solve=False)
     pending = [u for u in range(pm.n_vertices) if res.status[u] == ""]
     kept = set()
     if st is not None:

@@ -167,3 +167,50 @@ def test_edge_treatments_of_a_mesh_without_sharp_vertices():
     d = design_of("cube")
     t = edge_treatments(d.mesh, d.rounding, d.vertices.treatment)
     assert set(t) == {"cylinder"}
+
+
+@pytest.mark.parametrize("name", ["torus", "l-prism", "blob", "saddle-patch", "cube"])
+def test_saddles_are_found_before_the_frames_as_the_classification_finds_them(name):
+    """saddle_vertices (mesh and radii alone) marks exactly the vertices classify_vertices
+    calls saddles from their frames."""
+    from filletfold.mesh import load_mesh
+    from filletfold.rounding.edges import round_edges
+    from filletfold.vertex.solve import VertexResult, classify_vertices, saddle_vertices
+
+    pm = load_mesh(name)[0]
+    rounding = round_edges(pm, np.full(pm.n_edges, 0.1 * pm.mean_edge_length))
+    res = VertexResult.empty(pm.n_vertices)
+    classify_vertices(pm, rounding, res)
+    found = saddle_vertices(pm, rounding)
+    assert found.tolist() == [s == "saddle" for s in res.status]
+    assert found.any() == (name != "cube")
+    flat = round_edges(pm, np.zeros(pm.n_edges))  # no rounded edge: no saddle, only "sharp"
+    assert not saddle_vertices(pm, flat).any()
+
+
+def test_each_frame_is_built_once_when_saddles_are_made_sharp(monkeypatch):
+    """The saddles are sharp before the frames are built: every vertex is classified once
+    before the apices (none again for its neighbours), and a saddle whose edges all end at
+    saddles (so are all left unrounded) is still reported as a saddle kept sharp."""
+    import filletfold.design as design
+
+    counts = []
+    real = design.classify_vertices
+
+    def counting(mesh, rounding, res, vertices=None, *args, **kwargs):
+        counts.append(mesh.n_vertices if vertices is None else len(vertices))
+        return real(mesh, rounding, res, vertices, *args, **kwargs)
+
+    monkeypatch.setattr(design, "classify_vertices", counting)
+    d = filletfold.round_mesh("torus")
+    assert counts == [d.mesh.n_vertices]
+    saddles = [u for u, s in enumerate(d.vertices.status) if s == "saddle"]
+    assert len(saddles) == 24
+    ends = d.mesh.edges
+    lone = [u for u in saddles if (d.rounding.radius[(ends == u).any(axis=1)] == 0).all()]
+    assert lone, "the torus has saddles whose edges are all left unrounded"
+    for u in saddles:
+        assert d.vertices.treatment[u] == "sharp"
+        assert d.vertices.reason[u].startswith("saddle vertex: no plane through it")
+        assert d.vertices.reason[u].endswith("; kept sharp (its corner, no hole)")
+    assert d.certificate.ok

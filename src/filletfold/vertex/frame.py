@@ -649,6 +649,45 @@ def _halfedge_ids(mesh: PolyMesh, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.where(keys[i] == k, mesh._he_order[i], -1)
 
 
+def closed_ring_sides(mesh: PolyMesh, verts):
+    """The sides of the closed rings among ``verts``, without their frames: what telling a
+    saddle apart needs (:func:`~filletfold.vertex.solve.saddle_vertices`), as
+    :func:`vertex_frames` finds it (rings in the same order, from the same walks).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    verts : (n,) int
+
+    Returns
+    -------
+    closed : (c,) int
+        The positions in ``verts`` of the closed rings.
+    R : (P, 3) float
+        Each side's :attr:`Side.R` (unit, from its neighbour to the vertex), rings one after
+        another.
+    edge, face : (P,) int
+        Each side's edge and the ring face after it (``e_i``, ``f_i``).
+    count : (c,) int
+        Sides per closed ring.
+
+    Raises
+    ------
+    MeshError
+        As :func:`vertex_frames`.
+    """
+    verts = np.asarray(verts, dtype=np.int64).reshape(-1)
+    he, nf, _, closed = _ring_walks(mesh, verts)
+    idx = np.flatnonzero(closed)
+    count = nf[idx]
+    sv = np.repeat(idx, count)
+    sp = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    h = he[sv, sp]
+    d = mesh.vertices[verts][sv] - mesh.vertices[mesh.halfedge_to[h]]
+    R = d / norm_rows(d)[:, None]
+    return idx, R, mesh.halfedge_edge[h], mesh.halfedge_face[h], count
+
+
 def _ring_walks(mesh: PolyMesh, verts: np.ndarray):
     """Walk the rings of many vertices at once, as :meth:`PolyMesh.vertex_ring` does one by one.
 

@@ -99,6 +99,34 @@ def sharp_kind(status: str) -> str | None:
     return None
 
 
+def unround_between(
+    mesh: PolyMesh,
+    rounding: EdgeRounding,
+    centres: np.ndarray,
+    sharp: np.ndarray,
+    face_centres,
+    flat_deg: float,
+    floor: float,
+    min_width: float,
+) -> tuple[EdgeRounding, np.ndarray, np.ndarray]:
+    """Leave every rounded edge between two ``sharp`` vertices unrounded (a straight crease).
+
+    Returns the rounding and face piece centres afterwards (the same objects when no edge
+    changed) and which edges changed, (n_edges,) bool. ``face_centres``, ``flat_deg``,
+    ``floor`` and ``min_width`` as :func:`~filletfold.vertex.rescue.reround` takes them.
+    """
+    ends = mesh.edges
+    both = sharp[ends[:, 0]] & sharp[ends[:, 1]] & (rounding.radius > 0)
+    if not both.any():
+        return rounding, centres, both
+    radius = rounding.radius.copy()
+    radius[both] = 0.0
+    _, rounding, centres = reround(
+        mesh, radius, rounding.half_angle, face_centres, flat_deg, floor, min_width
+    )
+    return rounding, centres, both
+
+
 @dataclass
 class Sharpening:
     """What :func:`sharpen_vertices` did.
@@ -135,7 +163,6 @@ def sharpen_vertices(
     progress=None,
     classified: VertexResult | None = None,
     sharp: np.ndarray | None = None,
-    solve: bool = True,
     cuts: dict | None = None,
 ) -> tuple[EdgeRounding, np.ndarray, Sharpening]:
     """Make the cone-less vertices of ``kinds`` sharp and solve their neighbours again.
@@ -168,10 +195,6 @@ def sharpen_vertices(
     sharp : (n_vertices,) bool, optional
         Vertices already sharp (their frames built so): they stay sharp and keep their
         reasons. Default: none.
-    solve : bool
-        False: only classify the neighbours again, with their sides toward the sharp vertices
-        conical, and leave their apices to the caller (status ``""``): the saddles, known
-        before any apex, are made sharp so, and their neighbours are solved once.
     cuts : dict, optional
         The samples earlier solves added (:func:`~filletfold.vertex.solve.solve_apices`).
 
@@ -201,15 +224,9 @@ def sharpen_vertices(
             break
         out.rounds += 1
         sharp[new] = True
-        changed = np.zeros(mesh.n_edges, dtype=bool)
-        both = sharp[ends[:, 0]] & sharp[ends[:, 1]] & (rounding.radius > 0)
-        if both.any():  # a straight crease between two sharp vertices
-            radius = rounding.radius.copy()
-            radius[both] = 0.0
-            _, rounding, centres = reround(
-                mesh, radius, rounding.half_angle, face_centres, flat_deg, floor, min_width
-            )
-            changed = both
+        rounding, centres, changed = unround_between(
+            mesh, rounding, centres, sharp, face_centres, flat_deg, floor, min_width
+        )
         # the vertices whose sides changed: neighbours of the new sharp vertices, and every
         # vertex of a face whose piece (and centre) changed with an unrounded edge
         near = np.zeros(n, dtype=bool)
@@ -233,7 +250,7 @@ def sharpen_vertices(
         todo = [int(u) for u in again if res.status[u] == ""]
         for u in np.flatnonzero(sharp).tolist():
             apices.pop(u, None)
-        if todo and solve:
+        if todo:
             solved = solve_apices(
                 {u: frames[u] for u in todo}, depths, res, centres, progress, todo, size=size,
                 cuts=cuts,
@@ -241,5 +258,10 @@ def sharpen_vertices(
             apices.update(solved)
         out.resolved.update(int(u) for u in again)
     for u in np.flatnonzero(sharp & ~initial).tolist():
-        res.reason[u] = (res.reason[u] or "no cone") + "; kept sharp (its corner, no hole)"
+        res.reason[u] = kept_sharp(res.reason[u])
     return rounding, centres, out
+
+
+def kept_sharp(reason: str) -> str:
+    """The reason of a vertex without a cone, once it is made sharp."""
+    return (reason or "no cone") + "; kept sharp (its corner, no hole)"

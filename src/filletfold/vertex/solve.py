@@ -22,7 +22,7 @@ from .apex import (
     validate_apices,
 )
 from .batch import solve_apex_batch
-from .frame import VertexFrame, developed_apices, vertex_frames
+from .frame import VertexFrame, closed_ring_sides, developed_apices, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
 from .settings import START_PARALLEL
@@ -182,13 +182,12 @@ def classify_vertices(
     sides = [frames[k].arrays for k in closed]
     count = np.array([len(a.arc) for a in sides], dtype=np.int64)
     edges = np.concatenate([a.edge for a in sides])
-    row = np.repeat(np.arange(len(closed)), count)
-    col = np.arange(len(row)) - np.repeat(np.cumsum(count) - count, count)
-    edge_dir = np.zeros((len(closed), int(count.max()), 3))
-    face_normal = np.zeros_like(edge_dir)
-    edge_dir[row, col] = np.concatenate([a.R for a in sides])
-    face_normal[row, col] = mesh.face_normal[np.concatenate([frames[k].ring.faces for k in closed])]
-    D, bound, sigma = vertex_normals(edge_dir, face_normal, count, count)
+    D, bound, sigma = _ring_normals(
+        mesh,
+        np.concatenate([a.R for a in sides]),
+        np.concatenate([frames[k].ring.faces for k in closed]),
+        count,
+    )
     u_closed = verts[closed]
     res.normal[u_closed], res.normal_bound[u_closed], res.sigma[u_closed] = D, bound, sigma
     res.solid_angle[u_closed] = solid_angles_front(
@@ -225,13 +224,50 @@ def classify_vertices(
                 )
         elif b <= tol.normal_bound:
             res.kind[u] = res.status[u] = "saddle"
-            res.reason[u] = (
-                f"saddle vertex: no plane through it has all its faces on one side "
-                f"(max-min bound {b:.3g} <= 0); no cone possible"
-            )
+            res.reason[u] = saddle_reason(b)
         else:
             res.kind[u] = "cone"
     return frames
+
+
+def saddle_reason(bound: float) -> str:
+    """Why a saddle vertex has no cone, given its max-min bound."""
+    return (
+        f"saddle vertex: no plane through it has all its faces on one side "
+        f"(max-min bound {bound:.3g} <= 0); no cone possible"
+    )
+
+
+def _ring_normals(mesh: PolyMesh, R: np.ndarray, faces: np.ndarray, count: np.ndarray):
+    """:func:`~filletfold.vertex.normal.vertex_normals` of closed rings given flat: their
+    sides' directions ``R`` (P, 3) and faces (P,), ``count`` (c,) per ring. Returns the
+    normals, max-min bounds and sides (sigma) of the rings."""
+    row = np.repeat(np.arange(len(count)), count)
+    col = np.arange(len(row)) - np.repeat(np.cumsum(count) - count, count)
+    edge_dir = np.zeros((len(count), int(count.max()), 3))
+    face_normal = np.zeros_like(edge_dir)
+    edge_dir[row, col] = R
+    face_normal[row, col] = mesh.face_normal[faces]
+    return vertex_normals(edge_dir, face_normal, count, count)
+
+
+def saddle_vertices(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
+    """(n_vertices,) bool: the vertices :func:`classify_vertices` calls saddles (a closed ring
+    with a rounded edge, an angle sum away from 2 pi and no plane through the vertex with all
+    its faces on one side), found from the mesh and the radii alone, before any frame: the
+    saddles are made sharp before the frames are built, so that their neighbours' frames are
+    built once (:func:`~filletfold.vertex.sharpen.unround_between`).
+    """
+    out = np.zeros(mesh.n_vertices, dtype=bool)
+    closed, R, edge, face, count = closed_ring_sides(mesh, np.arange(mesh.n_vertices))
+    if not len(closed):
+        return out
+    _, bound, _ = _ring_normals(mesh, R, face, count)
+    start = np.cumsum(count) - count
+    rounded = np.maximum.reduceat(np.where(rounding.radius[edge] > 0, 1, 0), start) > 0
+    developable = is_developable(mesh.vertex_angle_sum[closed])
+    out[closed] = rounded & ~developable & (bound <= tol.normal_bound)
+    return out
 
 
 def _opens_with_a_near_apex(frame: VertexFrame) -> bool:
