@@ -60,9 +60,9 @@ import shapely
 from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
-from .export.fold_read import _edge_faces, read_fold_document
+from .export.fold_read import read_fold_document
 from .layout.convex import BoxGrid
-from .surface.pattern import CreasePattern, face_arrays
+from .surface.pattern import CreasePattern, edge_faces_of, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
 
@@ -434,7 +434,7 @@ class _Data:
             raise ParameterError(f"pattern edges refer to a vertex outside 0..{n - 1}")
         ef = pattern.edge_faces
         if ef is None:
-            ef = _edge_faces(e, pattern.faces, n)
+            ef = edge_faces_of(e, pattern.faces, n)
         try:
             self.edge_faces = np.asarray(ef, dtype=np.int64).reshape(len(e), 2)
         except (TypeError, ValueError) as exc:

@@ -347,11 +347,11 @@ def test_a_fillet_of_one_triangle_has_its_rulings_at_its_tapered_corner():
     inner side to find its rulings' meeting point by: they are its two sides at the corner
     opposite its shortest side. (Least squares over all three sides found no ruling, and the
     simulator file failed with an IndexError.)"""
-    from filletfold.export.simulator import _edge_faces_of, _ruled_strips, _split_faces
+    from filletfold.export.simulator import _ruled_strips, _split_faces
 
     pattern = design_of("blob").pattern
     faces = _split_faces(pattern)
-    strips = list(_ruled_strips(pattern, faces, _edge_faces_of(pattern, faces)))
+    strips = list(_ruled_strips(pattern, faces, pattern.faces_beside_edges()))
     single = [
         s
         for s in strips

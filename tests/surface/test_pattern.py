@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from filletfold.surface.pattern import CreasePattern, face_arrays
+from filletfold.surface.pattern import CreasePattern, edge_faces_of, face_arrays
 
 from ..conftest import design_of
 
@@ -95,3 +95,21 @@ def test_cut_mask_treats_minus_zero_as_zero():
     p = CreasePattern(v2, v3, [[0, 1, 2], [3, 4, 5]], ["face 0", "face 1"], [0, 1], [0, 1])
     assert np.array_equal(p.cut_mask(), reference_cut_mask(p))
     assert p.cut_mask().sum() == 2
+
+
+@pytest.mark.parametrize("name", ["cube", "torus"])
+def test_edge_faces_of_finds_the_faces_the_pattern_derived(name):
+    """edge_faces_of (what a pattern read from a file is given) agrees with the faces a
+    pattern found beside its own edges; an edge given the other way round has them swapped,
+    an edge no face has gets -1 on both sides."""
+    p = design_of(name).pattern
+    n = len(p.vertices_2d)
+    assert np.array_equal(edge_faces_of(p.edges, p.faces, n), p.edge_faces)
+    assert np.array_equal(edge_faces_of(p.edges[:, ::-1], p.faces, n), p.edge_faces[:, ::-1])
+    assert edge_faces_of([[0, n - 1]], [], n).tolist() == [[-1, -1]]
+    read = CreasePattern(
+        p.vertices_2d, p.vertices_3d, p.faces, p.face_patch, p.face_piece, p.piece_vertex,
+        edges=p.edges, edge_assignment=p.edge_assignment, edge_fold_angle=p.edge_fold_angle,
+    )  # fmt: skip
+    assert read.edge_faces is None
+    assert np.array_equal(read.faces_beside_edges(), p.edge_faces)

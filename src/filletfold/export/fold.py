@@ -216,12 +216,7 @@ def edge_dihedrals(pattern: CreasePattern) -> np.ndarray:
     (m,) float
     """
     edges = np.asarray(pattern.edges, dtype=np.int64).reshape(-1, 2)
-    ef = pattern.edge_faces
-    if ef is None:  # a pattern read from a file
-        from .fold_read import _edge_faces
-
-        ef = _edge_faces(edges, list(pattern.faces), len(pattern.vertices_2d))
-    ef = np.asarray(ef, dtype=np.int64).reshape(-1, 2)
+    ef = pattern.faces_beside_edges()
     out = np.full(len(edges), np.nan)
     inner = (ef >= 0).all(axis=1)
     if not inner.any():

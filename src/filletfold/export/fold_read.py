@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ExportError, MeshReadError
-from ..surface.pattern import Annotations, CreasePattern, Label, LabelRows
+from ..surface.pattern import Annotations, CreasePattern, Label, LabelRows, edge_faces_of
 from ..surface.validate import validate_pattern
 from .fold import ANNOTATIONS_FILE, NAMESPACE, design_counts
 
@@ -188,7 +188,7 @@ def pattern_from_fold(doc: dict) -> CreasePattern:
         validate_pattern(pattern)
     except ExportError as exc:
         raise MeshReadError(f"not a valid filletfold design: {exc}") from None
-    pattern.edge_faces = _edge_faces(pattern.edges, pattern.faces, len(v2))
+    pattern.edge_faces = edge_faces_of(pattern.edges, pattern.faces, len(v2))
     return pattern
 
 
@@ -202,30 +202,6 @@ def _folded_frame(doc: dict) -> dict:
     if not frames:
         raise MeshReadError("not a filletfold FOLD file: no frame of file_frames has coordinates")
     return frames[0]
-
-
-def _edge_faces(edges: np.ndarray, faces: list, n: int) -> np.ndarray:
-    """(m, 2) int: the face on each edge's ``a -> b`` side, then on its ``b -> a`` side."""
-    ef = -np.ones((len(edges), 2), dtype=np.int64)
-    if not len(faces) or not len(edges):
-        return ef
-    sizes = np.array([len(f) for f in faces])
-    a = np.concatenate(faces).astype(np.int64)
-    start = np.concatenate([[0], np.cumsum(sizes)])
-    nxt = np.arange(len(a)) + 1
-    nxt[start[1:] - 1] = start[:-1]
-    b = a[nxt]
-    face_of = np.repeat(np.arange(len(faces)), sizes)
-    lo, hi = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
-    keys = lo * n + hi
-    order = np.argsort(keys)
-    hkey = np.minimum(a, b) * n + np.maximum(a, b)
-    pos = np.clip(np.searchsorted(keys[order], hkey), 0, len(keys) - 1)
-    found = keys[order][pos] == hkey
-    e = order[pos[found]]
-    side = (a[found] != edges[e, 0]).astype(np.int64)
-    ef[e, side] = face_of[found]
-    return ef
 
 
 def _annotations(data, where: str = NAMESPACE + "annotations") -> Annotations:

@@ -216,16 +216,6 @@ def _components(n_faces: int, pairs: np.ndarray) -> np.ndarray:
     return np.array([find(i) for i in range(n_faces)], dtype=np.int64)
 
 
-def _edge_faces_of(pattern: CreasePattern, faces: list[np.ndarray]) -> np.ndarray:
-    """(m, 2) the faces beside each pattern edge (derived when the pattern has none)."""
-    ef = pattern.edge_faces
-    if ef is None:  # a pattern read from a file
-        from .fold_read import _edge_faces
-
-        ef = _edge_faces(pattern.edges, faces, len(pattern.vertices_2d))
-    return np.asarray(ef, dtype=np.int64).reshape(-1, 2)
-
-
 def _split_faces(pattern: CreasePattern) -> list[np.ndarray]:
     """The faces of ``pattern`` as a list of int arrays."""
     flat, start = face_arrays(pattern.faces)
@@ -328,7 +318,7 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
     the rest are collapsed again without them, until no face is broken.
     """
     faces = _split_faces(pattern)
-    edge_faces = _edge_faces_of(pattern, faces)
+    edge_faces = pattern.faces_beside_edges()
     n = len(pattern.vertices_2d)
     v2 = pattern.vertices_2d
     proposals = []  # per strip: the pairs of points that become one
@@ -978,7 +968,7 @@ def simulator_pattern(
     face_of = np.repeat(np.arange(len(faces)), np.diff(start))
     droppable = np.ones(n, dtype=bool)
     droppable[flat[~ruled[face_of]]] = False
-    edge_faces = _edge_faces_of(pattern, faces)
+    edge_faces = pattern.faces_beside_edges()
     dihedral = np.nan_to_num(edge_dihedrals(pattern))
     gone = _dropped_rulings(pattern, faces, edge_faces, dihedral, droppable, max_turn, min_angle)
     gone |= _dropped_crease_points(pattern, faces, min_angle)

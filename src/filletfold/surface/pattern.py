@@ -216,6 +216,39 @@ def face_arrays(faces) -> tuple[np.ndarray, np.ndarray]:
     return flat, start
 
 
+def edge_faces_of(edges: np.ndarray, faces, n_vertices: int) -> np.ndarray:
+    """(m, 2) int: the face on each edge's ``a -> b`` side, then the one on its ``b -> a``
+    side (-1 where there is none): the faces beside given edges, as
+    :attr:`CreasePattern.edge_faces` holds them (a pattern read from a file is given its own so).
+
+    Parameters
+    ----------
+    edges : (m, 2) int
+    faces : FlatFaces, or list of (k,) int
+    n_vertices : int
+    """
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    ef = -np.ones((len(edges), 2), dtype=np.int64)
+    if not len(faces) or not len(edges):
+        return ef
+    a, start = face_arrays(faces)
+    nxt = np.arange(len(a)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    b = a[nxt]
+    face_of = np.repeat(np.arange(len(start) - 1), np.diff(start))
+    n = n_vertices
+    lo, hi = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
+    keys = lo * n + hi
+    order = np.argsort(keys)
+    hkey = np.minimum(a, b) * n + np.maximum(a, b)
+    pos = np.clip(np.searchsorted(keys[order], hkey), 0, len(keys) - 1)
+    found = keys[order][pos] == hkey
+    e = order[pos[found]]
+    side = (a[found] != edges[e, 0]).astype(np.int64)
+    ef[e, side] = face_of[found]
+    return ef
+
+
 @dataclass
 class Label:
     """A text placed on the flat layout (part numbers, glue-tab matches, fold angles).
@@ -427,6 +460,13 @@ class CreasePattern:
         self.edge_assignment[e] = np.where(theta[fold] > 0, "M", "V")
         self.edge_fold_angle[e] = -theta[fold]
         return len(e)
+
+    def faces_beside_edges(self) -> np.ndarray:
+        """(n_edges, 2) int: :attr:`edge_faces`, or (a pattern made without them) the faces
+        beside :attr:`edges` found from the faces (:func:`edge_faces_of`)."""
+        if self.edge_faces is not None:
+            return np.asarray(self.edge_faces, dtype=np.int64).reshape(-1, 2)
+        return edge_faces_of(self.edges, self.faces, len(self.vertices_2d))
 
     def _convexity(self, na: np.ndarray, nb: np.ndarray, edges: np.ndarray) -> np.ndarray:
         """(k,) the signed angle (degrees) from the folded normal ``na`` of the face holding
