@@ -157,9 +157,9 @@ import time
 t0 = time.perf_counter()
 import numba
 t1 = time.perf_counter()
-from filletfold.vertex import batch
+from filletfold.vertex import rows as r
 from filletfold.vertex.batch_kernel import interior_point_numba
-rows = batch.pack([(__import__('numpy').array([1.0, 2.0]), __import__('numpy').eye(2, 3),
+rows = r.pack([(__import__('numpy').array([1.0, 2.0]), __import__('numpy').eye(2, 3),
                     __import__('numpy').zeros(2))], 3)
 import numpy as np
 t2 = time.perf_counter()

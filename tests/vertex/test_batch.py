@@ -19,15 +19,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from filletfold.vertex import batch
-from filletfold.vertex.batch import (
-    pack,
-    pack_problems,
-    phase1_lp,
-    rows_of,
-    solve_apex,
-    solve_apex_batch,
-)
+from filletfold.vertex.batch import phase1_lp, solve_apex, solve_apex_batch
 from filletfold.vertex.reference import project_slsqp, solve_apex_slsqp
+from filletfold.vertex.rows import pack, pack_problems, rows_of
 from filletfold.vertex.solve import apex_problems
 
 from ..conftest import design_of, first_attempts, objective, random_convex

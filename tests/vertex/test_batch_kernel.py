@@ -204,9 +204,9 @@ def test_import_without_numba():
     code = (
         "import sys; sys.modules['numba'] = None\n"
         "import numpy as np\n"
-        "from filletfold.vertex import batch, batch_kernel as k\n"
+        "from filletfold.vertex import batch, batch_kernel as k, rows as r\n"
         "assert not k.AVAILABLE\n"
-        "rows = batch.pack([(np.array([1.0, 2.0]), np.array([[1.0, 0, 0], [0, 1.0, 0]]),"
+        "rows = r.pack([(np.array([1.0, 2.0]), np.array([[1.0, 0, 0], [0, 1.0, 0]]),"
         " np.zeros(2))], 3)\n"
         "y, conv = k.interior_point_numba(rows, np.full(3, 2.0), np.array([[1.0, 1.0, 1.0]]),"
         " np.zeros((1, 3)))\n"

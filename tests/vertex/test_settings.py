@@ -11,7 +11,8 @@ import pytest
 
 from filletfold.tolerances import tol
 from filletfold.vertex import batch, settings
-from filletfold.vertex.batch import interior_point_numpy, pack
+from filletfold.vertex.batch import interior_point_numpy
+from filletfold.vertex.rows import pack
 
 from ..conftest import first_attempts
 

@@ -128,7 +128,7 @@ class ApexConstraints:
         dn = crease_denominator(V, vi, self.quad_M, self.quad_R)
         quad = (self.quad_sign * num - self.quad_coef * dn) / self.scale + self.quad_const
         # einsum, not BLAS: the same sums as the rows of many problems together
-        # (batch.pack_problems)
+        # (rows.pack_problems)
         return np.concatenate([quad, np.einsum("ij,j->i", self.lin_a, V) + self.lin_b])
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:

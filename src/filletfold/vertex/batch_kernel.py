@@ -36,7 +36,7 @@ the rule for dropping finished problems, which changes nothing for a problem tha
 
 The kernel has no copy of the crease formula of eq. (1) (:mod:`filletfold.vertex.crease`):
 it receives every constraint row already evaluated about the target, as
-``a + A . y + alpha (y . e y)`` (:func:`filletfold.vertex.batch.pack_problems`), which is exact
+``a + A . y + alpha (y . e y)`` (:func:`filletfold.vertex.rows.pack_problems`), which is exact
 for those rows because the charts are rigid (tests/vertex/test_batch.py checks the rows
 against :meth:`~filletfold.vertex.apex.ApexConstraints.values` away from the target).
 
@@ -80,7 +80,7 @@ except ImportError:  # pragma: no cover - exercised only without numba
 
 
 if TYPE_CHECKING:
-    from .batch import RowBlock
+    from .rows import RowBlock
 
 #: LLVM fast-math flags of the row loops: reassociation (vectorised sums), contraction (fused
 #: multiply-add), reciprocals and signed zeros; not the ones that assume no NaN or infinity.
