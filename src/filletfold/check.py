@@ -62,6 +62,7 @@ from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
 from .export.fold_read import read_fold_document
 from .layout.convex import BoxGrid
+from .mesh.measures import newell_vectors
 from .surface.pattern import CreasePattern, edge_faces_of, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
@@ -779,9 +780,7 @@ def _holes(g: _Data) -> Check:
 def _face_newell(g: _Data) -> tuple[np.ndarray, np.ndarray]:
     """(n_faces, 3) Newell vectors (twice the vector area) and (n_faces,) perimeters, in 3D."""
     p = g.v3[g.flat]
-    centre = np.add.reduceat(p, g.start[:-1], axis=0) / g.size_of[:, None]
-    qc = p - np.repeat(centre, g.size_of, axis=0)
-    newell = np.add.reduceat(np.cross(qc, qc[g.nxt]), g.start[:-1], axis=0)
+    newell = newell_vectors(p, g.start, g.nxt)
     side = np.linalg.norm(p[g.nxt] - p, axis=1)
     return newell, np.add.reduceat(side, g.start[:-1])
 

@@ -94,3 +94,20 @@ def test_faces_used_twice_in_one_direction_are_named():
         PolyMesh(np.vstack([v, [[1.0, 1.0, 1.0]]]), [[0, 1, 2], [0, 1, 3]])
     with pytest.raises(MeshError, match="fewer than 3 vertices"):
         PolyMesh(v, [[0, 1]])
+
+
+def test_newell_vectors_are_twice_the_vector_areas_about_the_centroid():
+    """newell_vectors (the one definition the mesh, its repair and the certificate share):
+    twice a polygon's vector area, the same however far the polygon is moved."""
+    from filletfold.mesh.measures import newell_vectors
+
+    square = np.array([[0.0, 0, 0], [2, 0, 0], [2, 1, 0], [0, 1, 0]])
+    tri = np.array([[0.0, 0, 0], [0, 0, 3], [0, 1, 0]])
+    corners = np.vstack([square, tri])
+    start = np.array([0, 4, 7])
+    nxt = np.array([1, 2, 3, 0, 5, 6, 4])
+    got = newell_vectors(corners, start, nxt)
+    assert np.allclose(got, [[0, 0, 4.0], [-3.0, 0, 0]])
+    far = newell_vectors(corners + 1e6, start, nxt)
+    assert np.allclose(far, got, atol=1e-9)
+    assert newell_vectors(np.zeros((0, 3)), np.array([0]), np.zeros(0, dtype=int)).shape == (0, 3)

@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 from ..arrays import split_runs
 from ..errors import MeshError
 from ..tolerances import tol
+from .measures import newell_vectors
 from .polymesh import PolyMesh
 from .repair import (
     RepairLog,
@@ -464,10 +465,7 @@ class _Flat:
 
 def _face_newell(fl: _Flat, v: np.ndarray) -> np.ndarray:
     """(n_faces, 3) float: Newell vectors (twice the vector areas), computed about each centroid."""
-    p = v[fl.index]
-    centroid = np.add.reduceat(p, fl.start[:-1], axis=0) / fl.size[:, None]
-    p = p - centroid[fl.face]
-    return np.add.reduceat(np.cross(p, p[fl.next]), fl.start[:-1], axis=0)
+    return newell_vectors(v[fl.index], fl.start, fl.next)
 
 
 def _corner_angles(fl: _Flat, v: np.ndarray) -> np.ndarray:

@@ -19,6 +19,7 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import MeshError
+from .measures import newell_vectors
 
 
 @dataclass(frozen=True)
@@ -151,23 +152,16 @@ class PolyMesh:
     # ------------------------------------------------------------------ measures
     @cached_property
     def _face_newell(self) -> np.ndarray:
-        """(n_faces, 3) float: Newell vectors (twice the vector areas), about each centroid.
-
-        About the centroid, as :func:`~filletfold.mesh.repair.planarize` fits the planes and the
-        certificate measures them: about the origin the terms ``p x q`` are ``|p|^2`` large and
-        cancel down to twice the area, so a sliver far from the origin got a normal off its own
-        triangle's plane by ``|p|^2 eps / area`` (``2e-11`` rad at ``|p| = 16``, area ``4e-4``),
-        its chart's axes were not orthogonal to the cylinders' tangent lines by as much, and the
-        development's gluing maps shrank lengths by ``1e-11``.
+        """(n_faces, 3) float: Newell vectors (twice the vector areas), about each centroid
+        (:func:`~filletfold.mesh.measures.newell_vectors`, as
+        :func:`~filletfold.mesh.repair.planarize` fits the planes and the certificate measures
+        them: about the origin a sliver far from it got a normal off its own plane, its chart's
+        axes were not orthogonal to the cylinders' tangent lines by as much, and the
+        development's gluing maps shrank lengths by ``1e-11``).
         """
-        if not self.n_faces:
-            return np.zeros((0, 3))
-        size = np.diff(self.face_start)
-        p = self.vertices[self.halfedge_from]
-        centroid = np.add.reduceat(p, self.face_start[:-1], axis=0) / size[:, None]
-        c = np.repeat(centroid, size, axis=0)
-        q = self.vertices[self.halfedge_to] - c
-        return np.add.reduceat(np.cross(p - c, q), self.face_start[:-1], axis=0)
+        nxt = np.arange(len(self.halfedge_from)) + 1
+        nxt[self.face_start[1:] - 1] = self.face_start[:-1]
+        return newell_vectors(self.vertices[self.halfedge_from], self.face_start, nxt)
 
     @cached_property
     def face_normal(self) -> np.ndarray:
