@@ -62,7 +62,7 @@ from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
 from .export.fold_read import read_fold_document
 from .layout.convex import BoxGrid
-from .mesh.measures import newell_vectors
+from .mesh.measures import dihedral_turns, newell_vectors
 from .surface.pattern import CreasePattern, edge_faces_of, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
@@ -801,10 +801,7 @@ def _folded(g: _Data, which: np.ndarray):
         fa, fb = np.where(ef >= 0, ef, 0).T
         na, nb = unit[fa], unit[fb]
         d = g.v3[g.edges[which, 1]] - g.v3[g.edges[which, 0]]
-        d /= np.linalg.norm(d, axis=1)[:, None]
-        sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
-        cos = np.einsum("ij,ij->i", na, nb)
-        folded = -np.degrees(np.arctan2(sin, cos))  # FOLD's sign: valley positive
+        folded = -dihedral_turns(na, nb, d)  # FOLD's sign: valley positive
         slack = math.sqrt(3.0) * g.q * (2 * perimeter / norm)  # P / A, A = |newell| / 2
         allowed = ANGLE_TOL_DEG + np.degrees(slack[fa] + slack[fb])
     allowed = np.where(np.isfinite(allowed), allowed, np.inf)

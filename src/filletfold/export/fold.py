@@ -20,6 +20,7 @@ import numpy as np
 
 from ..arrays import split_runs
 from ..errors import ExportError, ParameterError
+from ..mesh.measures import dihedral_turns
 from ..surface.pattern import Annotations, CreasePattern, LabelRows, face_arrays
 from ..surface.validate import validated_faces
 from .paths import point_rows
@@ -225,10 +226,7 @@ def edge_dihedrals(pattern: CreasePattern) -> np.ndarray:
     # an edge lo -> hi is traversed forward by its first face, as CreasePattern orders them
     na, nb = normals[ef[inner, 0]], normals[ef[inner, 1]]
     d = pattern.vertices_3d[edges[inner, 1]] - pattern.vertices_3d[edges[inner, 0]]
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
-    cos = np.einsum("ij,ij->i", na, nb)
-    out[inner] = -np.degrees(np.arctan2(sin, cos))
+    out[inner] = -dihedral_turns(na, nb, d)
     return out
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["newell_vectors"]
+__all__ = ["dihedral_turns", "newell_vectors"]
 
 
 def newell_vectors(corners: np.ndarray, start: np.ndarray, nxt: np.ndarray) -> np.ndarray:
@@ -36,3 +36,14 @@ def newell_vectors(corners: np.ndarray, start: np.ndarray, nxt: np.ndarray) -> n
     centroid = np.add.reduceat(corners, start[:-1], axis=0) / size[:, None]
     q = corners - np.repeat(centroid, size, axis=0)
     return np.add.reduceat(np.cross(q, q[nxt]), start[:-1], axis=0)
+
+
+def dihedral_turns(na: np.ndarray, nb: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """(k,) float: the signed angle (degrees, in (-180, 180]) that turns each unit normal
+    ``na`` (k, 3) to ``nb`` about its edge's direction ``axis`` (k, 3; any length): positive
+    counter-clockwise seen from the tip of ``axis``. For the faces holding an edge ``a -> b``
+    and ``b -> a``, with ``axis = b - a``, it is positive where the surface is convex seen from
+    the front (a mountain); FOLD's fold angle is its negative."""
+    d = axis / np.linalg.norm(axis, axis=1)[:, None]
+    sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
+    return np.degrees(np.arctan2(sin, np.einsum("ij,ij->i", na, nb)))

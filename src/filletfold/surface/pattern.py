@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..arrays import split_runs
+from ..mesh.measures import dihedral_turns
 from ..tolerances import tol
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
@@ -473,9 +474,7 @@ class CreasePattern:
         each edge ``a -> b`` (``a < b``) to ``nb`` of the other, about the edge: > 0 where the
         surface is convex from the front (a mountain)."""
         d = self.vertices_3d[edges[:, 1]] - self.vertices_3d[edges[:, 0]]
-        d /= np.linalg.norm(d, axis=1)[:, None]
-        sin = np.einsum("ij,ij->i", np.cross(na, nb), d)
-        return np.degrees(np.arctan2(sin, np.einsum("ij,ij->i", na, nb)))
+        return dihedral_turns(na, nb, d)
 
     def _halfedges(self):
         """(from (h,), to (h,), face_start (n_faces + 1,), next (h,)) of the faces'
