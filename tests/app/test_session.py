@@ -17,15 +17,11 @@ from numpy.testing import assert_allclose
 
 from filletfold.app import session as session_mod
 from filletfold.app.session import AppSession, nearest_vertex_to_ray
-from filletfold.app.view import (
-    SCENE_WIDTH,
-    scene_arrays,
-    triangulate_faces,
-    triangulate_polygon,
-)
+from filletfold.app.view import SCENE_WIDTH, scene_arrays
 from filletfold.check import check_folder
 from filletfold.cli import main
 from filletfold.errors import MeshReadError, ParameterError
+from filletfold.surface.triangulate import triangulate_faces, triangulate_polygon_2d
 
 from ..conftest import design_of
 
@@ -227,7 +223,7 @@ def _area(p):
 )
 def test_triangulation_covers_the_polygon(poly):
     p = np.array(poly, dtype=float)
-    tris = triangulate_polygon(p)
+    tris = triangulate_polygon_2d(p)
     assert tris.shape == (len(p) - 2, 3)
     areas = [_area(p[t]) for t in tris]
     assert min(areas) > 0
@@ -259,12 +255,14 @@ def test_triangulate_faces_covers_every_face():
 @pytest.mark.parametrize("as_arrays", [False, True])
 def test_triangulate_faces_is_triangulate_polygon_face_by_face(as_arrays):
     """The triangles of every face, convex or not (resch has non-convex face shares), as
-    triangulate_polygon gives them, face after face; faces of fewer than 3 corners give none."""
+    triangulate_polygon_2d gives them, face after face; faces of fewer than 3 corners give none."""
     pattern = design_of("resch").pattern
     faces = [f if as_arrays else f.tolist() for f in pattern.faces[:600]]
     faces[3:3] = [faces[3][:2], faces[7][:1]]
     tris, owner = triangulate_faces(pattern.vertices_2d, faces)
-    want = [np.asarray(f)[triangulate_polygon(pattern.vertices_2d[f])] for f in faces if len(f) > 2]
+    want = [
+        np.asarray(f)[triangulate_polygon_2d(pattern.vertices_2d[f])] for f in faces if len(f) > 2
+    ]
     assert tris.dtype == np.int64 and np.array_equal(tris, np.vstack(want))
     sizes = np.array([len(f) for f in faces])
     assert np.array_equal(owner, np.repeat(np.arange(len(faces)), np.maximum(sizes - 2, 0)))

@@ -26,7 +26,7 @@ from filletfold.app.view import (
     legend_markdown,
     scene_arrays,
 )
-from filletfold.surface.triangulate import triangulate_faces, triangulate_polygon
+from filletfold.surface.triangulate import triangulate_faces, triangulate_polygon_2d
 
 from ..conftest import design_of, signed_area
 
@@ -85,7 +85,7 @@ def check_covers(poly: np.ndarray, tris: np.ndarray) -> None:
 def test_a_convex_polygon_becomes_a_fan(k):
     t = 2 * np.pi * np.arange(k) / k
     poly = np.c_[np.cos(t), np.sin(t)] * 3 + [1, -2]
-    tris = triangulate_polygon(poly)
+    tris = triangulate_polygon_2d(poly)
     check_covers(poly, tris)
     assert tris.tolist() == [[0, i, i + 1] for i in range(1, k - 1)]
 
@@ -103,7 +103,7 @@ def test_a_convex_polygon_becomes_a_fan(k):
 )
 def test_a_non_convex_polygon_is_covered_exactly(poly):
     p = np.array(poly, dtype=float)
-    check_covers(p, triangulate_polygon(p))
+    check_covers(p, triangulate_polygon_2d(p))
 
 
 @settings(max_examples=150, deadline=None)
@@ -111,12 +111,12 @@ def test_a_non_convex_polygon_is_covered_exactly(poly):
 def test_random_star_shaped_polygons_are_covered_exactly(k, seed, spread):
     rng = np.random.default_rng(seed)
     poly = star_polygon(rng, k, spread)
-    tris = triangulate_polygon(poly)
+    tris = triangulate_polygon_2d(poly)
     check_covers(poly, tris)
     # from any first corner, and moved and scaled: still a cover
     s = int(rng.integers(k))
-    check_covers(np.roll(poly, s, axis=0), triangulate_polygon(np.roll(poly, s, axis=0)))
-    check_covers(poly * 1e3 + 1e4, triangulate_polygon(poly * 1e3 + 1e4))
+    check_covers(np.roll(poly, s, axis=0), triangulate_polygon_2d(np.roll(poly, s, axis=0)))
+    check_covers(poly * 1e3 + 1e4, triangulate_polygon_2d(poly * 1e3 + 1e4))
 
 
 @settings(max_examples=50, deadline=None)
@@ -149,7 +149,6 @@ def test_triangulate_faces_covers_each_face(sizes, seed):
 def test_the_app_draws_the_library_triangulation():
     """The app has no triangulation of its own: it uses the one the writers use."""
     assert view.triangulate_faces is triangulate_faces
-    assert view.triangulate_polygon is triangulate_polygon
 
 
 def test_triangulate_faces_of_no_faces_and_of_small_ones():

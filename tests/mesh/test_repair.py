@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from filletfold.errors import MeshError
-from filletfold.mesh.repair import RepairLog, planarize, triangulate_polygon
+from filletfold.mesh.repair import RepairLog, planarize, triangulate_polygon_3d
 
 
 def quad_torus(na=13, nb=7, big=2.0, small=0.7):
@@ -115,7 +115,7 @@ def test_triangulating_a_simple_polygon_covers_it_exactly(n, seed):
     if not poly.is_valid or poly.area < 1e-6:
         return
     q, _ = np.linalg.qr(rng.normal(size=(3, 3)))  # the polygon in a plane of any direction
-    tris = triangulate_polygon(np.c_[p, np.zeros(n)] @ q.T + rng.normal(size=3))
+    tris = triangulate_polygon_3d(np.c_[p, np.zeros(n)] @ q.T + rng.normal(size=3))
     assert len(tris) == n - 2
     signed = [shapely.Polygon(p[list(t)]).exterior.is_ccw for t in tris]
     if np.linalg.det(q) > 0:  # counter-clockwise about the plane's normal, as the polygon

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..design import Design
-from ..surface.triangulate import triangulate_faces, triangulate_polygon  # noqa: F401 (re-exported)
+from ..surface.triangulate import triangulate_faces
 
 #: RGB (0..255) of each patch kind.
 PATCH_RGB = {

@@ -42,7 +42,7 @@ from .repair import (
     split_face_loops,
     split_non_manifold,
     triangulate_faces,
-    triangulate_polygon,
+    triangulate_polygon_3d,
 )
 
 logger = logging.getLogger(__name__)
@@ -1059,7 +1059,7 @@ def _remove_flat_vertices(face_list, face_origin, v, coplanar_deg):
         loop = _fan_boundary(u, [face_list[f].tolist() for f in fan])
         if loop is None:
             continue
-        tris = triangulate_polygon(v[loop])
+        tris = triangulate_polygon_3d(v[loop])
         new = {
             min(loop[t[i]], loop[t[i - 1]]) * base + max(loop[t[i]], loop[t[i - 1]])
             for t in tris

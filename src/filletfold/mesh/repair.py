@@ -706,7 +706,7 @@ def _pair_around_edge(hs, a, b, frm, face, start, size, v):
 
 
 # ------------------------------------------------------------------------- triangulation
-def triangulate_polygon(p: np.ndarray) -> list[tuple[int, int, int]]:
+def triangulate_polygon_3d(p: np.ndarray) -> list[tuple[int, int, int]]:
     """Triangles (local corner indices) of a polygon ``p`` (k, 3), counter-clockwise about its
     Newell normal: a constrained Delaunay triangulation of its projection (shapely), or a fan
     from the first corner when the projection is not a simple polygon."""
@@ -797,7 +797,7 @@ def triangulate_avoiding(f: np.ndarray, v: np.ndarray, used: set, base: int, new
     ``used`` (undirected edges as ``min * base + max``, see :func:`edge_keys`), which gets
     the diagonals chosen.
 
-    Tries :func:`triangulate_polygon`, then the fans from each corner whose triangles all face
+    Tries :func:`triangulate_polygon_3d`, then the fans from each corner whose triangles all face
     the polygon's way; when each of these reuses an edge (two polygons on the same pair of
     opposite corners: their triangles would be one doubled triangle), a fan around a new
     vertex ``new`` at the polygon's centroid. Two faces sharing a diagonal would make it an
@@ -823,7 +823,7 @@ def triangulate_avoiding(f: np.ndarray, v: np.ndarray, used: set, base: int, new
                 keys.add(min(a, b) * n + max(a, b))
         return keys - own
 
-    first = triangulate_polygon(p)
+    first = triangulate_polygon_3d(p)
     options = [first]
     if k > 3:
         axes = plane_axes(polygon_normal(p))

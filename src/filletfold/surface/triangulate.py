@@ -15,10 +15,10 @@ import numpy as np
 from ..tolerances import tol
 from .pattern import face_arrays
 
-__all__ = ["triangulate_faces", "triangulate_polygon"]
+__all__ = ["triangulate_faces", "triangulate_polygon_2d"]
 
 
-def triangulate_polygon(poly_2d: np.ndarray) -> np.ndarray:
+def triangulate_polygon_2d(poly_2d: np.ndarray) -> np.ndarray:
     """Triangles of a simple counter-clockwise polygon (ear clipping; a fan when convex).
 
     Parameters
@@ -66,7 +66,7 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
     """Triangles of many simple counter-clockwise polygons at once.
 
     Faces of one corner count are handled together: convex ones become fans in one array
-    operation, the others go through :func:`triangulate_polygon`. A face of ``k >= 3`` corners
+    operation, the others go through :func:`triangulate_polygon_2d`. A face of ``k >= 3`` corners
     gives ``k - 2`` triangles, placed face after face.
 
     Parameters
@@ -102,7 +102,7 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
         rows = t_start[which][:, None] + np.arange(k - 2)
         triangles[rows[convex]] = f[convex][:, fan]
         for row, at in zip(f[~convex], rows[~convex], strict=True):
-            triangles[at] = row[triangulate_polygon(p[row])]
+            triangles[at] = row[triangulate_polygon_2d(p[row])]
     return triangles, np.repeat(np.arange(len(sizes)), count)
 
 
