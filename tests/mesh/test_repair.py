@@ -118,8 +118,9 @@ def test_triangulating_a_simple_polygon_covers_it_exactly(n, seed):
     tris = triangulate_polygon_3d(np.c_[p, np.zeros(n)] @ q.T + rng.normal(size=3))
     assert len(tris) == n - 2
     signed = [shapely.Polygon(p[list(t)]).exterior.is_ccw for t in tris]
-    if np.linalg.det(q) > 0:  # counter-clockwise about the plane's normal, as the polygon
-        assert all(signed)
+    if np.linalg.det(q) > 0:  # turning about the plane's normal as the polygon does (its
+        # corners sorted by angle run clockwise when the origin is outside it)
+        assert all(s == poly.exterior.is_ccw for s in signed)
     areas = [shapely.Polygon(p[list(t)]).area for t in tris]
     assert min(areas) > 0
     assert sum(areas) == pytest.approx(poly.area, rel=1e-9)
