@@ -6,7 +6,7 @@ import itertools
 
 import numpy as np
 
-__all__ = ["split_runs"]
+__all__ = ["round_significant", "split_runs"]
 
 
 def split_runs(values: np.ndarray, cuts) -> list[np.ndarray]:
@@ -33,3 +33,13 @@ def split_runs(values: np.ndarray, cuts) -> list[np.ndarray]:
     if size[0] > 0 and (size == size[0]).all():
         return list(values.reshape(len(size), int(size[0]), *values.shape[1:]))
     return [values[a:b] for a, b in itertools.pairwise(bounds.tolist())]
+
+
+def round_significant(x: np.ndarray, digits: int) -> np.ndarray:
+    """``x`` (any shape, finite) with each value rounded to ``digits`` significant digits
+    as ``%g`` prints it (``-0.0`` becomes ``0.0``): what a file that holds ``x`` so gives its
+    reader."""
+    x = np.asarray(x, dtype=float)
+    flat = (x + 0.0).ravel().tolist()
+    text = (f"%.{int(digits)}g " * len(flat)) % tuple(flat)
+    return np.array(text.split(), dtype=float).reshape(x.shape) + 0.0

@@ -281,7 +281,8 @@ def test_fold_json_rejects(doc, match):
 def test_fold_facet_angles_are_written_on_a_nanodegree_grid():
     """F edges' dihedrals keep 9 decimals (degrees): within 5e-10 of the folded form's, no more
     digits; M and V angles keep their 12 significant digits."""
-    from filletfold.export.fold import _round, edge_dihedrals
+    from filletfold.export.fold import _round
+    from filletfold.surface.pattern import edge_dihedrals
 
     from ..conftest import design_of
 

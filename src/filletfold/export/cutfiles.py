@@ -9,7 +9,7 @@ format         files                            content
                ``annotations.json``             tabs, labels and sheets beside it
 ``simulator``  ``simulator.fold``,              FOLD 1.2 for Origami Simulator: the pattern
                ``simulator.svg``                coarsened and triangulated (see
-                                                :mod:`~filletfold.export.simulator`), and the
+                                                :mod:`~filletfold.surface.coarse`), and the
                                                 same in the simulator's SVG colours
 ``json``       ``report.json``                  the design report (needs the design, not only
                                                 the pattern)
@@ -63,7 +63,13 @@ from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows
 from ..surface.validate import validated_faces
 from ..units import check_units, sheet_size_mm
 from .dxf import check_scale, pattern_dxf
-from .fold import ANNOTATIONS_FILE, _fold_document, annotations_json, fold_json_chunks
+from .fold import (
+    ANNOTATIONS_FILE,
+    FOLD_DIGITS,
+    _fold_document,
+    annotations_json,
+    fold_json_chunks,
+)
 from .obj import _folded_obj
 from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
@@ -368,12 +374,12 @@ def cut_files(
 
     @functools.cache
     def coarse():
-        from .simulator import simulator_pattern
+        from ..surface.coarse import simulator_pattern
 
-        return simulator_pattern(pattern)
+        return simulator_pattern(pattern, digits=FOLD_DIGITS)  # fold angles as the file holds
 
     def simulator():
-        from .simulator import SIM_MAX_TURN, SIM_MIN_ANGLE
+        from ..surface.coarse import SIM_MAX_TURN, SIM_MIN_ANGLE
 
         settings = {"max_turn": SIM_MAX_TURN, "min_angle": SIM_MIN_ANGLE}
         doc = _fold_document(
@@ -388,7 +394,7 @@ def cut_files(
         return fold_json_chunks(doc)  # written a key at a time (lazy)
 
     def simulator_svg():
-        from .simulator import simulator_svg_pattern
+        from ..surface.coarse import simulator_svg_pattern
 
         drawn = scaled_pattern(simulator_svg_pattern(coarse()), scale)
         return _pattern_svg(drawn, units=units, preset="origami-simulator")

@@ -20,8 +20,7 @@ import numpy as np
 
 from ..arrays import split_runs
 from ..errors import ExportError, ParameterError
-from ..mesh.measures import dihedral_turns
-from ..surface.pattern import Annotations, CreasePattern, LabelRows, face_arrays
+from ..surface.pattern import Annotations, CreasePattern, LabelRows, edge_dihedrals, face_arrays
 from ..surface.validate import validated_faces
 from .paths import point_rows
 from .report import python_scalar
@@ -35,7 +34,6 @@ __all__ = [
     "annotations_document",
     "annotations_json",
     "design_counts",
-    "edge_dihedrals",
     "face_arrays",
     "file_creator",
     "fold_document",
@@ -98,7 +96,8 @@ def fold_document(
         Keys in a fixed order: file metadata, key-frame metadata, ``vertices_coords`` (n, 2),
         ``edges_vertices`` (m, 2), ``edges_assignment`` (m,), ``edges_foldAngle`` (m,) degrees
         (valley positive; ``null`` on borders, the folded form's dihedral on ``F`` edges, see
-        :func:`edge_dihedrals`, rounded to :data:`FOLD_ANGLE_DECIMALS`), ``faces_vertices``
+        :func:`~filletfold.surface.pattern.edge_dihedrals`, rounded to
+        :data:`FOLD_ANGLE_DECIMALS`), ``faces_vertices``
         (counter-clockwise),
         ``filletfold:faces_patch`` and ``filletfold:faces_piece`` (n_faces,),
         ``filletfold:pieces_vertex`` (n_pieces,),
@@ -199,40 +198,10 @@ def _fold_document(
     return doc
 
 
-def edge_dihedrals(pattern: CreasePattern) -> np.ndarray:
-    """(m,) the folded form's dihedral at every pattern edge, in FOLD's sign (valley positive).
-
-    The angle between the 3D normals of the edge's two faces, signed as
-    :class:`~filletfold.surface.pattern.CreasePattern` signs its creases; NaN on an edge with
-    fewer than two faces. On M and V edges it is ``pattern.edge_fold_angle``; on F edges it is
-    the small bend of a sampled cylinder or cone between two of its facets (the pattern itself
-    keeps 0 there).
-
-    Parameters
-    ----------
-    pattern : CreasePattern
-
-    Returns
-    -------
-    (m,) float
-    """
-    edges = np.asarray(pattern.edges, dtype=np.int64).reshape(-1, 2)
-    ef = pattern.faces_beside_edges()
-    out = np.full(len(edges), np.nan)
-    inner = (ef >= 0).all(axis=1)
-    if not inner.any():
-        return out
-    normals = pattern.face_normal_3d()
-    # an edge lo -> hi is traversed forward by its first face, as CreasePattern orders them
-    na, nb = normals[ef[inner, 0]], normals[ef[inner, 1]]
-    d = pattern.vertices_3d[edges[inner, 1]] - pattern.vertices_3d[edges[inner, 0]]
-    out[inner] = -dihedral_turns(na, nb, d)
-    return out
-
-
 def _fold_angle_data(pattern: CreasePattern, raw: bool) -> list | _Raw:
     """``edges_foldAngle``: M and V edges as the pattern has them, F edges the folded form's
-    dihedral (:func:`edge_dihedrals`) rounded to :data:`FOLD_ANGLE_DECIMALS`, B edges ``null``;
+    dihedral (:func:`~filletfold.surface.pattern.edge_dihedrals`) rounded to
+    :data:`FOLD_ANGLE_DECIMALS`, B edges ``null``;
     a list, or with ``raw`` JSON text."""
     angle = np.asarray(pattern.edge_fold_angle, dtype=np.float64).copy()
     assign = np.asarray(pattern.edge_assignment, dtype=str)
@@ -504,16 +473,6 @@ def _round(x: float) -> float:
         raise ExportError(f"FOLD values must be finite, got {x}")
     r = float(f"{x:.{FOLD_DIGITS}g}")
     return 0.0 if r == 0 else r
-
-
-def rounded(x: np.ndarray) -> np.ndarray:
-    """``x`` (any shape, finite) rounded as :func:`fold_json` writes it: each value to
-    :data:`FOLD_DIGITS` significant digits, so that what is derived from the rounded values
-    (a fold angle) is what a reader of the file measures."""
-    x = np.asarray(x, dtype=float)
-    flat = (x + 0.0).ravel().tolist()
-    text = (f"%.{FOLD_DIGITS}g " * len(flat)) % tuple(flat)
-    return np.array(text.split(), dtype=float).reshape(x.shape) + 0.0
 
 
 class _RaggedInts:

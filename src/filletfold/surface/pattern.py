@@ -250,6 +250,37 @@ def edge_faces_of(edges: np.ndarray, faces, n_vertices: int) -> np.ndarray:
     return ef
 
 
+def edge_dihedrals(pattern: CreasePattern) -> np.ndarray:
+    """(m,) the folded form's dihedral at every pattern edge, in FOLD's sign (valley positive).
+
+    The angle between the 3D normals of the edge's two faces, signed as
+    :class:`~filletfold.surface.pattern.CreasePattern` signs its creases; NaN on an edge with
+    fewer than two faces. On M and V edges it is ``pattern.edge_fold_angle``; on F edges it is
+    the small bend of a sampled cylinder or cone between two of its facets (the pattern itself
+    keeps 0 there).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+
+    Returns
+    -------
+    (m,) float
+    """
+    edges = np.asarray(pattern.edges, dtype=np.int64).reshape(-1, 2)
+    ef = pattern.faces_beside_edges()
+    out = np.full(len(edges), np.nan)
+    inner = (ef >= 0).all(axis=1)
+    if not inner.any():
+        return out
+    normals = pattern.face_normal_3d()
+    # an edge lo -> hi is traversed forward by its first face, as CreasePattern orders them
+    na, nb = normals[ef[inner, 0]], normals[ef[inner, 1]]
+    d = pattern.vertices_3d[edges[inner, 1]] - pattern.vertices_3d[edges[inner, 0]]
+    out[inner] = -dihedral_turns(na, nb, d)
+    return out
+
+
 @dataclass
 class Label:
     """A text placed on the flat layout (part numbers, glue-tab matches, fold angles).

@@ -1,4 +1,4 @@
-"""``simulator.fold`` and ``simulator.svg`` (:mod:`filletfold.export.simulator`): what Origami
+"""``simulator.fold`` and ``simulator.svg`` (:mod:`filletfold.surface.coarse`): what Origami
 Simulator needs, read back from the written files, on real designs. No browser: the checks are
 the geometric conditions the simulator's solver relies on, and the SVG read as the simulator's
 SVG import reads it."""
@@ -18,7 +18,7 @@ from scipy.spatial import cKDTree
 import filletfold
 from filletfold.errors import ParameterError
 from filletfold.export import cut_files
-from filletfold.export.simulator import (
+from filletfold.surface.coarse import (
     SIM_MAX_STRETCH,
     SIM_MIN_ANGLE,
     SIM_SVG_FLAT,
@@ -347,7 +347,7 @@ def test_a_fillet_of_one_triangle_has_its_rulings_at_its_tapered_corner():
     inner side to find its rulings' meeting point by: they are its two sides at the corner
     opposite its shortest side. (Least squares over all three sides found no ruling, and the
     simulator file failed with an IndexError.)"""
-    from filletfold.export.simulator import _ruled_strips, _split_faces
+    from filletfold.surface.coarse import _ruled_strips, _split_faces
 
     pattern = design_of("blob").pattern
     faces = _split_faces(pattern)
@@ -371,7 +371,7 @@ def test_a_fillet_of_one_triangle_has_its_rulings_at_its_tapered_corner():
 
 
 def test_outline_is_none_unless_the_faces_make_a_disc():
-    from filletfold.export.simulator import _outline
+    from filletfold.surface.coarse import _outline
 
     square = [np.array([0, 1, 2]), np.array([0, 2, 3])]
     assert _outline(square) == [0, 1, 2, 3]
@@ -385,7 +385,7 @@ def test_outline_is_none_unless_the_faces_make_a_disc():
 
 
 def test_triangles_refuse_what_would_be_broken():
-    from filletfold.export.simulator import _triangles, _triangulate
+    from filletfold.surface.coarse import _triangles, _triangulate
 
     v2 = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     v3 = np.c_[v2, np.zeros(4)]
@@ -405,7 +405,7 @@ def test_triangles_refuse_what_would_be_broken():
 def test_collapsed_strips_turn_no_face_over():
     """Collapsing every narrow strip of bunny-lowres at once turned faces over (two faces
     became one triangle, once each way round); the strips that would do it stay."""
-    from filletfold.export.simulator import _collapse_narrow, _split_faces
+    from filletfold.surface.coarse import _collapse_narrow, _split_faces
 
     pattern = _design("bunny-lowres").pattern
     collapsed = _collapse_narrow(pattern, SIM_MIN_ANGLE)
@@ -421,7 +421,7 @@ def test_crossing_groups_names_the_merged_group_whose_chord_crosses():
     """The guard in ``_merged_patches`` (no merge on the corpus needs it): a merged group's
     triangle whose side cuts across another group's is named; touching at a shared point,
     or an unmerged group crossing, is not."""
-    from filletfold.export.simulator import _crossing_groups
+    from filletfold.surface.coarse import _crossing_groups
 
     v2 = np.array([[0, 0], [4, 0], [2, 3], [2, 1], [5, 2], [5, 4], [4, 1]], dtype=float)
     merged = (0, [[0, 1, 2]], np.array([9]))

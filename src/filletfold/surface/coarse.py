@@ -1,5 +1,8 @@
 """A coarse, triangulated copy of a crease pattern for Origami Simulator (``simulator.fold``).
 
+A surface operation (the exports only write what it gives: ``export/cutfiles.py`` writes
+``simulator.fold`` and ``simulator.svg`` from it).
+
 Origami Simulator (https://origamisimulator.org) folds a FOLD file with a bar-and-hinge
 solver on the GPU. ``design.fold`` samples every cylinder arc finely, which the simulator
 reads badly: its shader takes ``acos`` of triangle angles unclamped (a sliver turns into NaN),
@@ -40,8 +43,9 @@ import math
 
 import numpy as np
 
+from ..arrays import round_significant
 from ..errors import ParameterError
-from ..surface.pattern import CreasePattern, face_arrays
+from .pattern import Annotations, CreasePattern, edge_dihedrals, face_arrays
 
 __all__ = [
     "SIM_MAX_TURN",
@@ -925,6 +929,7 @@ def simulator_pattern(
     *,
     max_turn: float = SIM_MAX_TURN,
     min_angle: float = SIM_MIN_ANGLE,
+    digits: int | None = None,
 ) -> CreasePattern:
     """A coarse triangulated copy of ``pattern`` that Origami Simulator folds.
 
@@ -939,6 +944,10 @@ def simulator_pattern(
         Smallest corner angle (degrees) that a cylinder cell is kept wide enough for; a
         cylinder narrower than that in one cell becomes a single crease (the points at each of
         its ends merged into their mean).
+    digits : int, optional
+        The significant digits of the file it goes to: its points are rounded so, before its
+        edges' fold angles are measured (a thin triangle's dihedral moves by micro-degrees
+        when its corners are rounded to the file's digits). None: not rounded.
 
     Returns
     -------
@@ -956,8 +965,6 @@ def simulator_pattern(
         raise ParameterError(f"max_turn must be in (0, 180], got {max_turn}", name="max_turn")
     if not 0 <= min_angle < 60:
         raise ParameterError(f"min_angle must be in [0, 60), got {min_angle}", name="min_angle")
-    from .fold import edge_dihedrals
-
     pattern = _collapse_narrow(pattern, min_angle)
     faces = _split_faces(pattern)
     flat, start = face_arrays(pattern.faces)
@@ -988,13 +995,11 @@ def simulator_pattern(
         annotations=pattern.annotations,
     )
     coarse = _clean_slivers(coarse, min_angle)
-    # the file's fold angles are measured on the coordinates it holds: a thin triangle's
-    # dihedral moves by micro-degrees when its corners are rounded to the file's digits
-    from .fold import rounded
-
+    if digits is None:
+        return coarse
     return CreasePattern(
-        rounded(coarse.vertices_2d),
-        rounded(coarse.vertices_3d),
+        round_significant(coarse.vertices_2d, digits),
+        round_significant(coarse.vertices_3d, digits),
         coarse.faces,
         coarse.face_patch,
         coarse.face_piece,
@@ -1154,9 +1159,6 @@ def simulator_svg_pattern(coarse: CreasePattern) -> CreasePattern:
         no annotations.
     """
     import dataclasses
-
-    from ..surface.pattern import Annotations
-    from .fold import edge_dihedrals
 
     pattern = _welded(coarse, SIM_SVG_WELD)
     assign = np.asarray(pattern.edge_assignment, dtype="<U1").copy()
