@@ -40,7 +40,7 @@ from .layout.fabrication import sheet_in_pattern_units
 from .layout.nest import choose_nester
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh, mesh_size
-from .rounding.conical import conical_material_loss, is_conical, use_cone_axes
+from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
 from .surface.assemble import locate_apices
@@ -66,6 +66,7 @@ from .vertex.solve import (
     saddle_reason,
     saddle_vertices,
     solve_apices,
+    use_cone_axes,
 )
 
 

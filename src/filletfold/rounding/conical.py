@@ -12,17 +12,12 @@ The axis is the vertex normal.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from ..mesh.polymesh import PolyMesh
 from ..tolerances import tol
 from .edges import edge_dihedral, radius_from_loss, tan_minus_angle
 from .material_loss import MaterialLoss, cycle_equalities
-
-if TYPE_CHECKING:
-    from ..vertex.solve import VertexResult
 
 
 def vertex_cone_axes(mesh: PolyMesh) -> tuple[np.ndarray, np.ndarray]:
@@ -152,21 +147,3 @@ def conical_material_loss(
             else "conical mesh: no positive face offset fits"
         ),
     ), delta
-
-
-def use_cone_axes(mesh: PolyMesh, frames: list, res: VertexResult) -> None:
-    """Make each cone vertex's normal its cone axis (conical meshes, sec. 4.4)."""
-    axis, _ = vertex_cone_axes(mesh)
-    for u, frame in enumerate(frames):
-        if res.kind[u] != "cone" or not np.all(np.isfinite(axis[u])):
-            continue
-        D = res.sigma[u] * axis[u]
-        dirs = np.vstack(
-            [
-                -np.array([s.R for s in frame.sides]),
-                res.sigma[u] * mesh.face_normal[frame.ring.faces],
-            ]
-        )
-        bound = float((dirs @ D).min())
-        if bound > tol.normal_bound:
-            res.normal[u], res.normal_bound[u] = D, bound

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..mesh.polymesh import PolyMesh, mesh_size
 from ..parallel import thread_map
+from ..rounding.conical import vertex_cone_axes
 from ..rounding.edges import EdgeRounding
 from ..tolerances import tol
 from . import batch
@@ -736,3 +737,21 @@ def _solve_round(
             if cuts is not None:
                 cuts[u] = cut_fractions(p.frame, p.extra)
             del pending[u]
+
+
+def use_cone_axes(mesh: PolyMesh, frames: list, res: VertexResult) -> None:
+    """Make each cone vertex's normal its cone axis (conical meshes, sec. 4.4)."""
+    axis, _ = vertex_cone_axes(mesh)
+    for u, frame in enumerate(frames):
+        if res.kind[u] != "cone" or not np.all(np.isfinite(axis[u])):
+            continue
+        D = res.sigma[u] * axis[u]
+        dirs = np.vstack(
+            [
+                -np.array([s.R for s in frame.sides]),
+                res.sigma[u] * mesh.face_normal[frame.ring.faces],
+            ]
+        )
+        bound = float((dirs @ D).min())
+        if bound > tol.normal_bound:
+            res.normal[u], res.normal_bound[u] = D, bound
