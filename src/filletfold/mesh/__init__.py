@@ -1,6 +1,7 @@
 """Stage 1, the mesh: reading (:mod:`.io`), built-in examples and tessellations
 (:mod:`.examples`, :mod:`.tessellations`), validation, cleaning and repair (:mod:`.clean`,
-:mod:`.repair`, :mod:`.intersect`) and half-edge connectivity (:mod:`.polymesh`).
+:mod:`.repair`, :mod:`.intersect`), half-edge connectivity (:mod:`.polymesh`) and the
+measures of polygons the stages share (:mod:`.measures`).
 
 :func:`load_mesh` is the one entry point front ends call: it accepts a file, a built-in example
 name, a ``(vertices, faces)`` pair or a :class:`PolyMesh`, and returns a cleaned mesh.

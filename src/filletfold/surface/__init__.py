@@ -4,4 +4,5 @@ folded positions, built for all vertices at once (:mod:`.module`; the fans of sh
 :mod:`.sharp`; :mod:`.piece`, :mod:`.faces`, :mod:`.overlap`, :mod:`.centres`), sampled so
 that no cone's facets fold by more than the arc step (:mod:`.sampling`), the crease
 pattern they assemble into (:mod:`.assemble`, :mod:`.pattern`), its validation
-(:mod:`.validate`) and the triangles of its faces (:mod:`.triangulate`)."""
+(:mod:`.validate`), the triangles of its faces (:mod:`.triangulate`) and its coarse copy for
+Origami Simulator (:mod:`.coarse`)."""
