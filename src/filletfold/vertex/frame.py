@@ -652,12 +652,8 @@ def _halfedge_ids(mesh: PolyMesh, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def closed_ring_sides(mesh: PolyMesh, verts):
     """The sides of the closed rings among ``verts``, without their frames: what telling a
     saddle apart needs (:func:`~filletfold.vertex.solve.saddle_vertices`), as
-    :func:`vertex_frames` finds it (rings in the same order, from the same walks).
-
-    Parameters
-    ----------
-    mesh : PolyMesh
-    verts : (n,) int
+    :func:`vertex_frames` finds it (rings in the same order, from the same walks), for the
+    vertices ``verts`` (n,) of ``mesh``.
 
     Returns
     -------
@@ -671,10 +667,7 @@ def closed_ring_sides(mesh: PolyMesh, verts):
     count : (c,) int
         Sides per closed ring.
 
-    Raises
-    ------
-    MeshError
-        As :func:`vertex_frames`.
+    Raises MeshError as :func:`vertex_frames` does.
     """
     verts = np.asarray(verts, dtype=np.int64).reshape(-1)
     he, nf, _, closed = _ring_walks(mesh, verts)
