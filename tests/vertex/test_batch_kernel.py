@@ -331,8 +331,12 @@ def test_the_kernel_cache_is_found_where_numba_writes_it(tmp_path, monkeypatch):
     assert not batch.kernel_cached()
     user = tmp_path / "user" / "numba" / "site-packages_filletfold_vertex"
     user.mkdir(parents=True)
-    (user / "batch_kernel._kernel-204.py311.nbi").write_bytes(b"")
+    index = user / "batch_kernel._kernel-204.py311.nbi"
+    index.write_bytes(b"")
     assert batch.kernel_cached()
+    # an index older than the source (a checkout or an upgrade changed it): compiled again
+    os.utime(copy, (index.stat().st_mtime + 10, index.stat().st_mtime + 10))
+    assert not batch.kernel_cached()
 
 
 def test_a_kernel_that_cannot_load_falls_back_to_numpy(monkeypatch):

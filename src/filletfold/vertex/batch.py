@@ -134,17 +134,27 @@ def kernel_cached() -> bool:
     """Whether numba's on-disk cache holds a compiled kernel (its index file for the kernel's
     entry point, in one of the places numba caches to: ``NUMBA_CACHE_DIR``, beside the source,
     or the user's cache folder when the source's is read-only): then loading it takes about
-    0.3-1 s; without it the first use compiles it (about 15 s). Looked up without importing
-    numba."""
+    0.3-1 s; without it the first use compiles it (about 15 s). An index older than the
+    kernel's source does not count: numba compiles again when the source changed (a
+    checkout, an upgrade), and rewrites the index then. Looked up without importing numba."""
     spec = importlib.util.find_spec(f"{__package__}.batch_kernel")
     if spec is None or spec.origin is None:
+        return False
+    try:
+        changed = Path(spec.origin).stat().st_mtime
+    except OSError:
         return False
     pattern = "batch_kernel._kernel-*.nbi"
     user = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     places = [Path(spec.origin).parent / "__pycache__", Path(user) / "numba"]
     if os.environ.get("NUMBA_CACHE_DIR"):
         places.insert(0, Path(os.environ["NUMBA_CACHE_DIR"]))
-    return any(next(p.rglob(pattern), None) is not None for p in places if p.is_dir())
+    return any(
+        index.stat().st_mtime >= changed
+        for place in places
+        if place.is_dir()
+        for index in place.rglob(pattern)
+    )
 
 
 def warm_kernel() -> bool:
