@@ -659,24 +659,9 @@ def round_mesh(
         # and classification of the vertices it classifies again in lists of this design's
         frames, classified = list(st.frames), copy.deepcopy(st.classified)
     else:
-        classified = VertexResult.empty(pm.n_vertices)
-        if "saddle" in kinds:
-            saddles = saddle_vertices(pm, rounding)
-        if saddles is not None and saddles.any():
-            # saddles are known before any frame: sharp from the start, so that every frame
-            # is built once, the neighbours' sides toward them conical
-            rounding, centres, _ = unround_between(
-                pm, rounding, centres, saddles, face_piece_centres, coplanar_deg, floor, min_width
-            )
-        else:
-            saddles = None
-        frames = classify_vertices(pm, rounding, classified, sharp=saddles)
-        for u in [] if saddles is None else np.flatnonzero(saddles).tolist():
-            # a saddle stays one, though its edges may all be unrounded now
-            classified.kind[u] = classified.status[u] = "saddle"
-            classified.reason[u] = saddle_reason(classified.normal_bound[u])
-        if conical:
-            use_cone_axes(pm, frames, classified)
+        rounding, centres, frames, classified, saddles = _classified(
+            pm, rounding, centres, "saddle" in kinds, conical, coplanar_deg, floor, min_width
+        )
     res = copy.deepcopy(classified)
     if saddles is not None:
         for u in np.flatnonzero(saddles).tolist():
@@ -819,6 +804,31 @@ def round_mesh(
         timings["certificate"] = time.perf_counter() - t
     timings["total"] = time.perf_counter() - t0
     return design
+
+
+def _classified(pm, rounding, centres, sharp_saddles, conical, coplanar_deg, floor, min_width):
+    """The vertex frames and classification of :func:`round_mesh` (every vertex classified
+    once). With ``sharp_saddles``, the saddles are known before any frame
+    (:func:`~filletfold.vertex.solve.saddle_vertices`) and made sharp from the start, their
+    shared edges unrounded, so that each frame is built once with the neighbours' sides
+    toward them conical. Returns the rounding, face piece centres, frames, classification and
+    the saddles made sharp ((n_vertices,) bool, or None)."""
+    classified = VertexResult.empty(pm.n_vertices)
+    saddles = saddle_vertices(pm, rounding) if sharp_saddles else None
+    if saddles is not None and saddles.any():
+        rounding, centres, _ = unround_between(
+            pm, rounding, centres, saddles, face_piece_centres, coplanar_deg, floor, min_width
+        )
+    else:
+        saddles = None
+    frames = classify_vertices(pm, rounding, classified, sharp=saddles)
+    for u in [] if saddles is None else np.flatnonzero(saddles).tolist():
+        # a saddle stays one, though its edges may all be unrounded now
+        classified.kind[u] = classified.status[u] = "saddle"
+        classified.reason[u] = saddle_reason(classified.normal_bound[u])
+    if conical:
+        use_cone_axes(pm, frames, classified)
+    return rounding, centres, frames, classified, saddles
 
 
 def _apices(
