@@ -83,6 +83,26 @@ def test_svg_groups_and_colours(name, counts):
         assert all(ln.get("stroke") == colour[gid] for ln in lines)
 
 
+def test_svg_chunks_are_the_document_a_group_at_a_time():
+    """pattern.svg is written from chunks (each group drawn when its turn comes): joined they
+    are pattern_svg's document, whole lines each, the header first and the legend (which
+    names every group drawn) last."""
+    from filletfold.export.svg import _pattern_svg_chunks
+
+    from ..conftest import design_of
+
+    pattern = design_of("cube").pattern
+    chunks = list(_pattern_svg_chunks(pattern, flat_edges=True))
+    assert "".join(chunks) == pattern_svg(pattern, flat_edges=True)
+    assert all(c.endswith("\n") for c in chunks) and len(chunks) > 10
+    assert chunks[0].startswith("<?xml") and chunks[-1] == "</svg>\n"
+    legend = "".join(
+        chunks[chunks.index('<g id="legend" font-family="sans-serif" fill="#000000">\n') :]
+    )
+    for label in ("mountain", "valley", "facet (flat)", "tab hinge"):
+        assert f">{label}</text>" in legend
+
+
 def test_svg_flat_edges_optional():
     root = _svg(strip_pattern(), flat_edges=False)
     assert not [g for g in root.iter(SVG_NS + "g") if g.get("id") == "flat"]

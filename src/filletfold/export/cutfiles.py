@@ -75,7 +75,7 @@ from .paths import pattern_extent
 from .pdf import REGION_PAD_MM, pattern_pdf
 from .png import parse_view, pattern_png, preview_png
 from .presets import Preset, get_preset
-from .svg import _pattern_svg
+from .svg import _pattern_svg_chunks
 
 __all__ = [
     "ALL_FORMATS",
@@ -317,8 +317,8 @@ def cut_files(
     lazy : bool
         Return, for each file, a function without arguments that builds its contents (for
         :func:`~filletfold.export.atomic.write_outputs`, which then holds one file in memory
-        at a time; the FOLD files' are iterators of text chunks, written as they come, so
-        not even a whole file is); the pattern is still checked here, once.
+        at a time; the FOLD and SVG files' are iterators of text chunks, written as they
+        come, so not even a whole file is); the pattern is still checked here, once.
     preset : str or Preset, optional
         Cutter preset of the SVG and DXF (:data:`~filletfold.export.presets.PRESETS`; default
         ``print``).
@@ -397,7 +397,7 @@ def cut_files(
         from ..surface.coarse import simulator_svg_pattern
 
         drawn = scaled_pattern(simulator_svg_pattern(coarse()), scale)
-        return _pattern_svg(drawn, units=units, preset="origami-simulator")
+        return _pattern_svg_chunks(drawn, units=units, preset="origami-simulator")
 
     def pdf():
         pdf_units, pdf_scale = units or "mm", scale
@@ -420,7 +420,7 @@ def cut_files(
         "json": {"report.json": lambda: report if isinstance(report, str) else report_json(report)},
         "obj": {"folded.obj": lambda: _folded_obj(pattern, faces)},
         "svg": {
-            "pattern.svg": lambda: _pattern_svg(
+            "pattern.svg": lambda: _pattern_svg_chunks(  # written a group at a time (lazy)
                 scaled_pattern(pattern, scale), units=units, preset=preset
             )
         },

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Iterator
 from xml.sax.saxutils import escape
 
 import numpy as np
@@ -250,6 +251,17 @@ def _pattern_svg(
     pattern, units="", preset=None, stroke_mm=None, flat_edges=None, angle_opacity=None
 ) -> str:
     """:func:`pattern_svg` of a pattern and arguments already checked."""
+    return "".join(
+        _pattern_svg_chunks(pattern, units, preset, stroke_mm, flat_edges, angle_opacity)
+    )
+
+
+def _pattern_svg_chunks(
+    pattern, units="", preset=None, stroke_mm=None, flat_edges=None, angle_opacity=None
+) -> Iterator[str]:
+    """:func:`_pattern_svg`'s text a group at a time, each group drawn when its turn comes:
+    written as it comes (:func:`~filletfold.export.atomic.write_outputs`), a large design's
+    drawing is never whole in memory, only its largest group."""
     preset = get_preset(preset)
     flat_edges = preset.flat_edges if flat_edges is None else bool(flat_edges)
     angle_opacity = preset.angle_opacity if angle_opacity is None else bool(angle_opacity)
@@ -273,6 +285,7 @@ def _pattern_svg(
         [v[np.unique(edges[drawn])], *[q for q, _ in paths], hinges.reshape(-1, 2)]
     )
     user = svg_user_per_mm(points, mm_per_unit, extent)  # user units per mm
+    del points
     k = mm_per_unit * user  # user units per pattern unit
     margin = _MARGIN_MM * user
     font = _FONT_MM * user
@@ -280,50 +293,50 @@ def _pattern_svg(
     fmt = _formatter(decimals)
     draw = _Drawing(lo, hi, k, margin, decimals, user, stroke_mm)
 
-    body = []
-    legend = []
-    for code, gid, label in _GROUPS:
-        if code == "F" and not flat_edges:
-            continue
-        pen = getattr(preset, _ROLE[code])
-        legend.append((pen.color, label))
-        mask = assign == code
-        body.append(draw.group_open(gid, pen))
-        if pen.perforation_mm is not None:
-            dashes = draw.dashes(
-                [(v[c], closed) for c, closed in edge_chains(edges, mask)], pen.perforation_mm
-            )
-            body.append(draw.polylines([(q, False) for q in dashes], pen.color))
-        elif (angle_opacity and code in ("M", "V")) or not preset.join_lines:
-            sel = np.flatnonzero(mask)
-            opacity = None
-            if angle_opacity and code in ("M", "V"):
-                opacity = np.clip(np.abs(angle[sel]) / 180.0, 1e-6, 1.0)
-            body.append(draw.lines(v[edges[sel, 0]], v[edges[sel, 1]], pen.color, opacity))
-        else:
-            chains = edge_chains(edges, mask)
-            simple = simplify_polylines([(v[c], closed) for c, closed in chains])
-            body.append(
-                draw.polylines(
-                    [(q, closed) for q, (_, closed) in zip(simple, chains, strict=True)], pen.color
-                )
-            )
-        body.append("</g>")
-    if paths:
-        body.append(draw.group_open("tab-cut", preset.cut, join=True))
-        body.append(draw.polylines(paths, preset.cut.color))
-        body.append("</g>")
+    groups = [g for g in _GROUPS if g[0] != "F" or flat_edges]
+    legend = [(getattr(preset, _ROLE[code]).color, label) for code, _, label in groups]
     if len(hinges):
-        pen = preset.tab
-        legend.append((pen.color, "tab hinge"))
-        body.append(draw.group_open("tab-hinge", pen))
-        if pen.perforation_mm is not None:
-            dashes = draw.dashes([(h, False) for h in hinges], pen.perforation_mm)
-            body.append(draw.polylines([(q, False) for q in dashes], pen.color))
-        else:
-            body.append(draw.lines(hinges[:, 0], hinges[:, 1], pen.color))
-        body.append("</g>")
-    body.extend(_label_group(pattern, draw, preset.label.color))
+        legend.append((preset.tab.color, "tab hinge"))
+
+    def body() -> Iterator[str]:
+        """The drawing's groups, each made when it is written."""
+        for code, gid, _ in groups:
+            pen = getattr(preset, _ROLE[code])
+            mask = assign == code
+            yield draw.group_open(gid, pen)
+            if pen.perforation_mm is not None:
+                dashes = draw.dashes(
+                    [(v[c], closed) for c, closed in edge_chains(edges, mask)], pen.perforation_mm
+                )
+                yield draw.polylines([(q, False) for q in dashes], pen.color)
+            elif (angle_opacity and code in ("M", "V")) or not preset.join_lines:
+                sel = np.flatnonzero(mask)
+                opacity = None
+                if angle_opacity and code in ("M", "V"):
+                    opacity = np.clip(np.abs(angle[sel]) / 180.0, 1e-6, 1.0)
+                yield draw.lines(v[edges[sel, 0]], v[edges[sel, 1]], pen.color, opacity)
+            else:
+                chains = edge_chains(edges, mask)
+                simple = simplify_polylines([(v[c], closed) for c, closed in chains])
+                yield draw.polylines(
+                    [(q, closed) for q, (_, closed) in zip(simple, chains, strict=True)],
+                    pen.color,
+                )
+            yield "</g>"
+        if paths:
+            yield draw.group_open("tab-cut", preset.cut, join=True)
+            yield draw.polylines(paths, preset.cut.color)
+            yield "</g>"
+        if len(hinges):
+            pen = preset.tab
+            yield draw.group_open("tab-hinge", pen)
+            if pen.perforation_mm is not None:
+                dashes = draw.dashes([(h, False) for h in hinges], pen.perforation_mm)
+                yield draw.polylines([(q, False) for q in dashes], pen.color)
+            else:
+                yield draw.lines(hinges[:, 0], hinges[:, 1], pen.color)
+            yield "</g>"
+        yield from _label_group(pattern, draw, preset.label.color)
 
     draw_w = float(size[0]) * k + 2 * margin
     draw_h = float(size[1]) * k + 2 * margin
@@ -382,7 +395,12 @@ def _pattern_svg(
         f"<desc>preset {escape(preset.name)}: {colours}; units: {escape(units or 'none')}; "
         f"{fmt(user)} user units per mm</desc>",
     ]
-    return "\n".join([*head, *body, *ann_text, "</svg>"]) + "\n"
+    for part in head:
+        yield part + "\n"
+    for part in body():
+        yield part + "\n"
+    for part in [*ann_text, "</svg>"]:
+        yield part + "\n"
 
 
 class _Drawing:
