@@ -421,12 +421,12 @@ class _Faces:
                 valid[faces] = surely_valid(corners, turn)
             self.convex[faces] = is_convex(corners, turn)
             u = side_normals(corners)
-            t = [
-                u[..., 0] * corners[:, i, None, 0] + u[..., 1] * corners[:, i, None, 1]
-                for i in range(k)
-            ]
-            self.sets[k] = (corners[..., 0], corners[..., 1], u[..., 0], u[..., 1])
-            self.sets[k] += (np.minimum.reduce(t), np.maximum.reduce(t))
+            t_lo = t_hi = None  # the corners' extents along each side's normal, one at a time
+            for i in range(k):
+                t = u[..., 0] * corners[:, i, None, 0] + u[..., 1] * corners[:, i, None, 1]
+                t_lo = t if t_lo is None else np.minimum(t_lo, t)
+                t_hi = t if t_hi is None else np.maximum(t_hi, t)
+            self.sets[k] = (corners[..., 0], corners[..., 1], u[..., 0], u[..., 1], t_lo, t_hi)
         self.polys: dict[int, object] = {}
         doubt = np.flatnonzero(~valid)
         if len(doubt):  # a face that is not a valid polygon is taken as its valid part
