@@ -1145,20 +1145,31 @@ class _Separator:
         self.k = int(size[convex].max(initial=3))
         ks = np.arange(self.k)
         first = g.start[:-1, None]
+        # (n_faces, K) arrays, made in place where they can be: a scan's 2 million faces
+        # take some 80 MB per array
         corner = g.flat[first + np.minimum(ks, size[:, None] - 1)]
-        nxt = g.flat[first + np.where(ks + 1 < size[:, None], ks + 1, 0)]
         x, y = g.v2[corner, 0], g.v2[corner, 1]
+        del corner
+        nxt = g.flat[first + np.where(ks + 1 < size[:, None], ks + 1, 0)]
         dx, dy = g.v2[nxt, 0] - x, g.v2[nxt, 1] - y
+        del nxt
         length = np.hypot(dx, dy)
         live = (ks < size[:, None]) & (length > 0)
         with np.errstate(invalid="ignore", divide="ignore"):
-            nx = np.where(live, dy / length, 0.0)
-            ny = np.where(live, -dx / length, 0.0)
+            nx = np.divide(dy, length, out=dy)
+            ny = np.divide(np.negative(dx, out=dx), length, out=dx)
+        del length
+        nx[~live] = 0.0
+        ny[~live] = 0.0
         eps = 64 * np.finfo(float).eps * max(float(np.abs(g.v2).max()), g.size)
         self.x, self.y, self.nx, self.ny = x, y, nx, ny
         # an edge separates when the other face's nearest corner is at least this far along
         # its normal (the edge's own offset, less the rounding of the products)
-        self.reach = np.where(live, nx * x + ny * y - eps, np.inf)
+        reach = nx * x
+        reach += ny * y
+        reach -= eps
+        reach[~live] = np.inf
+        self.reach = reach
 
     def separated(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """(k,) bool: whether the convex faces ``i`` and ``j`` (k,) are proved to have
