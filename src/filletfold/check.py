@@ -63,7 +63,7 @@ from .export.fold import FOLD_DIGITS
 from .export.fold_read import read_fold_document
 from .layout.convex import BoxGrid
 from .mesh.measures import dihedral_turns, newell_vectors
-from .surface.pattern import CreasePattern, edge_faces_of, face_arrays
+from .surface.pattern import CreasePattern, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
 
@@ -433,11 +433,8 @@ class _Data:
             raise ParameterError(f"pattern edge arrays are malformed ({exc})") from None
         if len(e) and (e.min() < 0 or e.max() >= n):
             raise ParameterError(f"pattern edges refer to a vertex outside 0..{n - 1}")
-        ef = pattern.edge_faces
-        if ef is None:
-            ef = edge_faces_of(e, pattern.faces, n)
         try:
-            self.edge_faces = np.asarray(ef, dtype=np.int64).reshape(len(e), 2)
+            self.edge_faces = pattern.faces_beside_edges().reshape(len(e), 2)
         except (TypeError, ValueError) as exc:
             raise ParameterError(f"pattern edge_faces is malformed ({exc})") from None
         self.edges, self.assign, self.angle = e, assign, angle

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ExportError, MeshReadError
-from ..surface.pattern import Annotations, CreasePattern, Label, LabelRows, edge_faces_of
+from ..surface.pattern import Annotations, CreasePattern, Label, LabelRows
 from ..surface.validate import validate_pattern
 from .fold import ANNOTATIONS_FILE, NAMESPACE, design_counts
 
@@ -188,7 +188,7 @@ def pattern_from_fold(doc: dict) -> CreasePattern:
         validate_pattern(pattern)
     except ExportError as exc:
         raise MeshReadError(f"not a valid filletfold design: {exc}") from None
-    pattern.edge_faces = edge_faces_of(pattern.edges, pattern.faces, len(v2))
+    pattern.edge_faces = pattern.faces_beside_edges()  # found once, from its faces
     return pattern
 
 
