@@ -265,7 +265,7 @@ def saddle_vertices(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
         return out
     _, bound, _ = _ring_normals(mesh, R, face, count)
     start = np.cumsum(count) - count
-    rounded = np.maximum.reduceat(np.where(rounding.radius[edge] > 0, 1, 0), start) > 0
+    rounded = np.logical_or.reduceat(rounding.radius[edge] > 0, start)
     developable = is_developable(mesh.vertex_angle_sum[closed])
     out[closed] = rounded & ~developable & (bound <= tol.normal_bound)
     return out
