@@ -7,17 +7,17 @@ import typer.main
 from filletfold import defaults
 from filletfold.app.session import AppSession
 from filletfold.cli import app
-from filletfold.design import round_mesh
+from filletfold.parameters import Parameters
 
 NAMES = {"radius": "DEFAULT_RADIUS", "depth": "DEFAULT_DEPTH", "samples": "DEFAULT_SAMPLES",
          "arc_step": "DEFAULT_ARC_STEP"}  # fmt: skip
 
 
-def test_round_mesh_and_the_app_default_to_the_shared_values():
-    for fn in (round_mesh, AppSession.__init__):
-        params = inspect.signature(inspect.unwrap(fn)).parameters
-        for name, const in NAMES.items():
-            assert params[name].default == getattr(defaults, const), (fn, name)
+def test_the_parameters_and_the_app_default_to_the_shared_values():
+    params = inspect.signature(AppSession.__init__).parameters
+    for name, const in NAMES.items():
+        assert getattr(Parameters(), name) == getattr(defaults, const), name
+        assert params[name].default == getattr(defaults, const), name
 
 
 def test_the_round_command_defaults_to_the_shared_values():
@@ -37,8 +37,7 @@ def test_the_defaults_are_valid_parameters():
 
 
 def test_the_chord_tolerance_defaults_alike_in_the_api_and_the_command_line():
-    params = inspect.signature(inspect.unwrap(round_mesh)).parameters
-    assert params["chord_tol"].default == defaults.DEFAULT_CHORD_TOL
+    assert Parameters().chord_tol == defaults.DEFAULT_CHORD_TOL
     command = typer.main.get_command(app)
     options = {p.name: p for p in command.commands["round"].params}
     assert options["chord_tol"].default == defaults.DEFAULT_CHORD_TOL

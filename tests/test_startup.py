@@ -107,8 +107,9 @@ def test_every_public_name_is_loaded_on_first_use():
 
 
 def test_the_lazy_names_are_the_modules_objects():
-    from filletfold.design import Design, Parameters, round_mesh
+    from filletfold.design import Design, round_mesh
     from filletfold.mesh import PolyMesh, example_names, load_mesh
+    from filletfold.parameters import Parameters
     from filletfold.surface.pattern import CreasePattern
 
     assert filletfold.round_mesh is round_mesh
@@ -133,12 +134,10 @@ def test_a_subpackage_is_an_attribute_once_used():
 
 def test_the_defaults_are_the_pipelines():
     """The command line shows the defaults without loading the pipeline: the same values."""
-    import inspect
-
     from filletfold import defaults
 
-    params = inspect.signature(filletfold.round_mesh).parameters
-    assert params["radius"].default == defaults.DEFAULT_RADIUS
-    assert params["depth"].default == defaults.DEFAULT_DEPTH
-    assert params["samples"].default == defaults.DEFAULT_SAMPLES
-    assert params["arc_step"].default == defaults.DEFAULT_ARC_STEP
+    params = filletfold.Parameters()
+    assert params.radius == defaults.DEFAULT_RADIUS
+    assert params.depth == defaults.DEFAULT_DEPTH
+    assert params.samples == defaults.DEFAULT_SAMPLES
+    assert params.arc_step == defaults.DEFAULT_ARC_STEP

@@ -27,8 +27,9 @@ from .errors import (
 )
 
 if TYPE_CHECKING:
-    from .design import Design, Parameters, round_mesh
+    from .design import Design, round_mesh
     from .mesh import PolyMesh, example_names, load_mesh
+    from .parameters import Parameters
     from .surface.pattern import CreasePattern
 
 # The rest of the API is imported on first use (PEP 562), so that ``import filletfold`` and
@@ -36,7 +37,7 @@ if TYPE_CHECKING:
 _LAZY = {
     "CreasePattern": ".surface.pattern",
     "Design": ".design",
-    "Parameters": ".design",
+    "Parameters": ".parameters",
     "PolyMesh": ".mesh",
     "example_names": ".mesh",
     "load_mesh": ".mesh",

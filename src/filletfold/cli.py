@@ -4,13 +4,15 @@ Commands
 --------
 ``filletfold examples``
     List the built-in meshes.
-``filletfold round MESH [-o OUT] [--radius R] [--depth D] [--samples N] [--arc-step DEG]``
+``filletfold round MESH [-o OUT] [--from REPORT] [--radius R] [--depth D] [--samples N]``
+``[--arc-step DEG]``
 ``[--chord-tol TOL] [--coplanar-tol DEG]``
 ``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME] [--nest NESTER]``
 ``[--view V]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
     ``folded.obj`` and ``pattern.svg`` into ``OUT`` (``--format all`` adds the cut files and
-    pictures).
+    pictures). ``--from REPORT`` makes a design again from its ``report.json`` (its mesh and
+    parameters, the options given replacing theirs).
 ``filletfold app [MESH] [--port N] [--host ADDR]``
     Start the browser app (viser) on MESH and print its address.
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
@@ -174,15 +176,69 @@ def _default_out(mesh: str) -> Path:
     return Path("out") / Path(mesh).stem
 
 
+#: The options of ``filletfold round`` that are design parameters: option -> field of
+#: :class:`~filletfold.parameters.Parameters` (``--no-tabs`` is ``tabs`` negated).
+ROUND_PARAMETERS = {
+    "radius": "radius",
+    "depth": "depth",
+    "samples": "samples",
+    "arc_step": "arc_step",
+    "chord_tol": "chord_tol",
+    "clamp": "clamp",
+    "material_loss": "material_loss",
+    "max_loss": "max_loss",
+    "layout": "layout",
+    "coplanar_tol": "coplanar_deg",
+    "fit_vertices": "fit_vertices",
+    "strict": "strict",
+    "sharp": "sharp",
+    "sheet": "sheet",
+    "units": "units",
+    "scale": "scale",
+    "no_tabs": "tabs",
+    "nest": "nest",
+}
+
+
+def _round_parameters(ctx: typer.Context, from_report: Path | None):
+    """The :class:`~filletfold.parameters.Parameters` of ``filletfold round`` and the mesh
+    its report names (None without ``--from``): the report's parameters (or the defaults),
+    with the options given on the command line replacing theirs."""
+    from .parameters import Parameters, report_parameters
+
+    base, source = Parameters(), None
+    if from_report is not None:
+        base, source = report_parameters(from_report)
+    given = {}
+    for option, name in ROUND_PARAMETERS.items():
+        source_of = ctx.get_parameter_source(option)  # click's (or typer's own) enum
+        if source_of is not None and source_of.name == "COMMANDLINE":
+            value = ctx.params[option]
+            given[name] = not value if option == "no_tabs" else value
+    return base.replace(**given), source
+
+
 @app.command("round")
 def round_cmd(
+    ctx: typer.Context,
     mesh: Annotated[
-        str,
+        str | None,
         typer.Argument(
             help="Mesh file (OBJ, OFF, PLY, STL, glTF/GLB) or the "
-            "name of a built-in example (see 'examples')."
+            "name of a built-in example (see 'examples'). With --from: the report's mesh "
+            "by default.",
+            show_default=False,
         ),
-    ],
+    ] = None,
+    from_report: Annotated[
+        Path | None,
+        typer.Option(
+            "--from",
+            help="Make a design again from its report.json: its mesh and parameters, the "
+            "options given here replacing theirs (the same input and options give the same "
+            "files).",
+        ),
+    ] = None,
     out: Annotated[
         Path | None, typer.Option("-o", "--out", help="Output folder [default: out/<mesh name>].")
     ] = None,
@@ -354,13 +410,18 @@ def round_cmd(
     from .export.cutfiles import DEFAULT_FORMATS, parse_formats
     from .export.outputs import export_design
 
-    target = out if out is not None else _default_out(mesh)
     try:
+        params, source = _round_parameters(ctx, from_report)
+        if mesh is None:
+            if source is None:
+                raise _error("give MESH (a mesh file or a built-in example) or --from REPORT")
+            mesh = source
         chosen = parse_formats(formats if formats is not None else DEFAULT_FORMATS)
         # check units, scale, page, preset and view before the (slow) design
-        _check_export_options(units, scale, sheet, preset, view)
+        _check_export_options(params.units, params.scale, params.sheet, preset, view)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
+    target = out if out is not None else _default_out(mesh)
     try:
         log = StageLog(err_console) if not quiet and not err_console.is_terminal else None
         with (
@@ -386,24 +447,7 @@ def round_cmd(
 
             design = round_mesh(
                 mesh,
-                radius=radius,
-                depth=depth,
-                samples=samples,
-                arc_step=arc_step,
-                chord_tol=chord_tol,
-                clamp=clamp,
-                fit_vertices=fit_vertices,
-                strict=strict,
-                sharp=sharp,
-                material_loss=material_loss,
-                max_loss=max_loss,
-                layout=layout,
-                sheet=sheet,
-                units=units or "mm",
-                scale=scale if scale is not None else 1.0,
-                tabs=not no_tabs,
-                nest=nest,
-                coplanar_deg=coplanar_tol,
+                params,
                 progress=progress,
                 keep_stages=False,  # nothing is reused: let frames and modules go early
             )
@@ -421,9 +465,9 @@ def round_cmd(
             design,
             target,
             formats=chosen,
-            units=units,
-            scale=scale,
-            page=sheet or "A4",
+            units=params.units,
+            scale=params.scale,
+            page=params.sheet or "A4",
             preset=preset,
             view=view,
             tables=report_tables,

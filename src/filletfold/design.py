@@ -9,20 +9,14 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import math
 import time
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .defaults import (
-    DEFAULT_ARC_STEP,
-    DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
-    DEFAULT_RADIUS,
-    DEFAULT_SAMPLES,
-    DEFAULT_SHARP,
 )
 from .errors import (
     FilletfoldError,
@@ -36,10 +30,9 @@ from .errors import (
 )
 from .errors import stage as _stage
 from .layout.arrange import arrange
-from .layout.fabrication import sheet_in_pattern_units
-from .layout.nest import choose_nester
 from .mesh import load_mesh
 from .mesh.polymesh import PolyMesh, mesh_size
+from .parameters import Parameters, resolve_chord_tol
 from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
@@ -51,9 +44,7 @@ from .surface.sampling import cone_sample_counts, unsampled_cones
 from .tolerances import tol
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
-    SHARP_KINDS,
     kept_sharp,
-    parse_sharp,
     set_treatments,
     sharp_kind,
     sharpen_vertices,
@@ -112,80 +103,6 @@ def parse_length(value, reference: float, name: str, *, count: int | None = None
     if np.any(arr <= 0):
         raise ParameterError(f"{name} must be positive, got {value!r}", name=name)
     return out
-
-
-@dataclass
-class Parameters:
-    """The parameters of a design, as given and as resolved to absolute lengths.
-
-    Attributes
-    ----------
-    radius, depth : float, str or array
-        As given (absolute, ``"N%"`` of the mean edge length, or per edge / per vertex).
-    samples : int
-        Most points per cylinder arc.
-    arc_step : float
-        Largest turn between two samples of an arc (degrees; 0: no limit).
-    chord_tol : float or str
-        As given: the largest distance of an arc's chord from the arc (absolute, ``"N%"`` of
-        the mean edge length; 0: no limit, and with ``arc_step`` 0 every arc gets ``samples``).
-    clamp : bool
-        Whether radii over their limit were reduced to fit (the default; off with ``strict``).
-    fit_vertices : bool
-        Whether infeasible vertices got smaller radii on their edges when that makes their
-        cone feasible (the default; off with ``strict``).
-    strict : bool
-        Whether defects of the mesh were refused instead of repaired.
-    material_loss : bool
-        Whether radii came from the consistent-material-loss programme.
-    max_loss : float, str or None
-        Cap on each edge's loss.
-    layout : str
-        Layout asked for.
-    coplanar_deg : float
-        Neighbouring faces closer than this angle are merged on input.
-    sharp : str
-        The kinds of cone-less vertices kept sharp, comma-separated (``"none"``: holes).
-    """
-
-    radius: object = DEFAULT_RADIUS
-    depth: object = DEFAULT_DEPTH
-    samples: int = DEFAULT_SAMPLES
-    arc_step: float = DEFAULT_ARC_STEP
-    chord_tol: object = DEFAULT_CHORD_TOL
-    clamp: bool = True
-    material_loss: bool = False
-    max_loss: object = None
-    layout: str = "auto"
-    coplanar_deg: float = tol.coplanar_deg
-    fit_vertices: bool = True
-    strict: bool = False
-    sharp: str = "saddle,infeasible,boundary"
-
-    def as_dict(self) -> dict:
-        def plain(x):
-            return np.asarray(x).tolist() if not isinstance(x, str | int | float) else x
-
-        return {
-            "radius": plain(self.radius),
-            "depth": plain(self.depth),
-            "samples": self.samples,
-            "arc_step": self.arc_step,
-            "chord_tol": self.chord_tol,
-            "clamp": self.clamp,
-            "material_loss": self.material_loss,
-            "max_loss": plain(self.max_loss) if self.max_loss is not None else None,
-            "layout": self.layout,
-            "coplanar_deg": self.coplanar_deg,
-            "fit_vertices": self.fit_vertices,
-            "strict": self.strict,
-            "sharp": self.sharp,
-        }
-
-    def round_mesh_kwargs(self) -> dict:
-        """The keyword arguments of :func:`round_mesh` that give this design again from its
-        cleaned mesh (every field, by the same name)."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
 @dataclass
@@ -440,29 +357,13 @@ def _round(pm: PolyMesh, radius, clamp, material_loss, max_loss, coplanar_deg, f
 @named_stages("reading the mesh")
 def round_mesh(
     mesh,
-    radius=DEFAULT_RADIUS,
-    depth=DEFAULT_DEPTH,
+    params: Parameters | None = None,
     *,
-    samples: int = DEFAULT_SAMPLES,
-    arc_step: float = DEFAULT_ARC_STEP,
-    chord_tol=DEFAULT_CHORD_TOL,
-    clamp: bool | None = None,
-    material_loss: bool = False,
-    max_loss=None,
-    layout: str = "auto",
-    sheet: str | None = None,
-    units: str = "mm",
-    scale: float = 1.0,
-    tabs: bool = True,
-    coplanar_deg: float = tol.coplanar_deg,
     progress=None,
     reuse: Design | None = None,
     keep_stages: bool = True,
-    strict: bool = False,
-    fit_vertices: bool | None = None,
     certify: bool = True,
-    sharp: str | None = DEFAULT_SHARP,
-    nest: str = "shelf",
+    **options,
 ) -> Design:
     """Turn a polyhedral mesh into its curved-crease rounded design.
 
@@ -470,65 +371,14 @@ def round_mesh(
     ----------
     mesh : PolyMesh, str, Path or (vertices, faces)
         A mesh, a file path (OBJ, OFF, PLY, STL, glTF), a built-in example name, or arrays.
-    radius : float, str or (n_edges,) float
-        Rounding radius: absolute, ``"10%"`` of the mean edge length, or per edge (in the order
-        of the cleaned mesh's ``edges``).
-    depth : float, str, (n_vertices,) float or dict
-        Apex depth ``d`` along the vertex normal (``P = U + d D``): absolute, a percentage of the
-        mean edge length, per vertex, or ``{"default": ..., vertex: value}``.
-    samples : int
-        Most points per arc, both ends included (>= 3). With ``chord_tol`` and ``arc_step``
-        both 0, every arc gets this many.
-    arc_step : float
-        Largest turn between two samples of an arc, in degrees (default 10; 0: no limit):
-        an arc gets at least one point per ``arc_step`` it turns (and at least 2), at most
-        ``samples``; the relative 2D - 3D mismatch of a chord grows with the square of its
-        turn, which an absolute ``chord_tol`` alone leaves large on small fillets (a fillet
-        of 10 % of the edge gets a point every 5.1 degrees from the default tolerance, one
-        of 1 % every 16 degrees: the step bounds it to 10). A finer step gives larger files
-        at a smaller mismatch.
-    chord_tol : float or str
-        Largest distance between a chord of an arc and the arc: absolute, or a percentage of
-        the mean edge length (default ``"0.01%"``). An arc of radius ``r`` turning by
-        ``2 gamma`` gets ``ceil(2 gamma / (2 acos(1 - chord_tol / r))) + 1`` points (at least
-        2, at most ``samples``; a conical fillet counts with twice its midpoint radius, the
-        most it reaches on a module), so that the files grow with the curvature the geometry
-        has, not with the number of edges: a small fillet gets fewer points than a large one.
-        0: no limit (see ``arc_step``).
-    clamp : bool, optional
-        Reduce radii over their edge's limit to 90% of it (see
-        :func:`filletfold.rounding.edges.clamp_radii`) instead of raising. Default: on, off with
-        ``strict``.
-    material_loss : bool
-        Choose every edge's radius from the consistent-material-loss linear programme (sec. 4,
-        :func:`filletfold.rounding.material_loss.solve_material_loss`); ``radius`` is then the
-        largest radius any edge may get.
-        On a developable input the rounded development of every interior vertex closes, so the
-        design folds from one uncut sheet.
-    max_loss : float or str, optional
-        Upper bound on each edge's material loss (a length or a percentage of the mean edge
-        length), with ``material_loss``.
-    layout : {"auto", "modules", "net", "sheet"}
-        ``"modules"``: one piece per vertex, side by side. ``"net"``: modules joined into as
-        few non-overlapping pieces as found (each cone keeps its cut). ``"sheet"``: all modules
-        glued into one uncut sheet (needs every vertex's development to close; raises
-        otherwise). ``"auto"``: the sheet when it can be made (with ``material_loss``), nets
-        when a ``sheet`` size is given, else modules.
-    sheet : str, optional
-        Size of the material sheets (``"A4"``, ``"A3"``, ``"A2"``, ``"A1"``, ``"Letter"``,
-        ``"Legal"`` or ``"WIDTHxHEIGHT"`` in mm): nets are split to fit and the pieces are
-        placed on as few sheets as found.
-    nest : str
-        How the pieces are placed on the sheets: ``"shelf"`` (rows of bounding rectangles, the
-        default), ``"sparrow"`` (the irregular nester of the ``nest`` extra, ``"sparrow:S"``
-        for S seconds per packing run; needs ``sheet``) or ``"auto"`` (sparrow when installed
-        and ``sheet`` is given, else the shelves). See :mod:`filletfold.layout.nest`.
-    units, scale : str, float
-        One pattern unit is ``scale`` ``units`` on the sheet (``units`` in mm, cm, m, in).
-    tabs : bool
-        Add a glue tab and two matching labels to every cut border, and part numbers.
-    coplanar_deg : float
-        Merge neighbouring faces whose normals differ by less than this (degrees).
+    params : Parameters, optional
+        The design's parameters (default: :class:`~filletfold.parameters.Parameters`'s
+        defaults).
+    **options
+        Fields of :class:`~filletfold.parameters.Parameters` that replace those of ``params``
+        (``radius="5%"``, ``depth=0.3``, ``samples``, ``arc_step``, ``chord_tol``, ``clamp``,
+        ``material_loss``, ``max_loss``, ``layout``, ``coplanar_deg``, ``fit_vertices``,
+        ``strict``, ``sharp``, ``sheet``, ``units``, ``scale``, ``tabs``, ``nest``).
     progress : callable, optional
         ``progress(stage, done, total)`` called during long stages.
     reuse : Design, optional
@@ -537,23 +387,6 @@ def round_mesh(
         are re-solved and rebuilt (see :class:`Stages`); when ``mesh`` is a :class:`PolyMesh`
         equal to the earlier one (same coplanar tolerance and ``strict``), its cleaned mesh is
         taken over whatever the other parameters. The result is the same as without.
-    strict : bool
-        Refuse instead of repairing: a defect of the mesh raises the :class:`MeshError` that
-        names it (see :func:`~filletfold.mesh.clean.clean_mesh`), and ``clamp`` and
-        ``fit_vertices`` default to off.
-    fit_vertices : bool, optional
-        When a cone vertex is infeasible, halve the radii of its edges (up to four times) and
-        keep them where that makes its cone feasible (:mod:`filletfold.vertex.rescue`); off,
-        the radius that would work is only given in its reason. Default: on, off with
-        ``strict``.
-    sharp : str or sequence of str
-        Which vertices without a cone keep their corner instead of a hole
-        (:mod:`filletfold.vertex.sharpen`): ``"none"``, ``"all"`` or a comma-separated list of
-        ``saddle``, ``infeasible`` (a developable vertex that does not close counts as
-        infeasible) and ``boundary``. Their edges to vertices with a cone become conical
-        fillets, those between two of them straight creases. ``"auto"`` (the default): all
-        three, except ``boundary`` with ``material_loss`` (a conical fillet would open the
-        neighbour's closed development, and the sheet would no longer be one piece).
     certify : bool
         Measure the design's invariants (:func:`filletfold.check.certify_design`) into
         ``design.certificate`` (about 5 % of the time; the browser app skips it).
@@ -566,14 +399,15 @@ def round_mesh(
     Returns
     -------
     Design
+        With ``design.params`` the parameters resolved
+        (:meth:`~filletfold.parameters.Parameters.resolved`).
 
     Raises
     ------
     MeshError
         Unreadable or invalid mesh.
     ParameterError
-        Invalid radius, depth, samples, arc step, chord tolerance or sheet (a radius over an
-        edge's limit names the edge).
+        An unknown or invalid parameter (a radius over an edge's limit names the edge).
     SolverError
         With ``material_loss``: the programme has no solution with positive losses (the
         message names the binding vertices and edges); with ``layout="sheet"``: the modules do
@@ -581,19 +415,14 @@ def round_mesh(
     """
     timings = {}
     t0 = time.perf_counter()
-    _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale)
-    resolve_chord_tol(chord_tol, 1.0)  # refuse a bad one before any work
-    choose_nester(nest, sheet)  # refuse a bad nester, or a missing one, before the solve
+    given = (params if params is not None else Parameters()).replace(**options)
+    given.check()
+    params = given.resolved()
     progress = callers_progress(progress)
-    strict = bool(strict)
-    clamp = (not strict) if clamp is None else bool(clamp)
-    fit_vertices = (not strict) if fit_vertices is None else bool(fit_vertices)
+    strict, kinds = params.strict, params.sharp_kinds()
     floor = 0.0 if strict else tol.fillet_floor
-    if sharp == "auto":
-        kinds = set(SHARP_KINDS) - ({"boundary"} if material_loss else set())
-    else:
-        kinds = parse_sharp(sharp)
-    sharp_spec = ",".join(k for k in SHARP_KINDS if k in kinds) or "none"
+    radius, depth, coplanar_deg = params.radius, params.depth, params.coplanar_deg
+    material_loss, max_loss, layout = params.material_loss, params.max_loss, params.layout
     source = str(mesh) if isinstance(mesh, str | Path) else type(mesh).__name__
     input_key = _input_key(mesh, coplanar_deg, strict)
     cleaned = reuse.stages.cleaned if reuse is not None and reuse.stages is not None else None
@@ -606,27 +435,12 @@ def round_mesh(
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)
     timings["read"] = time.perf_counter() - t0
-    params = Parameters(
-        radius=radius,
-        depth=depth,
-        samples=int(samples),
-        arc_step=float(arc_step),
-        chord_tol=chord_tol,
-        clamp=clamp,
-        material_loss=bool(material_loss),
-        max_loss=max_loss,
-        layout=layout,
-        coplanar_deg=coplanar_deg,
-        fit_vertices=fit_vertices,
-        strict=strict,
-        sharp=sharp_spec,
-    )
     ref = pm.mean_edge_length
     size = mesh_size(pm)
-    chord = resolve_chord_tol(chord_tol, ref)
+    chord = resolve_chord_tol(params.chord_tol, ref)
     min_width = 0.0 if strict else tol.min_fillet * size
 
-    key = _stage_key(pm, radius, clamp, material_loss, max_loss, coplanar_deg, sharp_spec)
+    key = _stage_key(pm, radius, params.clamp, material_loss, max_loss, coplanar_deg, params.sharp)
     st = reuse.stages if reuse is not None and reuse.stages is not None else None
     if st is not None and st.key != key:
         st = None
@@ -644,7 +458,7 @@ def round_mesh(
         requested = st.requested
     else:
         loss, rounding, conical, requested = _round(
-            pm, radius, clamp, material_loss, max_loss, coplanar_deg, floor, min_width
+            pm, radius, params.clamp, material_loss, max_loss, coplanar_deg, floor, min_width
         )
         centres = face_piece_centres(pm, rounding)
     fitted_radius = rounding.radius.copy()
@@ -685,12 +499,12 @@ def round_mesh(
         progress,
         size,
         material_loss=material_loss,
-        fit_vertices=fit_vertices,
+        fit_vertices=params.fit_vertices,
         coplanar_deg=coplanar_deg,
         floor=floor,
         min_width=min_width,
         sharp_kinds=kinds,
-        arc_step=float(arc_step),
+        arc_step=params.arc_step,
         min_chord=min_chord,
         needs=needs,
         cuts=cuts,
@@ -700,15 +514,15 @@ def round_mesh(
     t = time.perf_counter()
     _stage("vertex modules")
     points = rounding.arc_points(
-        int(samples),
-        float(arc_step),
+        params.samples,
+        params.arc_step,
         min_chord=min_chord,
         chord_tol=chord,
         radius_scale=np.where(conical_sides(frames, pm.n_edges), 2.0, 1.0),
     )
     # a cone's normal may turn faster than its arc: more points where it does
     points = np.maximum(
-        points, cone_sample_counts(solved, centres, pm.n_edges, float(arc_step), needs)
+        points, cone_sample_counts(solved, centres, pm.n_edges, params.arc_step, needs)
     )
     needs.clear()  # its last use: it holds every cone's frame, which the layout may not need
     same_samples = st is not None and np.array_equal(st.samples, points)
@@ -740,7 +554,7 @@ def round_mesh(
     )
     pieces = [piece for module in modules for piece in module]
     ring_closed = [f.ring.closed for f in frames]
-    if not keep_stages and not (layout == "net" or (layout == "auto" and sheet is not None)):
+    if not keep_stages and not (layout == "net" or (layout == "auto" and params.sheet is not None)):
         # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
         del frames, classified
         solved = modules = built = None
@@ -756,11 +570,11 @@ def round_mesh(
         ring_closed,
         layout=layout,
         material_loss=material_loss,
-        sheet=sheet,
-        units=units,
-        scale=scale,
-        tabs=tabs,
-        nest=nest,
+        sheet=params.sheet,
+        units=params.sheet_units,
+        scale=params.sheet_scale,
+        tabs=params.tabs,
+        nest=params.nest,
         stage=_stage,
         timings=timings,
         release_pieces=not keep_stages,
@@ -965,67 +779,12 @@ def _sharp_frames(frames) -> np.ndarray:
     return np.array([f.sharp for f in frames], dtype=bool)
 
 
-def resolve_chord_tol(value, reference: float) -> float:
-    """The chord tolerance of :func:`round_mesh` as a length: a number, or a ``"N%"`` string
-    of ``reference`` (the mean edge length); 0 (or ``"0"``, ``"0%"``) for none.
-
-    Raises
-    ------
-    ParameterError
-        When it is not a finite number >= 0 or such a percentage.
-    """
-    if isinstance(value, bool):
-        raise ParameterError(
-            f"chord tolerance must be a length or 'N%', got {value!r}", name="chord_tol"
-        )
-    text = value.strip() if isinstance(value, str) else None
-    try:
-        number = float(text.removesuffix("%")) if text is not None else float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"chord tolerance must be a length or a percentage like '0.01%', got {value!r}",
-            name="chord_tol",
-        ) from None
-    if not (math.isfinite(number) and number >= 0):
-        raise ParameterError(
-            f"chord tolerance must be finite and >= 0 (0: none), got {value!r}", name="chord_tol"
-        )
-    if text is not None and text.endswith("%"):
-        return number / 100.0 * float(reference)
-    return number
-
-
 def conical_sides(frames, n_edges: int) -> np.ndarray:
     """(n_edges,) bool: the edges some vertex frame rounds by a conical fillet."""
     out = np.zeros(n_edges, dtype=bool)
     edges = [side.edge for f in frames for side in f.sides if side.S is not None]
     out[np.asarray(edges, dtype=np.int64)] = True
     return out
-
-
-def _check_parameters(samples, arc_step, layout, coplanar_deg, sheet, units, scale) -> None:
-    """Refuse a bad parameter of :func:`round_mesh` before any work, naming it."""
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
-        raise ParameterError(f"samples must be an integer >= 3, got {samples!r}", name="samples")
-    if isinstance(arc_step, bool) or not isinstance(arc_step, int | float | np.number):
-        raise ParameterError(
-            f"arc step must be a number of degrees, got {arc_step!r}", name="arc_step"
-        )
-    if not (np.isfinite(arc_step) and 0 <= arc_step <= 180):
-        raise ParameterError(
-            f"arc step must be in [0, 180] degrees (0: no limit), got {arc_step!r}", name="arc_step"
-        )
-    if layout not in ("auto", "modules", "net", "sheet"):
-        raise ParameterError(
-            f"layout must be 'auto', 'modules', 'net' or 'sheet', got {layout!r}", name="layout"
-        )
-    if not (np.isfinite(coplanar_deg) and 0 <= coplanar_deg < 90):
-        raise ParameterError(
-            f"coplanar tolerance must be in [0, 90) degrees, got {coplanar_deg!r}",
-            name="coplanar_deg",
-        )
-    if sheet is not None:
-        sheet_in_pattern_units(sheet, units, scale)  # refuse a bad sheet before the solve
 
 
 def far_offset(vertices: np.ndarray) -> np.ndarray | None:

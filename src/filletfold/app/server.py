@@ -20,7 +20,7 @@ import threading
 import time
 import webbrowser
 
-from ..design import DEFAULT_ARC_STEP, DEFAULT_SAMPLES
+from ..defaults import DEFAULT_ARC_STEP, DEFAULT_SAMPLES
 from ..errors import FilletfoldError
 from ..mesh import example_names
 from ..vertex.batch import warm_kernel
@@ -481,7 +481,7 @@ def params_text(params) -> str:
 
     Parameters
     ----------
-    params : filletfold.design.Parameters
+    params : filletfold.parameters.Parameters
 
     Returns
     -------

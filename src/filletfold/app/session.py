@@ -21,14 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..design import (
-    DEFAULT_ARC_STEP,
-    DEFAULT_DEPTH,
-    DEFAULT_RADIUS,
-    DEFAULT_SAMPLES,
-    Design,
-    round_mesh,
-)
+from ..defaults import DEFAULT_ARC_STEP, DEFAULT_DEPTH, DEFAULT_RADIUS, DEFAULT_SAMPLES
+from ..design import Design, round_mesh
 from ..errors import MeshReadError, ParameterError
 from ..export.cutfiles import cut_files
 from ..export.outputs import mesh_fold_keys, summary_records
@@ -402,7 +396,7 @@ class AppSession:
             # the shown design was computed without glue tabs: add them (layout stage only)
             p = design.params
             source = design.source
-            design = round_mesh(design.mesh, **p.round_mesh_kwargs(), tabs=True, reuse=design)
+            design = round_mesh(design.mesh, p, tabs=True, reuse=design)
             design.source = source
         files = dict(
             cut_files(

@@ -64,7 +64,7 @@ def read_fold_document(path) -> tuple[CreasePattern, dict]:
     """:func:`read_fold`, and the parsed document (for its other keys, such as the mesh's
     ``filletfold:mesh_*`` that ``filletfold check`` reads)."""
     path = Path(os.fspath(path))
-    doc = _load_json(path, "a FOLD file")
+    doc = load_json(path, "a FOLD file")
     try:
         pattern = pattern_from_fold(doc)
     except MeshReadError as exc:
@@ -96,7 +96,7 @@ def read_annotations(path, pattern: CreasePattern) -> Annotations:
     path = Path(os.fspath(path))
     if not path.exists():
         return Annotations()
-    doc = _load_json(path, "an annotations file")
+    doc = load_json(path, "an annotations file")
     if not isinstance(doc, dict):
         raise MeshReadError(f"{path}: not an annotations file (not a JSON object)")
     expected = design_counts(pattern)
@@ -109,7 +109,7 @@ def read_annotations(path, pattern: CreasePattern) -> Annotations:
     return _annotations(doc, str(path))
 
 
-def _load_json(path: Path, what: str):
+def load_json(path: Path, what: str):
     """The parsed JSON text of ``path``; a :class:`MeshReadError` naming the file when it is
     missing, a folder, unreadable or not JSON (``what`` it should be: ``"a FOLD file"``)."""
     try:
@@ -124,6 +124,8 @@ def _load_json(path: Path, what: str):
         return json.loads(text)
     except json.JSONDecodeError as exc:
         raise MeshReadError(f"{path}: not {what} (invalid JSON: {exc.msg})") from None
+    except RecursionError:
+        raise MeshReadError(f"{path}: not {what} (JSON nested too deeply)") from None
 
 
 def pattern_from_fold(doc: dict) -> CreasePattern:
