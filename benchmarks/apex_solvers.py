@@ -54,8 +54,8 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.spatial import ConvexHull
 
-from filletfold.design import parse_length
 from filletfold.mesh import load_mesh
+from filletfold.parameters import parse_length
 from filletfold.rounding.edges import clamp_radii, round_edges
 from filletfold.vertex.batch import solve_apex_batch
 from filletfold.vertex.reference import solve_apex_slsqp

@@ -140,12 +140,12 @@ def test_defects_are_repaired_and_listed_or_refused_with_strict(tmp_path, capsys
 def test_unforeseen_failure_is_one_line_and_debug_shows_the_traceback(
     tmp_path, capsys, monkeypatch
 ):
-    from filletfold import design
+    from filletfold import pipeline
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("float division by zero\nsecond line")
 
-    monkeypatch.setattr(design, "face_piece_centres", broken)
+    monkeypatch.setattr(pipeline, "face_piece_centres", broken)
     assert main(["round", "cube", "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err.strip().splitlines() == [

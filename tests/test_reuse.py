@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import filletfold
-import filletfold.design as design_module
+import filletfold.pipeline as pipeline
 from filletfold.mesh import example_mesh
 
 
@@ -46,13 +46,13 @@ def test_without_stages_the_pieces_go_before_the_glue_tabs(monkeypatch):
 def solved_vertices(monkeypatch):
     """Record which vertices every ``solve_apices`` call was asked to solve."""
     calls = []
-    original = design_module.solve_apices
+    original = pipeline.solve_apices
 
     def spy(*args, vertices=None, **kwargs):
         calls.append(list(vertices) if vertices is not None else None)
         return original(*args, vertices=vertices, **kwargs)
 
-    monkeypatch.setattr(design_module, "solve_apices", spy)
+    monkeypatch.setattr(pipeline, "solve_apices", spy)
     return calls
 
 
@@ -117,7 +117,7 @@ def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
     import weakref
 
     refs = []
-    classify = design_module.classify_vertices
+    classify = pipeline.classify_vertices
 
     def spy(*args, **kwargs):
         frames = classify(*args, **kwargs)
@@ -125,15 +125,15 @@ def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
         return frames
 
     alive_at_layout = []
-    arrange = design_module.arrange
+    arrange = pipeline.arrange
 
     def layout_spy(*args, **kwargs):
         gc.collect()
         alive_at_layout.append(refs[-1]() is not None)
         return arrange(*args, **kwargs)
 
-    monkeypatch.setattr(design_module, "classify_vertices", spy)
-    monkeypatch.setattr(design_module, "arrange", layout_spy)
+    monkeypatch.setattr(pipeline, "classify_vertices", spy)
+    monkeypatch.setattr(pipeline, "arrange", layout_spy)
     kept = filletfold.round_mesh("icosahedron", tabs=False)
     lean = filletfold.round_mesh("icosahedron", tabs=False, keep_stages=False)
     assert kept.stages is not None and lean.stages is None
@@ -149,13 +149,13 @@ def test_without_stages_the_frames_go_before_the_layout(monkeypatch):
 def cleanings(monkeypatch):
     """Count the calls of ``load_mesh`` (which cleans the mesh) made by ``round_mesh``."""
     calls = []
-    original = design_module.load_mesh
+    original = pipeline.load_mesh
 
     def spy(*args, **kwargs):
         calls.append(args[0])
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(design_module, "load_mesh", spy)
+    monkeypatch.setattr(pipeline, "load_mesh", spy)
     return calls
 
 

@@ -27,7 +27,7 @@ from .defaults import (
 from .errors import ParameterError
 from .tolerances import tol
 
-__all__ = ["Parameters", "report_parameters", "resolve_chord_tol"]
+__all__ = ["Parameters", "parse_length", "report_parameters", "resolve_chord_tol", "resolve_depth"]
 
 #: The JSON types each field of :class:`Parameters` may take in a report (``number`` is an int
 #: or a float, never a bool).
@@ -415,3 +415,82 @@ def resolve_chord_tol(value, reference: float) -> float:
     if text is not None and text.endswith("%"):
         return number / 100.0 * float(reference)
     return number
+
+
+def parse_length(value, reference: float, name: str, *, count: int | None = None):
+    """Absolute length(s) from a number, a ``"12%"`` string (of ``reference``) or an array.
+
+    Parameters
+    ----------
+    value : float, str or array_like
+    reference : float
+        The length that 100% stands for (the mean edge length).
+    name : str
+        Parameter name, for error messages.
+    count : int, optional
+        Expected length of a per-element array.
+
+    Returns
+    -------
+    float or (count,) float array
+
+    Raises
+    ------
+    ParameterError
+        Not a number, a percentage or an array of the right shape; not finite; not positive.
+    """
+    import numpy as np
+
+    if isinstance(value, str):
+        text = value.strip()
+        try:
+            if text.endswith("%"):
+                out = float(text[:-1]) / 100.0 * reference
+            else:
+                out = float(text)
+        except ValueError:
+            raise ParameterError(
+                f"{name} must be a number or a percentage like '10%', got {value!r}", name=name
+            ) from None
+    else:
+        out = np.asarray(value, dtype=float)
+        if out.ndim == 0:
+            out = float(out)
+        elif count is not None and out.shape != (count,):
+            raise ParameterError(
+                f"per-element {name} must have shape ({count},), got {out.shape}", name=name
+            )
+    arr = np.atleast_1d(out)
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"{name} must be finite, got {value!r}", name=name)
+    if np.any(arr <= 0):
+        raise ParameterError(f"{name} must be positive, got {value!r}", name=name)
+    return out
+
+
+def resolve_depth(depth, reference: float, n: int):
+    """(n,) float: the cone depth at each of ``n`` vertices from :attr:`Parameters.depth` (a
+    length, a percentage of ``reference``, an array, or a dict of vertex index -> length with
+    an optional ``"default"``).
+
+    Raises
+    ------
+    ParameterError
+        A bad length, or a vertex index that does not exist.
+    """
+    import numpy as np
+
+    if isinstance(depth, dict):
+        base = parse_length(depth.get("default", DEFAULT_DEPTH), reference, "depth")
+        out = np.full(n, float(base))
+        for k, val in depth.items():
+            if k == "default":
+                continue
+            if not (0 <= int(k) < n):
+                raise ParameterError(
+                    f"depth given for vertex {k}, which does not exist", name="depth"
+                )
+            out[int(k)] = float(parse_length(val, reference, "depth"))
+        return out
+    d = parse_length(depth, reference, "depth", count=n)
+    return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()

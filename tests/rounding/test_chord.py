@@ -9,9 +9,9 @@ from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
 import filletfold
-from filletfold.design import resolve_chord_tol
 from filletfold.errors import ParameterError
 from filletfold.export.outputs import edge_mismatch, relative_mismatch
+from filletfold.parameters import resolve_chord_tol
 from filletfold.rounding.edges import chord_counts
 from filletfold.surface.sampling import cone_sample_counts
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 import filletfold
-import filletfold.design as design_mod
+import filletfold.pipeline as pipeline
 from filletfold.surface.sampling import (
     MAX_CONE_SAMPLES,
     SAFETY,
@@ -52,7 +52,7 @@ def test_a_cone_that_cannot_be_sampled_is_made_sharp(monkeypatch):
     of a 166k-face scan (face000.ply), whose arcs needed chords of 5e-8 of its size."""
     plain = filletfold.round_mesh("blob")
     target = int(np.flatnonzero(np.array(plain.vertices.status) == "ok")[0])
-    real = design_mod.unsampled_cones
+    real = pipeline.unsampled_cones
 
     def one(cones, centres, step, min_chord, cache=None):
         found = real(cones, centres, step, min_chord, cache)
@@ -60,7 +60,7 @@ def test_a_cone_that_cannot_be_sampled_is_made_sharp(monkeypatch):
             found[target] = "its cone folds too sharply (test)"
         return found
 
-    monkeypatch.setattr(design_mod, "unsampled_cones", one)
+    monkeypatch.setattr(pipeline, "unsampled_cones", one)
     d = filletfold.round_mesh("blob")
     assert d.vertices.status[target] == "infeasible"
     assert d.vertices.treatment[target] == "sharp" and "too sharply" in d.vertices.reason[target]

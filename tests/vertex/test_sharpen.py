@@ -192,16 +192,16 @@ def test_each_frame_is_built_once_when_saddles_are_made_sharp(monkeypatch):
     """The saddles are sharp before the frames are built: every vertex is classified once
     before the apices (none again for its neighbours), and a saddle whose edges all end at
     saddles (so are all left unrounded) is still reported as a saddle kept sharp."""
-    import filletfold.design as design
+    import filletfold.pipeline as pipeline
 
     counts = []
-    real = design.classify_vertices
+    real = pipeline.classify_vertices
 
     def counting(mesh, rounding, res, vertices=None, *args, **kwargs):
         counts.append(mesh.n_vertices if vertices is None else len(vertices))
         return real(mesh, rounding, res, vertices, *args, **kwargs)
 
-    monkeypatch.setattr(design, "classify_vertices", counting)
+    monkeypatch.setattr(pipeline, "classify_vertices", counting)
     d = filletfold.round_mesh("torus")
     assert counts == [d.mesh.n_vertices]
     saddles = [u for u, s in enumerate(d.vertices.status) if s == "saddle"]
