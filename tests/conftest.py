@@ -19,7 +19,6 @@ from filletfold.mesh import EXAMPLES, example_names, load_mesh
 from filletfold.rounding.edges import clamp_radii, round_edges
 from filletfold.rounding.material_loss import solve_material_loss
 from filletfold.surface.pattern import CreasePattern
-from filletfold.vertex import batch
 from filletfold.vertex.solve import apex_problems
 
 ALL = example_names()
@@ -47,15 +46,6 @@ def design_of(
         sharp=sharp,
         chord_tol=chord_tol,
     )
-
-
-@pytest.fixture(autouse=True)
-def _numpy_interior_point(request, monkeypatch):
-    """Every test but the kernel's own solves with the numpy interior-point method, whatever
-    is installed and whatever an earlier test loaded: the same bits in every order (the
-    kernel agrees to rounding, and test_batch_kernel.py checks that)."""
-    if request.node.path.name != "test_batch_kernel.py":
-        monkeypatch.setattr(batch, "USE_KERNEL", False)
 
 
 @pytest.fixture(params=ALL)

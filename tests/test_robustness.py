@@ -15,7 +15,6 @@ import pytest
 
 from filletfold.testing import KINDS, case_by_name, fuzz_cases, run_case
 from filletfold.testing.fuzz import certifier
-from filletfold.vertex import batch
 
 N_CASES = 200
 #: Seconds one case may take before it counts as a time-out (they take well under one).
@@ -35,12 +34,10 @@ N_FAST = 25
     ],
 )
 def outcomes(request, tmp_path_factory):
-    """The outcomes of the first cases of seed 0, run once for this file (the numpy
-    interior-point method, as in every other test: see conftest.py)."""
+    """The outcomes of the first cases of seed 0, run once for this file (with the solver
+    users get: the numba kernel when it is installed)."""
     folder = tmp_path_factory.mktemp("fuzz")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(batch, "USE_KERNEL", False)
-        return [run_case(case, folder, timeout=TIMEOUT) for case in fuzz_cases(request.param)]
+    return [run_case(case, folder, timeout=TIMEOUT) for case in fuzz_cases(request.param)]
 
 
 def listing(items, line) -> str:

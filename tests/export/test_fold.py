@@ -101,23 +101,27 @@ def test_fold_assignment_matches_angle_sign(pattern):
             assert angle < 0
 
 
-def _frame_dihedral(doc: dict, edge: int) -> float:
-    """The fold angle (valley positive) of ``edge`` measured in the folded frame of a FOLD
-    document: the signed angle between its two faces' normals, from the frame alone."""
+def _frame_dihedrals(doc: dict, edges) -> np.ndarray:
+    """The fold angles (valley positive) of ``edges`` measured in the folded frame of a FOLD
+    document: the signed angle between each edge's two faces' normals, from the frame alone."""
     v3 = np.array(doc["file_frames"][0]["vertices_coords"])
-    a, b = doc["edges_vertices"][edge]
-    sides = []
+    sides = {}  # (a, b) with a < b -> [(the face runs a -> b, its unit normal)]
     for f in doc["faces_vertices"]:
-        k = len(f)
-        for i in range(k):
-            if {f[i], f[(i + 1) % k]} == {a, b}:
-                p = v3[f]
-                n = np.sum(np.cross(p - p.mean(0), np.roll(p, -1, 0) - p.mean(0)), axis=0)
-                sides.append((f[i] == a, n / np.linalg.norm(n)))
-    assert len(sides) == 2
-    (_, n1), (_, n2) = sorted(sides, key=lambda s: not s[0])
-    d = (v3[b] - v3[a]) / np.linalg.norm(v3[b] - v3[a])
-    return -np.degrees(np.arctan2(np.cross(n1, n2) @ d, n1 @ n2))
+        p = v3[f]
+        n = np.sum(np.cross(p - p.mean(0), np.roll(p, -1, 0) - p.mean(0)), axis=0)
+        for i in range(len(f)):
+            a, b = f[i], f[(i + 1) % len(f)]
+            sides.setdefault((min(a, b), max(a, b)), []).append((a < b, n / np.linalg.norm(n)))
+    out = []
+    for edge in edges:
+        a, b = doc["edges_vertices"][edge]
+        found = sides[(min(a, b), max(a, b))]
+        assert len(found) == 2
+        # the face that runs a -> b first
+        (_, n1), (_, n2) = sorted(found, key=lambda s: s[0] != (a < b))
+        d = (v3[b] - v3[a]) / np.linalg.norm(v3[b] - v3[a])
+        out.append(-np.degrees(np.arctan2(np.cross(n1, n2) @ d, n1 @ n2)))
+    return np.array(out)
 
 
 def test_fold_facet_angles_are_the_folded_dihedrals():
@@ -128,7 +132,7 @@ def test_fold_facet_angles_are_the_folded_dihedrals():
     p = design_of("tetrahedron", samples=6).pattern
     doc = json.loads(fold_json(fold_document(p)))
     inner = [e for e, a in enumerate(doc["edges_assignment"]) if a != "B"]
-    measured = np.array([_frame_dihedral(doc, e) for e in inner])
+    measured = _frame_dihedrals(doc, inner)
     written = np.array([doc["edges_foldAngle"][e] for e in inner])
     assert_allclose(written, measured, atol=1e-7)
     flat = np.array([doc["edges_assignment"][e] == "F" for e in inner])
