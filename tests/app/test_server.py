@@ -281,7 +281,7 @@ def test_page_draws_slider_changes_design_and_bad_upload_shows_error(app, browse
     before = app.session.design_id
     thumb = browser.find_by_label("Radius (% edge)", '[role="slider"]')
     browser.send_keys(thumb, ARROW_RIGHT * 10)  # step 0.5
-    _wait(lambda: app.session.params["radius"] == "15.0%", 20, "the slider's value at the server")
+    _wait(lambda: app.session.params.radius == "15.0%", 20, "the slider's value at the server")
     _wait(
         lambda: (
             app.session.design_id > before

@@ -432,7 +432,7 @@ def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(mo
     armed, reached, release = threading.Event(), threading.Event(), threading.Event()
     finished, first_call = [], []
 
-    def gated_round_mesh(mesh, progress=None, **kw):
+    def gated_round_mesh(mesh, params, progress=None, **kw):
         def hook(stage, done, total):
             if progress is not None:
                 progress(stage, done, total)  # the app's callback: updates the page
@@ -441,8 +441,8 @@ def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(mo
                 reached.set()
                 release.wait(30)
 
-        design = real(mesh, progress=hook, **kw)
-        finished.append(kw["radius"])
+        design = real(mesh, params, progress=hook, **kw)
+        finished.append(params.radius)
         return design
 
     monkeypatch.setattr(session_mod, "round_mesh", gated_round_mesh)
@@ -467,7 +467,7 @@ def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(mo
         setter.start()
         setter.join(30)
         assert not setter.is_alive(), "the slider waited for the computation in progress"
-        assert app.session.params["radius"] == "20.0%"
+        assert app.session.params.radius == "20.0%"
         release.set()
         assert _wait_for(lambda: app.session.design.params.radius == "20.0%", 30)
         assert app.wait_drawn(app.session.design_id)

@@ -30,6 +30,7 @@ from ..export.report import report_json
 from ..layout.tabs import assembly_text
 from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
 from ..mesh.polymesh import PolyMesh
+from ..parameters import Parameters
 
 log = logging.getLogger(__name__)
 
@@ -54,8 +55,8 @@ class Request:
     mesh : PolyMesh
     name : str
         What the mesh came from (example name or file name).
-    params : dict
-        Keyword arguments of :func:`~filletfold.design.round_mesh` (``depth`` already merged
+    params : Parameters
+        The parameters of :func:`~filletfold.design.round_mesh` (``depth`` already merged
         with the per-vertex overrides).
     reuse : Design or None
         The current design when the request was made: what it shares with the request (same
@@ -65,7 +66,7 @@ class Request:
     id: int
     mesh: PolyMesh
     name: str
-    params: dict = field(default_factory=dict)
+    params: Parameters = field(default_factory=Parameters)
     reuse: Design | None = None
 
 
@@ -141,9 +142,9 @@ class AppSession:
     mesh : PolyMesh or None
     name : str
         What the mesh came from.
-    params : dict
-        ``radius``, ``depth``, ``samples``, ``arc_step``, ``material_loss``, ``clamp``,
-        ``tabs``.
+    params : Parameters
+        The parameters shown (the sliders change ``radius``, ``depth``, ``samples``,
+        ``arc_step``, ``material_loss``, ``clamp``, ``tabs``: :data:`PARAM_NAMES`).
     vertex_depth : dict of int to float or str
         Per-vertex depth overrides.
     design : Design or None
@@ -163,15 +164,15 @@ class AppSession:
     ):
         self.mesh: PolyMesh | None = None
         self.name = ""
-        self.params = {
-            "radius": radius,
-            "depth": depth,
-            "samples": samples,
-            "arc_step": arc_step,
-            "material_loss": material_loss,
-            "clamp": True,
-            "tabs": False,  # the download always has them (see export_files)
-        }
+        self.params = Parameters(
+            radius=radius,
+            depth=depth,
+            samples=samples,
+            arc_step=arc_step,
+            material_loss=material_loss,
+            clamp=True,
+            tabs=False,  # the download always has them (see export_files)
+        )
         self.vertex_depth: dict = {}
         self.design: Design | None = None
         self.design_id = 0
@@ -192,9 +193,9 @@ class AppSession:
             mesh = self.mesh if mesh is None else mesh
             if mesh is None:
                 raise MeshReadError("no mesh loaded")
-            params = dict(self.params)
+            params = self.params
             if self.vertex_depth:
-                params["depth"] = {"default": params["depth"], **self.vertex_depth}
+                params = params.replace(depth={"default": params.depth, **self.vertex_depth})
             return Request(
                 self._next_id, mesh, self.name if name is None else name, params, self.design
             )
@@ -213,7 +214,7 @@ class AppSession:
         """
         design = round_mesh(
             request.mesh,
-            **request.params,
+            request.params,
             progress=progress,
             reuse=request.reuse,
             certify=False,  # a slider drag needs the picture; the download certifies
@@ -310,7 +311,7 @@ class AppSession:
                     f"unknown parameter {key!r}: choose from {', '.join(PARAM_NAMES)}", name=key
                 )
         with self._lock:
-            self.params.update(kw)
+            self.params = self.params.replace(**kw)
 
     def set_vertex_depth(self, u: int, depth) -> None:
         """Give vertex ``u`` its own apex depth (``None`` removes the override).
