@@ -63,6 +63,7 @@ from .export.fold import FOLD_DIGITS
 from .export.fold_read import read_fold_document
 from .layout.convex import BoxGrid
 from .mesh.measures import dihedral_turns, newell_vectors
+from .surface.patch import PATCH_KINDS, Patch
 from .surface.pattern import CreasePattern, face_arrays
 from .surface.sampling import chord_mismatch_bound, facet_limit
 from .tolerances import tol
@@ -392,29 +393,23 @@ class _Data:
             _FACE: self.n_mesh_faces,
             _FILLET: self.n_mesh_edges,
         }
-        what = {
-            _CONE: "mesh vertex",
-            _CYLINDER: "mesh edge",
-            _FACE: "mesh face",
-            _FILLET: "mesh edge",
-        }
         parsed = {}
         for name in names:
-            parts = name.split()
-            kind = _KINDS.get(parts[0]) if len(parts) == 2 and parts[0] else None
-            if kind is None or not parts[1].isdigit():
+            try:
+                patch = Patch.parse(name)
+            except ValueError:
                 face = self.patch.index(name)
                 raise ParameterError(
                     f"pattern face {face} has patch {name!r}, not 'cone <vertex>', "
                     "'cylinder <edge>', 'fillet <edge>' or 'face <face>'",
                     name="face_patch",
-                )
-            index = int(parts[1])
+                ) from None
+            kind, index = _KINDS[patch.kind], patch.index
             if index >= limit[kind]:
                 face = self.patch.index(name)
                 raise ParameterError(
-                    f"pattern face {face} is on {name!r} but there is no {what[kind]} {index} "
-                    f"(the mesh has {limit[kind]})",
+                    f"pattern face {face} is on {name!r} but there is no "
+                    f"mesh {PATCH_KINDS[patch.kind]} {index} (the mesh has {limit[kind]})",
                     name="face_patch",
                 )
             parsed[name] = (kind, index)
@@ -852,7 +847,7 @@ def _facet_folds(g: _Data, limit_deg: float) -> Check:
                 f", {len(bad)} not a ruling to an unrounded edge: first pattern edge {e} "
                 f"(cone {int(u[bad[0]])})"
             )
-            ok, worst = False, {"pattern_edge": e, "patch": f"cone {int(u[bad[0]])}"}
+            ok, worst = False, {"pattern_edge": e, "patch": str(Patch("cone", int(u[bad[0]])))}
     return Check(name, ok, float(excess[k]), limit_deg, detail, "<=", worst)
 
 

@@ -148,10 +148,11 @@ def compas_meshes(design) -> dict:
         (3D) vertices, each face's patch name in its ``"patch"`` attribute.
     """
     Mesh, _ = _compas()
-    from .export.mesh3d import kinds_present, patch_kind
+    from .export.mesh3d import kinds_present
+    from .surface.patch import patch_kind
 
     pattern = _pattern(design)
-    kinds = [patch_kind(p) for p in pattern.face_patch]
+    kinds = [patch_kind(p, "patch") for p in pattern.face_patch]
     out = {}
     for kind in kinds_present(pattern.face_patch):
         ids = [i for i, k in enumerate(kinds) if k == kind]

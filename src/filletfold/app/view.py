@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..design import Design
+from ..surface.patch import patch_kind
 from ..surface.triangulate import triangulate_faces
 
 #: RGB (0..255) of each patch kind.
@@ -147,7 +148,7 @@ def scene_arrays(design: Design) -> SceneArrays:
     v3, flat3 = out.to_scene(v3), out.to_scene(flat3)
 
     triangles, owner = triangulate_faces(v2, pattern.faces)
-    kind_of = {patch: patch.split()[0] for patch in set(pattern.face_patch)}
+    kind_of = {patch: patch_kind(patch) for patch in set(pattern.face_patch)}
     kinds = [*PATCH_RGB, *sorted(set(kind_of.values()) - set(PATCH_RGB))]
     code = {patch: kinds.index(kind) for patch, kind in kind_of.items()}
     face_kind = np.fromiter(map(code.__getitem__, pattern.face_patch), dtype=np.int64)

@@ -32,6 +32,7 @@ import io
 
 import numpy as np
 
+from ..surface.patch import patch_kind
 from ..surface.pattern import CreasePattern, FaceRows
 from ..surface.triangulate import triangulate_faces
 from ..surface.validate import validated_faces
@@ -47,7 +48,6 @@ __all__ = [
     "folded_stl",
     "folded_triangles",
     "length_factor",
-    "patch_kind",
     "weld_vertices",
 ]
 
@@ -91,16 +91,10 @@ def length_factor(units: str = "", scale: float = 1.0, *, gltf: bool = False) ->
     return scale
 
 
-def patch_kind(patch: str) -> str:
-    """The kind of a patch name: its first word (``"cone 3"`` -> ``"cone"``)."""
-    words = str(patch).split()
-    return words[0] if words else "patch"
-
-
 def kinds_present(face_patch) -> list[str]:
     """The patch kinds of ``face_patch`` (a list of patch names), in :data:`KIND_ORDER`, then
     any others sorted by name."""
-    kinds = set(map(patch_kind, dict.fromkeys(face_patch)))
+    kinds = {patch_kind(p, "patch") for p in dict.fromkeys(face_patch)}
     return [k for k in KIND_ORDER if k in kinds] + sorted(kinds - set(KIND_ORDER))
 
 
@@ -132,7 +126,7 @@ def _kind_meshes(pattern: CreasePattern) -> list[tuple[str, np.ndarray, np.ndarr
     face_patch = np.fromiter(
         map(patches.__getitem__, pattern.face_patch), np.int64, len(pattern.face_patch)
     )
-    patch_kinds = np.array([patch_kind(p) for p in patches] or [""])
+    patch_kinds = np.array([patch_kind(p, "patch") for p in patches] or [""])
     tri_kind = patch_kinds[face_patch[face]] if len(face) else np.zeros(0, dtype=str)
     n = len(pattern.vertices_3d)
     out = []
@@ -218,7 +212,7 @@ def _welded(pattern: CreasePattern, factor: float = 1.0):
 
     tris, face = folded_triangles(pattern)
     v, inverse = weld_vertices(pattern.vertices_3d)
-    colours = np.array([_rgba(patch_kind(p)) for p in pattern.face_patch], dtype=np.uint8)
+    colours = np.array([_rgba(patch_kind(p, "patch")) for p in pattern.face_patch], dtype=np.uint8)
     return trimesh.Trimesh(
         vertices=v * factor,
         faces=inverse[tris].reshape(-1, 3),

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
+from ..surface.patch import patch_kind
 from ..surface.pattern import CreasePattern
 from ..surface.triangulate import triangulate_faces
 from ..surface.validate import validate_pattern
@@ -50,10 +51,6 @@ def _check_pixels(value, name: str) -> int:
     ):
         raise ParameterError(f"{name} must be an integer in 16..20000, got {value!r}", name=name)
     return int(value)
-
-
-def _kind(patch: str) -> str:
-    return patch.split(" ")[0] if patch else ""
 
 
 def _render(fig) -> bytes:
@@ -127,7 +124,7 @@ def pattern_png(pattern: CreasePattern, *, width_px: int = 1600) -> bytes:
                 edgecolors="none",
             )
         )
-    fills = [LAYOUT_FILL.get(_kind(p), _OTHER_FILL) for p in pattern.face_patch]
+    fills = [LAYOUT_FILL.get(patch_kind(p), _OTHER_FILL) for p in pattern.face_patch]
     if pattern.faces:
         ax.add_collection(
             PolyCollection(
@@ -292,7 +289,9 @@ def preview_png(
     triangles, tri_face = triangulate_faces(pattern.vertices_2d, pattern.faces)
     if len(pattern.face_patch):
         normal = np.nan_to_num(pattern.face_normal_3d())
-        color_of = {p: PATCH_COLOR.get(_kind(p), (0.8, 0.8, 0.8)) for p in set(pattern.face_patch)}
+        color_of = {
+            p: PATCH_COLOR.get(patch_kind(p), (0.8, 0.8, 0.8)) for p in set(pattern.face_patch)
+        }
         base = np.array([color_of[p] for p in pattern.face_patch], dtype=np.float64)
         facing = normal @ eye
         shade = _AMBIENT + _KEY * np.abs(normal @ light) + _HEAD * np.abs(facing)

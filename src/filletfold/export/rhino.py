@@ -44,11 +44,12 @@ import zlib
 import numpy as np
 
 from ..errors import ExportError, ParameterError
+from ..surface.patch import patch_kind
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validated_faces
 from ..units import check_units
 from .dxf import check_scale
-from .mesh3d import kinds_present, patch_kind
+from .mesh3d import kinds_present
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
 from .paths import chain_runs, edge_chains, edge_layer_masks, tab_cut_paths
 from .png import PATCH_COLOR
@@ -387,7 +388,7 @@ def _folded_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> b
             mesh.Faces.AddFace(*local[at : at + len(c)])
             at += len(c)
         mesh.Normals.ComputeNormals()
-        attr = model.attributes(kind_layer(patch_kind(name)), name)
+        attr = model.attributes(kind_layer(patch_kind(name, "patch")), name)
         model.file.Objects.AddMesh(mesh, attr)
     for layer, runs in crease_runs(pattern).items():
         for ids, spline, closed in runs:

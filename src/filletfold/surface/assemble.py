@@ -9,6 +9,7 @@ import numpy as np
 
 from ..tolerances import tol
 from .faces import flat_faces
+from .patch import Patch, patch_kinds
 from .pattern import CreasePattern, FaceRows
 from .piece import Piece
 
@@ -82,7 +83,7 @@ def true_rulings(v2, v3, flat, size, face_apex, patches) -> None:
     patches : list of str
         Each face's patch; the corners of ``"cone ..."`` faces are moved.
     """
-    cone = np.fromiter((p.startswith("cone") for p in patches), dtype=bool, count=len(patches))
+    cone = patch_kinds(patches) == "cone"
     cone &= face_apex >= 0
     if not cone.any():
         return
@@ -104,7 +105,8 @@ def locate_apices(pattern: CreasePattern, res: VertexResult) -> None:
     from scipy.spatial import cKDTree
 
     tree = cKDTree(pattern.vertices_3d)
-    cones = {int(s.split()[1]) for s in set(pattern.face_patch) if s.startswith("cone ")}
+    names = set(pattern.face_patch)
+    cones = {p.index for p in map(Patch.parse, names) if p.kind == "cone"}
     us = np.array(
         [u for u in np.flatnonzero(np.isfinite(res.apex[:, 0])).tolist() if u in cones],
         dtype=np.int64,

@@ -45,6 +45,7 @@ import numpy as np
 
 from ..arrays import round_significant
 from ..errors import ParameterError
+from .patch import RULED_KINDS, patch_kinds
 from .pattern import Annotations, CreasePattern, edge_dihedrals, face_arrays
 
 __all__ = [
@@ -232,7 +233,7 @@ def _ruled_strips(pattern: CreasePattern, faces: list[np.ndarray], edge_faces: n
     rulings: developed, a cylinder's rulings are parallel and a fillet's meet at one point),
     which of them are inner edges, each ruling's place across the strip (0 to 1), the strip's
     width across the rulings and their mean length."""
-    kind = np.array([p.split(" ")[0] for p in pattern.face_patch] or [""])
+    kind = patch_kinds(pattern.face_patch)
     patch = np.array(pattern.face_patch or [""])
     inner = (edge_faces >= 0).all(axis=1)
     fa, fb = edge_faces[:, 0], edge_faces[:, 1]
@@ -329,8 +330,8 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
     bound = math.tan(math.radians(min_angle))
     flat_sides = [
         np.linalg.norm(v2[f] - v2[np.roll(f, -1)], axis=1)
-        for f, name in zip(faces, pattern.face_patch, strict=True)
-        if name.startswith("face ")
+        for f, kind in zip(faces, patch_kinds(pattern.face_patch), strict=True)
+        if kind == "face"
     ]
     scale = float(np.median(np.concatenate(flat_sides))) if flat_sides else 0.0
     strips = _ruled_strips(pattern, faces, edge_faces)
@@ -565,7 +566,7 @@ def _dropped_crease_points(
     v2 = pattern.vertices_2d
     gone = np.zeros(n, dtype=bool)
     names = pattern.face_patch
-    kind = np.array([p.split(" ")[0] for p in names] or [""])
+    kind = patch_kinds(names)
     cone = kind == "cone"
     corners = np.concatenate(faces) if faces else np.zeros(0, dtype=np.int64)
     face_of = np.repeat(np.arange(len(faces)), [len(f) for f in faces])
@@ -969,9 +970,9 @@ def simulator_pattern(
     faces = _split_faces(pattern)
     flat, start = face_arrays(pattern.faces)
     n = len(pattern.vertices_2d)
-    kind = np.array([p.split(" ")[0] for p in pattern.face_patch] or [""])
+    kind = patch_kinds(pattern.face_patch)
     # a vertex may go when all its faces are on cylinders and cones
-    ruled = np.isin(kind, ["cylinder", "cone", "fillet"])
+    ruled = np.isin(kind, RULED_KINDS)
     face_of = np.repeat(np.arange(len(faces)), np.diff(start))
     droppable = np.ones(n, dtype=bool)
     droppable[flat[~ruled[face_of]]] = False

@@ -15,6 +15,7 @@ import numpy as np
 from ..arrays import split_runs
 from ..mesh.measures import dihedral_turns
 from ..tolerances import tol
+from .patch import patch_indices, patch_kinds
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
 NORMAL_CHUNK = 16_384
@@ -341,8 +342,9 @@ class CreasePattern:
     faces : list of (k,) int, or FaceRows
         Polygons, counter-clockwise in 2D.
     face_patch : list of str
-        The surface patch of each face: ``"cone <vertex>"``, ``"cylinder <edge>"`` or
-        ``"face <face>"`` (indices into the cleaned mesh and its edge list).
+        The surface patch of each face by its name (:class:`~filletfold.surface.patch.Patch`):
+        ``"cone <vertex>"``, ``"cylinder <edge>"``, ``"fillet <edge>"`` or ``"face <face>"``
+        (indices into the cleaned mesh and its edge list).
     face_piece : (n_faces,) int
         The flat piece (vertex module) each face belongs to.
     piece_vertex : (n_pieces,) int
@@ -454,14 +456,15 @@ class CreasePattern:
         """
         ef = self.edge_faces
         patch = np.asarray(self.face_patch, dtype=str)
+        kind = patch_kinds(self.face_patch)
         cand = np.flatnonzero((self.edge_assignment == "F") & (ef >= 0).all(axis=1))
         fa, fb = ef[cand, 0], ef[cand, 1]
-        keep = (patch[fa] == patch[fb]) & np.char.startswith(patch[fa], "cone ")
+        keep = (patch[fa] == patch[fb]) & (kind[fa] == "cone")
         cand, fa, fb = cand[keep], fa[keep], fb[keep]
         sharp = np.flatnonzero(np.asarray(unrounded, dtype=bool))
         if not len(cand) or not len(sharp):
             return 0
-        u = np.array([int(p[5:]) for p in patch[fa]], dtype=np.int64)
+        u = patch_indices(patch[fa].tolist())
         apex = np.asarray(vertex_apex, dtype=float)[u]
         a, b = self.vertices_3d[self.edges[cand, 0]], self.vertices_3d[self.edges[cand, 1]]
         at_a = np.linalg.norm(a - apex, axis=1) <= eps
@@ -549,7 +552,7 @@ class CreasePattern:
         patch = np.fromiter(
             map(ids.__getitem__, self.face_patch), dtype=np.int64, count=len(self.face_patch)
         )
-        kind = np.array([p.split(" ")[0] for p in ids] or [""])
+        kind = patch_kinds(list(ids))
         cyl = ((kind == "cylinder") | (kind == "fillet"))[patch]  # tangent to the faces
         face = (kind == "face")[patch]
         tangent = (cyl[fa] & face[fb]) | (face[fa] & cyl[fb])
