@@ -216,10 +216,10 @@ def round_mesh(
     with timed(timings, "rounding"):  # 2. a cylinder on every edge (sec. 2.1, 4)
         edges = edge_stage(job, st)
     with timed(timings, "normals"):  # 3. classes and vertex normals (sec. 3.1)
-        normals = normal_stage(job, edges, st)
+        state = normal_stage(job, edges, st)
     with timed(timings, "apices"):  # 3. apices (sec. 2.4, 3.2), rescue, sharp vertices
-        sol = apex_stage(job, normals, st)
-    del normals  # the solution holds what is left of it (the layout may release it)
+        sol = apex_stage(job, state, st)
+    del state  # the solution holds what is left of it (the layout may release it)
     with timed(timings, "surface"):
         mods = module_stage(job, sol, st)  # 4. creases (eq. 1), cones, cylinders, faces
         stages = stages_of(job, edges, sol, mods) if keep_stages else None

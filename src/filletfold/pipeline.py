@@ -8,7 +8,7 @@ stage                     computes                                         retur
 :func:`read_stage`        the mesh read and cleaned; the lengths that      :class:`Job`
                           every stage reads
 :func:`edge_stage`        a cylinder on every edge (sec. 2.1, 4)           :class:`Edges`
-:func:`normal_stage`      the vertex frames, classes and normals           :class:`Normals`
+:func:`normal_stage`      the vertex frames, classes and normals           :class:`VertexState`
                           (sec. 3.1)
 :func:`apex_stage`        the developed and spatial apices (sec. 2.4,      :class:`VertexSolution`
                           3.2), the rescue, the sharp vertices
@@ -65,6 +65,7 @@ from .vertex.solve import (
     solve_apices,
     use_cone_axes,
 )
+from .vertex.state import VertexState
 
 #: Rounds of :meth:`ApexStage.sharpen_cone_less`: cones no sampling can follow made sharp,
 #: their neighbours solved again (whose new cones may be such in turn).
@@ -165,21 +166,6 @@ class Edges:
     requested: np.ndarray
     centres: np.ndarray
     fitted: np.ndarray
-
-
-@dataclass
-class Normals:
-    """The normal stage's result: every vertex classified once, with its normal.
-
-    ``rounding`` and ``centres`` are the edge stage's, with the edges between saddles made
-    sharp unrounded; ``classified`` is the classification before any apex, ``res`` the copy
-    the apex stage fills in."""
-
-    rounding: EdgeRounding
-    centres: np.ndarray
-    frames: list
-    classified: VertexResult
-    res: VertexResult
 
 
 @dataclass
@@ -385,50 +371,56 @@ def edge_stage(job: Job, st: Stages | None) -> Edges:
     return Edges(loss, rounding, conical, requested, centres, rounding.radius.copy())
 
 
-def normal_stage(job: Job, edges: Edges, st: Stages | None) -> Normals:
+def normal_stage(job: Job, edges: Edges, st: Stages | None) -> VertexState:
     """Stage 3a (sec. 3.1): the vertex frames, classification and normals, every vertex
-    classified once (taken over from ``st`` when given). With saddles among the sharp kinds,
-    the saddles are known before any frame (:func:`~filletfold.vertex.solve.saddle_vertices`)
-    and made sharp from the start, their shared edges unrounded, so that each frame is built
-    once with the neighbours' sides toward them conical."""
+    classified once (taken over from ``st`` when given), as the state the apex stage starts
+    from (:class:`~filletfold.vertex.state.VertexState`: ``classified`` the classification
+    before any apex, ``res`` its copy the apex stage fills in). With saddles among the sharp
+    kinds, the saddles are known before any frame
+    (:func:`~filletfold.vertex.solve.saddle_vertices`) and made sharp from the start, their
+    shared edges unrounded, so that each frame is built once with the neighbours' sides
+    toward them conical."""
     _stage("vertex normals")
-    rounding, centres = edges.rounding, edges.centres
+    pm, p = job.mesh, job.params
+    state = VertexState(
+        mesh=pm, rounding=edges.rounding, centres=edges.centres, frames=[],
+        res=VertexResult.empty(pm.n_vertices), depths=job.depths, face_centres=face_piece_centres,
+        flat_deg=p.coplanar_deg, floor=job.floor, min_width=job.min_width, size=job.size,
+        progress=job.progress,
+    )  # fmt: skip
     if st is not None:
         # the earlier design's stages stay as they were: the apex stage replaces the frames
         # and classification of the vertices it classifies again in lists of this design's
-        frames, classified = list(st.frames), copy.deepcopy(st.classified)
-        return Normals(rounding, centres, frames, classified, copy.deepcopy(classified))
-    pm, p = job.mesh, job.params
-    classified = VertexResult.empty(pm.n_vertices)
-    saddles = saddle_vertices(pm, rounding) if "saddle" in job.kinds else None
+        state.frames, state.classified = list(st.frames), copy.deepcopy(st.classified)
+        state.res = copy.deepcopy(state.classified)
+        return state
+    classified = state.res
+    saddles = saddle_vertices(pm, state.rounding) if "saddle" in job.kinds else None
     if saddles is not None and saddles.any():
-        rounding, centres, _ = unround_between(
-            pm, rounding, centres, saddles, face_piece_centres, p.coplanar_deg, job.floor,
-            job.min_width,
-        )  # fmt: skip
+        state.rounding, state.centres, _ = unround_between(state, saddles)
     else:
         saddles = None
-    frames = classify_vertices(pm, rounding, classified, sharp=saddles)
+    state.frames = classify_vertices(pm, state.rounding, classified, sharp=saddles)
     made_sharp = [] if saddles is None else np.flatnonzero(saddles).tolist()
     for u in made_sharp:  # a saddle stays one, though its edges may all be unrounded now
         classified.kind[u] = classified.status[u] = "saddle"
         classified.reason[u] = saddle_reason(classified.normal_bound[u])
     if edges.conical:
-        use_cone_axes(pm, frames, classified)
-    res = copy.deepcopy(classified)
+        use_cone_axes(pm, state.frames, classified)
+    state.classified, state.res = classified, copy.deepcopy(classified)
     for u in made_sharp:
-        res.reason[u] = kept_sharp(res.reason[u])
-    return Normals(rounding, centres, frames, classified, res)
+        state.res.reason[u] = kept_sharp(state.res.reason[u])
+    return state
 
 
-def apex_stage(job: Job, normals: Normals, st: Stages | None) -> VertexSolution:
+def apex_stage(job: Job, state: VertexState, st: Stages | None) -> VertexSolution:
     """Stage 3b (sec. 2.4, 3.2): every vertex's apex, the rescue of the infeasible ones, the
-    cone-less vertices made sharp (:class:`ApexStage`)."""
-    return ApexStage(job, normals, st).run()
+    cone-less vertices made sharp (:class:`ApexStage`), from the normal stage's state."""
+    return ApexStage(job, state, st).run()
 
 
 class ApexStage:
-    """The apex stage's state, from the vertex normals to the :class:`VertexSolution`.
+    """The apex stage, from the vertex normals to the :class:`VertexSolution`.
 
     :meth:`run` solves every pending vertex's apex (those of a reused design's vertices whose
     depth did not change are kept), then rescues the infeasible ones, then makes the cone-less
@@ -438,18 +430,13 @@ class ApexStage:
     (degrees) with chords of at least ``min_chord`` can follow
     (:func:`~filletfold.surface.sampling.unsampled_cones`) is infeasible too, and made sharp;
     up to :data:`SAMPLING_ROUNDS` times, as its neighbours' new cones may be so in turn.
-    The frames and classification are this design's own and updated in place (the old frame
-    of a vertex classified again is freed at once: a scan's frames take hundreds of MB).
+    All of it works on one :class:`~filletfold.vertex.state.VertexState`, updated in place.
     """
 
-    def __init__(self, job: Job, normals: Normals, st: Stages | None):
-        self.job, self.st = job, st
-        self.rounding, self.centres = normals.rounding, normals.centres
-        self.frames, self.classified, self.res = normals.frames, normals.classified, normals.res
-        self.apices: dict = {}  # vertex -> (apex, developed apex), of the cones solved here
-        self.kept: set = set()
+    def __init__(self, job: Job, state: VertexState, st: Stages | None):
+        self.job, self.state, self.st = job, state, st
+        self.kept: set = set()  # the vertices whose results are taken over from ``st``
         self.rescue = Rescue()
-        self.cuts: dict = {}  # the samples each vertex's solves added, solve to solve
         self.needs: dict = {}  # each cone's sampling needs, measured once
 
     def run(self) -> VertexSolution:
@@ -458,24 +445,26 @@ class ApexStage:
         # thorough even with the rescue to come: a quick solve calls vertices infeasible that
         # are not, and the rescue would shrink their radii for nothing; but without the linear
         # programmes when the rescue follows (they pay for themselves only there)
-        p = self.job.params
-        self.apices = self.solve(pending, lp=not (p.fit_vertices and not p.material_loss))
-        if not p.material_loss and any(self.res.status[u] == "infeasible" for u in pending):
-            self.rescue_infeasible(pending)
+        p, state = self.job.params, self.state
+        state.apices = self.solve(pending, lp=not (p.fit_vertices and not p.material_loss))
+        if not p.material_loss and any(state.res.status[u] == "infeasible" for u in pending):
+            self.rescue = rescue_vertices(state, apply=p.fit_vertices, vertices=pending)
+            self.kept -= self.rescue.resolved
         self.sharpen_cone_less()
         return self.solution()
 
     def take_kept(self) -> list:
         """The vertices to solve: those not classified cone-less, less those whose depth did
         not change since the reused design (their results are taken over)."""
-        res, st, depths = self.res, self.st, self.job.depths
-        pending = [u for u in range(len(self.frames)) if res.status[u] == ""]
+        state, st = self.state, self.st
+        n, res = len(state.frames), state.res
+        pending = [u for u in range(n) if res.status[u] == ""]
         if st is None:
             return pending
-        self.kept = {u for u in range(len(self.frames)) if st.depths[u] == depths[u]}
+        self.kept = {u for u in range(n) if st.depths[u] == state.depths[u]}
         res.take(st.vertices, sorted(self.kept))
         if st.cuts:  # a kept vertex solved again starts as in a fresh design
-            self.cuts.update({u: st.cuts[u] for u in sorted(self.kept) if u in st.cuts})
+            state.cuts.update({u: st.cuts[u] for u in sorted(self.kept) if u in st.cuts})
         return [u for u in pending if u not in self.kept]
 
     def solve(self, pending: list, lp: bool = True) -> dict:
@@ -483,16 +472,16 @@ class ApexStage:
         fails unforeseen, the vertices are solved one by one and a vertex whose solve fails is
         infeasible, with the failure as its reason (a failure is data, not the end of the
         design)."""
-        job, res = self.job, self.res
+        state, res = self.state, self.state.res
 
         def solve(vertices, progress=None):
             return solve_apices(
-                self.frames, job.depths, res, self.centres, progress, vertices=vertices,
-                size=job.size, thorough=True, lp=lp, cuts=self.cuts,
+                state.frames, state.depths, res, state.centres, progress, vertices=vertices,
+                size=state.size, thorough=True, lp=lp, cuts=state.cuts,
             )  # fmt: skip
 
         try:
-            return solve(pending, job.progress)
+            return solve(pending, state.progress)
         except FilletfoldError:
             raise
         except Exception as exc:
@@ -511,25 +500,11 @@ class ApexStage:
                     out[u] = (None, None)
             return out
 
-    def rescue_infeasible(self, pending: list) -> None:
-        """The rescue of the infeasible vertices among ``pending``
-        (:func:`~filletfold.vertex.rescue.rescue_vertices`: smaller radii around them, applied
-        with ``fit_vertices``)."""
-        job = self.job
-        self.rounding, self.centres, self.rescue = rescue_vertices(
-            job.mesh, self.rounding, self.frames, self.res, job.depths, self.centres,
-            face_piece_centres, apply=job.params.fit_vertices, flat_deg=job.params.coplanar_deg,
-            floor=job.floor, min_width=job.min_width, apices=self.apices,
-            classified=self.classified, vertices=pending, sharp=self.sharp_frames(),
-            cuts=self.cuts,
-        )  # fmt: skip
-        self.kept -= self.rescue.resolved
-
     def sharpen_cone_less(self) -> None:
         """The cone-less vertices of the sharp kinds made sharp, their neighbours solved again;
         cones no sampling can follow made infeasible first (see the class)."""
-        kinds, res = self.job.kinds, self.res
-        check = set(self.apices)  # the cones solved here (those kept were checked then)
+        kinds, state = self.job.kinds, self.state
+        check = set(state.apices)  # the cones solved here (those kept were checked then)
         for _ in range(SAMPLING_ROUNDS):
             if "infeasible" in kinds and check and not self.job.params.material_loss:
                 # a cone no sampling can follow (its facets would fold past the arc step, or
@@ -537,66 +512,48 @@ class ApexStage:
                 # again (not with the material-loss radii, which fold one uncut sheet as they
                 # are)
                 self.drop_unsampled(check)
-            already = self.sharp_frames()
+            already = state.sharp_frames()
             if not kinds or not any(
-                sharp_kind(s) in kinds and not a for s, a in zip(res.status, already, strict=True)
+                sharp_kind(s) in kinds and not a
+                for s, a in zip(state.res.status, already, strict=True)
             ):
                 break
-            sharpening = self.sharpen()
+            _stage("sharp vertices")
+            sharpening = sharpen_vertices(state, kinds)
             self.kept -= sharpening.resolved | set(np.flatnonzero(sharpening.sharp).tolist())
-            check = {u for u in sharpening.resolved if u in self.apices}
+            check = {u for u in sharpening.resolved if u in state.apices}
 
     def drop_unsampled(self, check: set) -> None:
         """The cones among ``check`` that no sampling of their arcs can follow
         (:func:`~filletfold.surface.sampling.unsampled_cones`) made infeasible."""
-        job, res = self.job, self.res
-        cones = [
-            (self.frames[u], *self.apices[u])
-            for u in sorted(check)
-            if self.apices[u][0] is not None
-        ]
+        job, state, res = self.job, self.state, self.state.res
+        apices = state.apices
+        cones = [(state.frames[u], *apices[u]) for u in sorted(check) if apices[u][0] is not None]
         unsampled = unsampled_cones(
-            cones, self.centres, job.params.arc_step, job.min_chord, self.needs
+            cones, state.centres, job.params.arc_step, job.min_chord, self.needs
         )
         for u, why in unsampled.items():
-            res.status[u], res.reason[u], self.apices[u] = "infeasible", why, (None, None)
+            res.status[u], res.reason[u], apices[u] = "infeasible", why, (None, None)
             res.apex[u], res.apex_developed[u] = np.nan, np.nan  # no cone: no apex
             res.depth[u], res.margin[u], res.solver[u] = np.nan, np.nan, ""
 
-    def sharpen(self):
-        """:func:`~filletfold.vertex.sharpen.sharpen_vertices` of the sharp kinds on this
-        stage's state; the :class:`~filletfold.vertex.sharpen.Sharpening`."""
-        job = self.job
-        _stage("sharp vertices")
-        self.rounding, self.centres, sharpening = sharpen_vertices(
-            job.mesh, self.rounding, self.frames, self.res, job.depths, self.centres,
-            face_piece_centres, self.apices, job.kinds, flat_deg=job.params.coplanar_deg,
-            floor=job.floor, min_width=job.min_width, classified=self.classified,
-            sharp=self.sharp_frames(), cuts=self.cuts, size=job.size, progress=job.progress,
-        )  # fmt: skip
-        return sharpening
-
-    def sharp_frames(self) -> np.ndarray:
-        """(n_vertices,) bool: the vertices whose frames are built sharp."""
-        return np.array([f.sharp for f in self.frames], dtype=bool)
-
     def solution(self) -> VertexSolution:
-        st = self.st
+        state, st = self.state, self.st
         solved = [
-            st.solved[u] if u in self.kept else (frame, *self.apices.get(u, (None, None)))
-            for u, frame in enumerate(self.frames)
+            st.solved[u] if u in self.kept else (frame, *state.apices.get(u, (None, None)))
+            for u, frame in enumerate(state.frames)
         ]
-        set_treatments(self.res, self.sharp_frames())
+        set_treatments(state.res, state.sharp_frames())
         return VertexSolution(
-            rounding=self.rounding,
-            centres=self.centres,
-            frames=self.frames,
-            classified=self.classified,
-            res=self.res,
+            rounding=state.rounding,
+            centres=state.centres,
+            frames=state.frames,
+            classified=state.classified,
+            res=state.res,
             solved=solved,
             kept=self.kept,
             rescue=self.rescue,
-            cuts=self.cuts,
+            cuts=state.cuts,
             needs=self.needs,
         )
 

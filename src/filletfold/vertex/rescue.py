@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..mesh.polymesh import PolyMesh, mesh_size
-from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
+from ..mesh.polymesh import PolyMesh
 from .solve import VertexResult, classify_vertices, solve_apices
+from .state import VertexState
 
 #: Halvings of an infeasible vertex's radii tried before it is left infeasible (1/16 at most).
 ROUNDS = 4
@@ -56,73 +56,36 @@ class Rescue:
     sharpened: list = field(default_factory=list)
 
 
-def rescue_vertices(
-    mesh: PolyMesh,
-    rounding: EdgeRounding,
-    frames: list,
-    res: VertexResult,
-    depths: np.ndarray,
-    centres: np.ndarray,
-    face_centres,
-    *,
-    apply: bool,
-    flat_deg: float,
-    floor: float = 0.0,
-    min_width: float = 0.0,
-    apices: dict,
-    classified: VertexResult | None = None,
-    vertices=None,
-    sharp: np.ndarray | None = None,
-    cuts: dict | None = None,
-) -> tuple[EdgeRounding, np.ndarray, Rescue]:
+def rescue_vertices(state: VertexState, *, apply: bool, vertices=None) -> Rescue:
     """Try smaller radii on the edges of every infeasible cone vertex.
 
     Parameters
     ----------
-    mesh : PolyMesh
-    rounding : EdgeRounding
-    frames : list of VertexFrame
-        Indexed by vertex; entries of re-solved vertices are replaced (``apply``).
-    res : VertexResult
-        Updated in place: re-solved vertices (``apply``), or the reasons of the vertices a
-        smaller radius would rescue (not ``apply``).
-    depths : (n_vertices,) float
-    centres : (n_faces, 3) float
-        Face piece centres of ``rounding``.
-    face_centres : callable
-        ``face_centres(mesh, rounding) -> (n_faces, 3)`` (:func:`~filletfold.surface.module.
-        face_piece_centres`).
+    state : VertexState
+        With ``apply``: updated in place -- its rounding and centres, the frames, results,
+        classification and apices of the vertices classified and solved again. Without: only
+        the reasons of the vertices a smaller radius would rescue (``state.res``). Its
+        sharp vertices (frames built sharp) keep their neighbours' sides conical, their
+        status and their reason; the samples its solves added (``state.cuts``) are where each
+        vertex solved again starts, and are updated.
     apply : bool
-    flat_deg, floor, min_width : float
-        Passed to :func:`~filletfold.rounding.edges.round_edges`.
-    apices : dict
-        Vertex -> (apex, developed apex) of :func:`solve_apices`; updated in place
-        (``apply``).
-    classified : VertexResult, optional
-        The classification before any apex (what a later design reuses): updated in place at
-        the re-classified vertices (``apply``).
     vertices : iterable of int, optional
         Try only these vertices (default: every infeasible cone vertex).
-    sharp : (n_vertices,) bool, optional
-        Sharp vertices (:mod:`~filletfold.vertex.sharpen`): the frames built again keep their
-        neighbours' sides conical, and they keep their status and reason.
-    cuts : dict, optional
-        The samples earlier solves added (:func:`~filletfold.vertex.solve.solve_apices`):
-        each vertex solved again starts with its own, and the dict is updated.
 
     Returns
     -------
-    rounding : EdgeRounding
-    centres : (n_faces, 3) float
-    rescue : Rescue
+    Rescue
     """
+    mesh, frames, res, depths = state.mesh, state.frames, state.res, state.depths
+    classified, apices, cuts = state.classified, state.apices, state.cuts
+    rounding, sharp = state.rounding, state.sharp_frames()
     out = Rescue(applied=apply)
     bad = _infeasible(res)
     if vertices is not None:
         allowed = set(int(u) for u in vertices)
         bad = [u for u in bad if u in allowed]
     if not bad:
-        return rounding, centres, out
+        return out
     radius = rounding.radius.copy()
     start = radius.copy()
     factor = {u: 1.0 for u in bad}
@@ -138,10 +101,7 @@ def rescue_vertices(
         if apply:  # each new vertex's own factor first, found on a copy: one round, not four
             new = [u for u in bad if tries[u] == 0 and u not in probed]
             probed.update(new)
-            jump = _probe(
-                mesh, radius, rounding.half_angle, frames, depths, face_centres, new,
-                flat_deg, floor, min_width, sharp, cuts,
-            )  # fmt: skip
+            jump = _probe(state, radius, new, sharp)
         scale = np.ones(len(radius))
         for u in bad:
             halvings = jump.get(u, 1)
@@ -154,9 +114,7 @@ def rescue_vertices(
         if not len(edges):
             break
         radius[edges] *= scale[edges]
-        radius, new_rounding, new_centres = reround(
-            mesh, radius, rounding.half_angle, face_centres, flat_deg, floor, min_width
-        )
+        radius, new_rounding, new_centres = state.reround(radius)
         if apply:
             affected = face_vertices(mesh, edges)
             target = res
@@ -180,7 +138,7 @@ def rescue_vertices(
             new_centres,
             vertices=todo,
             thorough=max(tries[u] for u in bad) >= ROUNDS,  # the fallbacks at the last factor
-            size=mesh_size(mesh),
+            size=state.size,
             cuts=cuts,
         )
         if apply:
@@ -189,7 +147,7 @@ def rescue_vertices(
                 frames[u] = frame
             for u in affected.tolist():  # a vertex now without a cone (sharp) has no apex
                 apices[u] = solved.get(u, (None, None))
-            rounding, centres = new_rounding, new_centres
+            state.rounding, state.centres = new_rounding, new_centres
         for u in list(bad):
             if target.status[u] == "ok":
                 out.rescued[u] = factor[u]
@@ -226,27 +184,15 @@ def rescue_vertices(
                 f"; its cone is feasible with the radii of its edges multiplied by {f:g} "
                 f"(at most {r.max() * f:.4g}): --fit-vertices does so"
             )
-    return rounding, centres, out
+    return out
 
 
-def _probe(
-    mesh,
-    radius,
-    half_angle,
-    frames,
-    depths,
-    face_centres,
-    vertices,
-    flat_deg,
-    floor,
-    min_width,
-    sharp,
-    cuts=None,
-) -> dict:
+def _probe(state: VertexState, radius: np.ndarray, vertices, sharp: np.ndarray) -> dict:
     """How many halvings of its edges' radii (1 to :data:`ROUNDS`) each of ``vertices`` needs
     for a feasible cone, found on a copy: ``vertices`` alone are classified and solved again
     (quick solves) after each halving, as ``apply=False`` does. A vertex no halving makes
     feasible so gets :data:`ROUNDS` (the last factor, tried thoroughly when applied)."""
+    mesh, frames = state.mesh, state.frames
     need = dict.fromkeys(vertices, ROUNDS)
     todo = list(vertices)
     trial = VertexResult.empty(mesh.n_vertices)
@@ -256,64 +202,25 @@ def _probe(
         scale = np.ones(len(radius))
         for u in todo:
             scale[frames[u].ring.edges] = 0.5**j
-        _, rounding, centres = reround(
-            mesh, radius * scale, half_angle, face_centres, flat_deg, floor, min_width
-        )
+        _, rounding, centres = state.reround(radius * scale)
         idx = np.array(todo, dtype=np.int64)
         trial.take(VertexResult.empty(mesh.n_vertices), idx)
         new_frames = classify_vertices(mesh, rounding, trial, idx, sharp=sharp)
         solve_apices(
             dict(zip(todo, new_frames, strict=True)),
-            depths,
+            state.depths,
             trial,
             centres,
             vertices=[u for u in todo if trial.status[u] == ""],
             thorough=False,
-            size=mesh_size(mesh),
-            cuts=cuts,
+            size=state.size,
+            cuts=state.cuts,
         )
         for u in todo:
             if trial.status[u] == "ok":
                 need[u] = j
         todo = [u for u in todo if trial.status[u] != "ok"]
     return need
-
-
-def reround(
-    mesh: PolyMesh,
-    radius: np.ndarray,
-    half_angle: np.ndarray,
-    face_centres,
-    flat_deg: float,
-    floor: float,
-    min_width: float,
-) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
-    """The rounding of new radii, and its face piece centres: what the rescue and the sharp
-    vertices (:func:`~filletfold.vertex.sharpen.sharpen_vertices`) do after changing radii.
-
-    Parameters
-    ----------
-    mesh : PolyMesh
-    radius : (n_edges,) float
-        The new radii.
-    half_angle : (n_edges,) float
-        The edges' half angles (:attr:`EdgeRounding.half_angle`).
-    face_centres : callable
-        ``face_centres(mesh, rounding) -> (n_faces, 3)``.
-    flat_deg, floor, min_width : float
-        Passed to :func:`~filletfold.rounding.edges.round_edges`.
-
-    Returns
-    -------
-    radius : (n_edges,) float
-        ``radius`` with the radii that would break an obtuse corner shrunk
-        (:func:`~filletfold.rounding.edges.shrink_broken`).
-    rounding : EdgeRounding
-    centres : (n_faces, 3) float
-    """
-    radius = shrink_broken(mesh, radius, half_angle)
-    rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width)
-    return radius, rounding, face_centres(mesh, rounding)
 
 
 def face_vertices(mesh: PolyMesh, edges) -> np.ndarray:

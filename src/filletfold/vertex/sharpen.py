@@ -24,8 +24,9 @@ import numpy as np
 from ..errors import ParameterError
 from ..mesh.polymesh import PolyMesh
 from ..rounding.edges import EdgeRounding
-from .rescue import face_vertices, reround
+from .rescue import face_vertices
 from .solve import VertexResult, classify_vertices, solve_apices
+from .state import VertexState
 
 #: The kinds of cone-less vertices that ``--sharp`` can make sharp, in the order they are
 #: named.
@@ -100,30 +101,20 @@ def sharp_kind(status: str) -> str | None:
 
 
 def unround_between(
-    mesh: PolyMesh,
-    rounding: EdgeRounding,
-    centres: np.ndarray,
-    sharp: np.ndarray,
-    face_centres,
-    flat_deg: float,
-    floor: float,
-    min_width: float,
+    state: VertexState, sharp: np.ndarray
 ) -> tuple[EdgeRounding, np.ndarray, np.ndarray]:
     """Leave every rounded edge between two ``sharp`` vertices unrounded (a straight crease).
 
-    Returns the rounding and face piece centres afterwards (the same objects when no edge
-    changed) and which edges changed, (n_edges,) bool. ``face_centres``, ``flat_deg``,
-    ``floor`` and ``min_width`` as :func:`~filletfold.vertex.rescue.reround` takes them.
+    Returns the rounding and face piece centres afterwards (``state``'s own when no edge
+    changed; the state itself is not changed) and which edges changed, (n_edges,) bool.
     """
-    ends = mesh.edges
+    ends, rounding = state.mesh.edges, state.rounding
     both = sharp[ends[:, 0]] & sharp[ends[:, 1]] & (rounding.radius > 0)
     if not both.any():
-        return rounding, centres, both
+        return rounding, state.centres, both
     radius = rounding.radius.copy()
     radius[both] = 0.0
-    _, rounding, centres = reround(
-        mesh, radius, rounding.half_angle, face_centres, flat_deg, floor, min_width
-    )
+    _, rounding, centres = state.reround(radius)
     return rounding, centres, both
 
 
@@ -145,72 +136,32 @@ class Sharpening:
     rounds: int = 0
 
 
-def sharpen_vertices(
-    mesh: PolyMesh,
-    rounding: EdgeRounding,
-    frames: list,
-    res: VertexResult,
-    depths: np.ndarray,
-    centres: np.ndarray,
-    face_centres,
-    apices: dict,
-    kinds,
-    *,
-    flat_deg: float,
-    floor: float,
-    min_width: float,
-    size: float | None = None,
-    progress=None,
-    classified: VertexResult | None = None,
-    sharp: np.ndarray | None = None,
-    cuts: dict | None = None,
-) -> tuple[EdgeRounding, np.ndarray, Sharpening]:
+def sharpen_vertices(state: VertexState, kinds) -> Sharpening:
     """Make the cone-less vertices of ``kinds`` sharp and solve their neighbours again.
 
     Parameters
     ----------
-    mesh : PolyMesh
-    rounding : EdgeRounding
-    frames : list of VertexFrame
-        By vertex; the frames of the sharp vertices and of the vertices solved again are
-        replaced in place.
-    res : VertexResult
-        Updated in place (statuses and apices of the vertices solved again).
-    depths : (n_vertices,) float
-    centres : (n_faces, 3) float
-        Face piece centres.
-    face_centres : callable
-        ``face_centres(mesh, rounding)``: the centres again for a new rounding.
-    apices : dict
-        ``vertex -> (apex, developed apex)``, updated in place.
+    state : VertexState
+        Updated in place: its rounding and centres (the edges between sharp vertices
+        unrounded), the frames of the sharp vertices and of the vertices solved again, their
+        results, classification and apices. The vertices whose frames are built sharp
+        already stay sharp and keep their reasons.
     kinds : iterable of str
         Of :data:`SHARP_KINDS`.
-    flat_deg, floor, min_width : float
-        Passed to :func:`~filletfold.rounding.edges.round_edges`.
-    size : float, optional
-        Passed to :func:`~filletfold.vertex.solve.solve_apices`.
-    progress : callable, optional
-    classified : VertexResult, optional
-        The classification before the apices (for a later ``reuse``): updated alike.
-    sharp : (n_vertices,) bool, optional
-        Vertices already sharp (their frames built so): they stay sharp and keep their
-        reasons. Default: none.
-    cuts : dict, optional
-        The samples earlier solves added (:func:`~filletfold.vertex.solve.solve_apices`).
 
     Returns
     -------
-    rounding : EdgeRounding
-    centres : (n_faces, 3) float
     Sharpening
     """
+    mesh, frames, res, apices = state.mesh, state.frames, state.res, state.apices
+    rounding, centres, classified = state.rounding, state.centres, state.classified
     kinds = frozenset(kinds)
     n = mesh.n_vertices
-    sharp = np.zeros(n, dtype=bool) if sharp is None else np.array(sharp, dtype=bool)
+    sharp = state.sharp_frames()
     initial = sharp.copy()
     out = Sharpening(sharp)
     if not kinds:
-        return rounding, centres, out
+        return out
     ends = mesh.edges
     # rounds until no vertex of ``kinds`` is left without its corner: each makes the newly
     # infeasible neighbours of the last round's sharp vertices sharp, and every round adds one
@@ -224,9 +175,8 @@ def sharpen_vertices(
             break
         out.rounds += 1
         sharp[new] = True
-        rounding, centres, changed = unround_between(
-            mesh, rounding, centres, sharp, face_centres, flat_deg, floor, min_width
-        )
+        rounding, centres, changed = unround_between(state, sharp)
+        state.rounding, state.centres = rounding, centres
         # the vertices whose sides changed: neighbours of the new sharp vertices, and every
         # vertex of a face whose piece (and centre) changed with an unrounded edge
         near = np.zeros(n, dtype=bool)
@@ -252,14 +202,14 @@ def sharpen_vertices(
             apices.pop(u, None)
         if todo:
             solved = solve_apices(
-                {u: frames[u] for u in todo}, depths, res, centres, progress, todo, size=size,
-                cuts=cuts,
+                {u: frames[u] for u in todo}, state.depths, res, centres, state.progress, todo,
+                size=state.size, cuts=state.cuts,
             )  # fmt: skip
             apices.update(solved)
         out.resolved.update(int(u) for u in again)
     for u in np.flatnonzero(sharp & ~initial).tolist():
         res.reason[u] = kept_sharp(res.reason[u])
-    return rounding, centres, out
+    return out
 
 
 def kept_sharp(reason: str) -> str:

@@ -1,0 +1,133 @@
+"""The vertices' state that the apex stage, the rescue and the sharp vertices share.
+
+The apex stage of the pipeline solves every vertex's apex, then the rescue
+(:func:`~filletfold.vertex.rescue.rescue_vertices`) shrinks the radii around infeasible
+vertices and the sharp vertices (:func:`~filletfold.vertex.sharpen.sharpen_vertices`) unround
+the edges between cone-less ones; both classify and solve the affected vertices again. They
+read and update the same things -- the rounding, the face piece centres, the frames, the
+results, the apices -- which :class:`VertexState` holds, instead of a dozen arguments each.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..mesh.polymesh import PolyMesh
+from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
+from .solve import VertexResult
+
+
+@dataclass
+class VertexState:
+    """The vertices of one design while their apices are found; updated in place.
+
+    Attributes
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+        The current radii (the rescue and the sharp vertices replace it).
+    centres : (n_faces, 3) float
+        The face piece centres of ``rounding``.
+    frames : list of VertexFrame
+        By vertex; the frames of vertices classified again are replaced in place (the old
+        one freed at once: a scan's frames take hundreds of MB).
+    res : VertexResult
+        The per-vertex results.
+    depths : (n_vertices,) float
+    face_centres : callable
+        ``face_centres(mesh, rounding) -> (n_faces, 3)``
+        (:func:`~filletfold.surface.centres.face_piece_centres`, given by the pipeline: this
+        room comes before the surface's).
+    flat_deg, floor, min_width : float
+        What :func:`~filletfold.rounding.edges.round_edges` takes: the coplanar tolerance,
+        and the narrowest fillet kept, relative and absolute.
+    size : float
+        The mesh's size (:func:`~filletfold.mesh.polymesh.mesh_size`).
+    classified : VertexResult or None
+        The classification before any apex (what a later design reuses): updated alike at
+        the vertices classified again.
+    apices : dict
+        Vertex -> (apex, developed apex) of the cones solved
+        (:func:`~filletfold.vertex.solve.solve_apices`).
+    cuts : dict
+        The samples each vertex's solves added: a vertex solved again starts with its own.
+    progress : callable or None
+        ``progress(stage, done, total)``.
+    """
+
+    mesh: PolyMesh
+    rounding: EdgeRounding
+    centres: np.ndarray
+    frames: list
+    res: VertexResult
+    depths: np.ndarray
+    face_centres: Callable
+    flat_deg: float
+    floor: float
+    min_width: float
+    size: float
+    classified: VertexResult | None = None
+    apices: dict = field(default_factory=dict)
+    cuts: dict = field(default_factory=dict)
+    progress: Any = None
+
+    def sharp_frames(self) -> np.ndarray:
+        """(n_vertices,) bool: the vertices whose frames are built sharp."""
+        return np.array([f.sharp for f in self.frames], dtype=bool)
+
+    def reround(self, radius: np.ndarray) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
+        """The rounding of new radii and its face piece centres (the state unchanged).
+
+        Parameters
+        ----------
+        radius : (n_edges,) float
+
+        Returns
+        -------
+        radius : (n_edges,) float
+            ``radius`` with the radii that would break an obtuse corner shrunk
+            (:func:`~filletfold.rounding.edges.shrink_broken`).
+        rounding : EdgeRounding
+        centres : (n_faces, 3) float
+        """
+        return reround(
+            self.mesh, radius, self.rounding.half_angle, self.face_centres, self.flat_deg,
+            self.floor, self.min_width,
+        )  # fmt: skip
+
+
+def reround(
+    mesh: PolyMesh,
+    radius: np.ndarray,
+    half_angle: np.ndarray,
+    face_centres,
+    flat_deg: float,
+    floor: float,
+    min_width: float,
+) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
+    """The rounding of new radii, and its face piece centres.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    radius : (n_edges,) float
+        The new radii.
+    half_angle : (n_edges,) float
+        The edges' half angles (:attr:`EdgeRounding.half_angle`).
+    face_centres : callable
+        ``face_centres(mesh, rounding) -> (n_faces, 3)``.
+    flat_deg, floor, min_width : float
+        Passed to :func:`~filletfold.rounding.edges.round_edges`.
+
+    Returns
+    -------
+    radius, rounding, centres
+        As :meth:`VertexState.reround`.
+    """
+    radius = shrink_broken(mesh, radius, half_angle)
+    rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width)
+    return radius, rounding, face_centres(mesh, rounding)
