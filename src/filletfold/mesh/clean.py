@@ -177,28 +177,11 @@ def clean_mesh(
     v = v[used]
     face_list = [new_of_rep[f] for f in face_list]
 
-    # 5. non-manifold vertices and edges
-    face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
-    he = _HalfEdges(face_list, len(v))
-    if not strict and (he.edge_count > 2).any():  # sheets still joined elsewhere: cut them off
-        face_list, v, vert_orig = detach_faces(face_list, face_origin, v, vert_orig, he, log)
-        face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
-        he = _HalfEdges(face_list, len(v))
-    _check_manifold(he, vert_orig)
-
-    # 6. orientation (a component that cannot be oriented is cut where it conflicts)
-    face_list, flipped, conflicts = _orient(
-        he, face_list, v, face_origin, strict, log=log, vert_orig=vert_orig
+    # 5. non-manifold vertices and edges split; 6. orientation (a component that cannot be
+    # oriented is cut open where it conflicts)
+    face_list, v, vert_orig, he, flipped = _manifold_oriented(
+        face_list, face_origin, v, vert_orig, log, strict
     )
-    if conflicts:
-        face_list, v, vert_orig = split_non_manifold(
-            face_list, face_origin, v, vert_orig, log, unpaired=conflicts
-        )
-        he = _HalfEdges(face_list, len(v))
-        face_list, flipped2, conflicts = _orient(
-            he, face_list, v, face_origin, True, log=log, vert_orig=vert_orig
-        )
-        flipped += flipped2
     _check_not_soup(he, face_list, face_origin)
     face_list, face_origin, v, vert_orig, flipped2 = _unfold(
         he, face_list, face_origin, v, vert_orig, log, strict
@@ -598,15 +581,31 @@ def _ensure_manifold(face_list, face_origin, v, vert_orig, log: RepairLog, stric
             "oriented consistently",
             edge=(a, b),
         )
+    face_list, v, vert_orig, _, flipped = _manifold_oriented(
+        face_list, face_origin, v, vert_orig, log, False
+    )
+    return face_list, v, vert_orig, flipped
+
+
+def _manifold_oriented(face_list, face_origin, v, vert_orig, log: RepairLog, strict: bool):
+    """Non-manifold vertices and edges split (without ``strict``, sheets still joined along
+    an edge of more than two faces detached first), then the faces oriented consistently; a
+    component that cannot be oriented is cut open where it conflicts and oriented again.
+
+    Returns
+    -------
+    face_list, v, vert_orig, he, flipped
+        ``he`` the half-edges of the result, ``flipped`` the number of faces turned over.
+    """
     face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
     he = _HalfEdges(face_list, len(v))
-    if (he.edge_count > 2).any():
+    if not strict and (he.edge_count > 2).any():  # sheets still joined elsewhere: cut them off
         face_list, v, vert_orig = detach_faces(face_list, face_origin, v, vert_orig, he, log)
         face_list, v, vert_orig = split_non_manifold(face_list, face_origin, v, vert_orig, log)
         he = _HalfEdges(face_list, len(v))
     _check_manifold(he, vert_orig)
     face_list, flipped, conflicts = _orient(
-        he, face_list, v, face_origin, False, log=log, vert_orig=vert_orig
+        he, face_list, v, face_origin, strict, log=log, vert_orig=vert_orig
     )
     if conflicts:
         face_list, v, vert_orig = split_non_manifold(
@@ -617,7 +616,7 @@ def _ensure_manifold(face_list, face_origin, v, vert_orig, log: RepairLog, stric
             he, face_list, v, face_origin, True, log=log, vert_orig=vert_orig
         )
         flipped += flipped2
-    return face_list, v, vert_orig, flipped
+    return face_list, v, vert_orig, he, flipped
 
 
 # ------------------------------------------------------------------------------ 5. orient
