@@ -164,3 +164,38 @@ def test_the_checks_see_a_circle_and_an_upward_import(tmp_path):
     graph = import_graph(pkg)
     assert cycles(graph) == [["filletfold.surface.a", "filletfold.surface.b"]]
     assert upward(graph) == [("filletfold.surface.d", "filletfold.export.c")]
+
+
+def parameter_counts(path: Path) -> dict[str, int]:
+    """Function name -> how many parameters it takes (``self``/``cls`` not counted; ``*args``
+    and ``**kwargs`` not counted), for every function and method in ``path``."""
+    out = {}
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            a = node.args
+            names = [x.arg for x in (*a.posonlyargs, *a.args, *a.kwonlyargs)]
+            out[node.name] = len([n for n in names if n not in ("self", "cls")])
+    return out
+
+
+#: The pipeline's modules: the orchestrator, its stages, the parameters, and the state the apex
+#: stage shares with the rescue and the sharp vertices.
+PIPELINE = ["design.py", "pipeline.py", "parameters.py", "vertex/state.py", "vertex/rescue.py",
+            "vertex/sharpen.py"]  # fmt: skip
+
+
+def test_the_orchestrator_is_short_and_the_stages_take_few_parameters():
+    """round_mesh reads in one screen (under 80 lines with its docstring), and no function of
+    the pipeline takes more than 8 parameters (state travels in Job, VertexState and the
+    stages' results). Not vacuous: the scan counts the command line's round (its options)."""
+    assert parameter_counts(ROOT / "cli.py")["round_cmd"] > 8
+    tree = ast.parse((ROOT / "design.py").read_text(encoding="utf-8"))
+    (orchestrator,) = [n for n in tree.body if getattr(n, "name", "") == "round_mesh"]
+    assert orchestrator.end_lineno - orchestrator.lineno + 1 < 80
+    many = {
+        f"{path}:{name}": n
+        for path in PIPELINE
+        for name, n in parameter_counts(ROOT / path).items()
+        if n > 8
+    }
+    assert many == {}

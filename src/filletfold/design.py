@@ -164,24 +164,19 @@ def round_mesh(
     mesh : PolyMesh, str, Path or (vertices, faces)
         A mesh, a file path (OBJ, OFF, PLY, STL, glTF), a built-in example name, or arrays.
     params : Parameters, optional
-        The design's parameters (default: :class:`~filletfold.parameters.Parameters`'s
-        defaults).
+        The design's parameters (default: :class:`~filletfold.parameters.Parameters`()).
     **options
         Fields of :class:`~filletfold.parameters.Parameters` that replace those of ``params``
-        (``radius="5%"``, ``depth=0.3``, ``samples``, ``arc_step``, ``chord_tol``, ``clamp``,
-        ``material_loss``, ``max_loss``, ``layout``, ``coplanar_deg``, ``fit_vertices``,
-        ``strict``, ``sharp``, ``sheet``, ``units``, ``scale``, ``tabs``, ``nest``).
+        (``radius="5%"``, ``depth=0.3``, ``samples=24``, ``material_loss=True``, ...).
     progress : callable, optional
         ``progress(stage, done, total)`` called during long stages.
     reuse : Design, optional
-        An earlier design of the same mesh: when the rounding parameters are the same, its
-        rounding, frames and normals are taken over and only the vertices whose depth changed
-        are re-solved and rebuilt (see :class:`Stages`); when ``mesh`` is a :class:`PolyMesh`
-        equal to the earlier one (same coplanar tolerance and ``strict``), its cleaned mesh is
-        taken over whatever the other parameters. The result is the same as without.
+        An earlier design of the same mesh, whose stages are taken over where they hold for
+        this one (:func:`~filletfold.pipeline.reusable_stages`: only the vertices whose depth
+        changed are solved again). The result is the same as without.
     certify : bool
-        Measure the design's invariants (:func:`filletfold.check.certify_design`) into
-        ``design.certificate`` (about 5 % of the time; the browser app skips it).
+        Measure the design's invariants into ``design.certificate``
+        (:func:`filletfold.check.certify_design`, about 5 % of the time; the app skips it).
     keep_stages : bool
         Keep what ``reuse`` needs in ``design.stages`` (the default). False lets the vertex
         frames and modules go as soon as the layout no longer needs them, and the pieces once
@@ -201,9 +196,8 @@ def round_mesh(
     ParameterError
         An unknown or invalid parameter (a radius over an edge's limit names the edge).
     SolverError
-        With ``material_loss``: the programme has no solution with positive losses (the
-        message names the binding vertices and edges); with ``layout="sheet"``: the modules do
-        not fit into one sheet.
+        No positive losses with ``material_loss`` (naming the binding vertices and edges), or
+        no single sheet with ``layout="sheet"``.
     """
     t0 = time.perf_counter()
     timings: dict = {}
@@ -225,14 +219,20 @@ def round_mesh(
         stages = stages_of(job, edges, sol, mods) if keep_stages else None
         laid = layout_stage(job, sol, mods, not keep_stages, timings)  # 5. the crease pattern
     design = _design(job, edges, sol, laid, stages, timings)
-    if certify:
-        from .check import certify_design
-
+    if certify:  # 6. the design's invariants measured again
         with timed(timings, "certificate"):
-            _stage("certificate")
-            design.certificate = certify_design(design)
+            design.certificate = _certificate(design)
     timings["total"] = time.perf_counter() - t0
     return design
+
+
+def _certificate(design: Design):
+    """The design's certificate (:func:`filletfold.check.certify_design`, imported on the
+    first design that is certified: the app's slider designs are not)."""
+    from .check import certify_design
+
+    _stage("certificate")
+    return certify_design(design)
 
 
 def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, timings) -> Design:

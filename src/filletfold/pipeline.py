@@ -45,7 +45,7 @@ from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
 from .surface.assemble import locate_apices
 from .surface.centres import face_piece_centres
-from .surface.module import build_modules
+from .surface.module import Modules, build_modules
 from .surface.pattern import CreasePattern
 from .surface.sampling import cone_sample_counts, unsampled_cones
 from .tolerances import tol
@@ -57,6 +57,7 @@ from .vertex.sharpen import (
     sharpen_vertices,
     unround_between,
 )
+from .vertex.solution import VertexSolution
 from .vertex.solve import (
     VertexResult,
     classify_vertices,
@@ -166,51 +167,6 @@ class Edges:
     requested: np.ndarray
     centres: np.ndarray
     fitted: np.ndarray
-
-
-@dataclass
-class VertexSolution:
-    """The apex stage's result.
-
-    Attributes
-    ----------
-    rounding : EdgeRounding
-        The radii used (smaller where vertices were rescued, unrounded around sharp ones).
-    centres : (n_faces, 3) float
-    frames : list of VertexFrame
-    classified : VertexResult
-        The classification before any apex (of the frames as they are now).
-    res : VertexResult
-        The final per-vertex results.
-    solved : list of (VertexFrame, apex or None, developed apex or None)
-    kept : set of int
-        The vertices whose results were taken over from an earlier design.
-    rescue : Rescue
-    cuts : dict
-        The samples each vertex's solves added (:func:`~filletfold.vertex.solve.solve_apices`).
-    needs : dict
-        Each cone's sampling needs, measured here and used once by the module stage.
-    """
-
-    rounding: EdgeRounding
-    centres: np.ndarray
-    frames: list | None
-    classified: VertexResult | None
-    res: VertexResult
-    solved: list | None
-    kept: set
-    rescue: Rescue
-    cuts: dict
-    needs: dict
-
-
-@dataclass
-class Modules:
-    """The module stage's result: ``points`` (n_edges,) int, the samples on each edge's arc,
-    and ``modules``, each vertex's list of pieces."""
-
-    points: np.ndarray
-    modules: list | None
 
 
 @dataclass
@@ -555,6 +511,7 @@ class ApexStage:
             rescue=self.rescue,
             cuts=state.cuts,
             needs=self.needs,
+            ring_closed=[f.ring.closed for f in state.frames],
         )
 
 
@@ -623,31 +580,12 @@ def layout_stage(
     lowers the peak memory of a large design by about a third."""
     p, pm = job.params, job.mesh
     pieces = [piece for module in mods.modules for piece in module]
-    ring_closed = [f.ring.closed for f in sol.frames]
-    solved = sol.solved
     if release and not (p.layout == "net" or (p.layout == "auto" and p.sheet is not None)):
         # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
-        sol.frames = sol.classified = sol.solved = solved = mods.modules = None
+        sol.frames = sol.classified = sol.solved = mods.modules = None
     _stage("layout")
     pattern, layout_used, layout_note, fab = arrange(
-        pm,
-        sol.rounding,
-        pieces,
-        solved,
-        sol.centres,
-        mods.points,
-        sol.res,
-        ring_closed,
-        layout=p.layout,
-        material_loss=p.material_loss,
-        sheet=p.sheet,
-        units=p.sheet_units,
-        scale=p.sheet_scale,
-        tabs=p.tabs,
-        nest=p.nest,
-        stage=_stage,
-        timings=timings,
-        release_pieces=release,
+        pm, sol, mods, pieces, p, stage=_stage, timings=timings, release_pieces=release
     )
     locate_apices(pattern, sol.res)
     pattern.crease_sharp_rulings(  # a cone is creased along its rulings to sharp edges

@@ -13,8 +13,10 @@ import numpy as np
 
 from ..errors import ParameterError, SolverError
 from ..surface.assemble import assemble_pattern
+from ..surface.module import Modules
 from ..surface.piece import piece_area
 from ..tolerances import tol
+from ..vertex.solution import VertexSolution
 from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
 from .nest import SEED, choose_nester, nest_on_sheets, placement_errors, use_figures
 from .sheet import glue_pieces
@@ -26,22 +28,12 @@ TAB_HEIGHT = 0.04
 
 
 def arrange(
-    pm,
-    rounding,
+    mesh,
+    sol: VertexSolution,
+    mods: Modules,
     pieces: list,
-    solved: list | None,
-    centres,
-    points,
-    res,
-    ring_closed: list,
+    params,
     *,
-    layout: str,
-    material_loss: bool,
-    sheet,
-    units: str,
-    scale,
-    tabs: bool,
-    nest: str = "shelf",
     stage=lambda name: None,
     timings: dict | None = None,
     release_pieces: bool = False,
@@ -50,27 +42,21 @@ def arrange(
 
     Parameters
     ----------
-    pm : PolyMesh
-    rounding : EdgeRounding
+    mesh : PolyMesh
+    sol : VertexSolution
+        The vertices: their rounding, results, face piece centres, whether each ring is
+        closed, and ``solved`` (needed by nets only: they re-cut the modules; None when
+        released).
+    mods : Modules
+        The samples per arc (``mods.points``).
     pieces : list of Piece
         Every vertex module's pieces.
-    solved : list of (frame, apex, developed apex), or None
-        Per vertex (needed by nets only: they re-cut the modules).
-    centres : (n_faces, 3) float
-    points : (n_edges,) int
-        Samples per arc.
-    res : VertexResult
-    ring_closed : list of bool
-        Whether each vertex's ring is closed.
-    layout : str
-        ``"auto"``, ``"modules"``, ``"net"`` or ``"sheet"`` (:func:`filletfold.round_mesh`).
-    material_loss : bool
-    sheet, units, scale
-        The sheet of material (None: none) and how a pattern unit is drawn.
-    tabs : bool
-    nest : str
-        How pieces are placed on sheets: ``"shelf"``, ``"sparrow"`` or ``"auto"``, optionally
-        ``":SECONDS"`` (:func:`~filletfold.layout.nest.choose_nester`).
+    params : Parameters
+        ``layout`` (``"auto"``, ``"modules"``, ``"net"`` or ``"sheet"``), ``material_loss``,
+        ``sheet`` (None: none) with ``sheet_units`` and ``sheet_scale`` (how a pattern unit is
+        drawn), ``tabs``, and ``nest``: how pieces are placed on sheets (``"shelf"``,
+        ``"sparrow"`` or ``"auto"``, optionally ``":SECONDS"``,
+        :func:`~filletfold.layout.nest.choose_nester`).
     stage : callable
         Called with the name of each sub-stage as it starts (``"glue tabs"``).
     timings : dict, optional
@@ -88,6 +74,14 @@ def arrange(
     fabrication : dict
         Cut borders, tabs and sheet figures (the report's ``fabrication``).
     """
+    pm, res, ring_closed = mesh, sol.res, sol.ring_closed
+    layout, material_loss, sheet, tabs = (
+        params.layout,
+        params.material_loss,
+        params.sheet,
+        params.tabs,
+    )
+    units, scale = params.sheet_units, params.sheet_scale
     given = pieces  # the caller's list (``pieces`` may be rebound to laid-out copies)
     ref = pm.mean_edge_length
     layout_used, layout_note = "modules", ""
@@ -124,21 +118,12 @@ def arrange(
                 name="sheet",
             )
     if layout == "net" or (layout == "auto" and layout_used == "modules" and sheet is not None):
-        pieces = net_pieces(
-            pm,
-            rounding,
-            pieces,
-            solved,
-            centres,
-            points,
-            eps,
-            sheet=room,
-        )
+        pieces = net_pieces(pm, sol, pieces, mods.points, eps, sheet=room)
         layout_used = "net"
     if sheet is not None:
         pieces = [orient(piece) for piece in pieces]
         t = time.perf_counter()
-        offsets, boxes, sheet_of, nesting = place_on_sheets(pieces, sheet_box, gap, nest)
+        offsets, boxes, sheet_of, nesting = place_on_sheets(pieces, sheet_box, gap, params.nest)
         if timings is not None:
             timings["nest"] = time.perf_counter() - t
         pattern = assemble_pattern(pieces, offsets)

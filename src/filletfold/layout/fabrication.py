@@ -51,17 +51,17 @@ def sheet_in_pattern_units(sheet: str, units: str, scale: float) -> tuple[float,
     return w * k, h * k
 
 
-def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=None, tries=None):
+def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
     """Vertex modules joined into the fewest nets found over a few choices of cuts.
 
     Parameters
     ----------
-    mesh, rounding : PolyMesh, EdgeRounding
+    mesh : PolyMesh
+    sol : VertexSolution
+        Its rounding, face piece centres and ``solved``: the frames the apices were solved
+        in, and the apices (:class:`~filletfold.vertex.solution.VertexSolution`).
     modules : list of Piece
         The modules as built from ``solved`` (used for the first choice of cuts).
-    solved : list of (frame, apex or None, developed apex or None)
-        The frames the apices were solved in, and the apices.
-    centres : (n_faces, 3) float
     samples : int or (n_edges,) int
         Points per arc (see :func:`~filletfold.surface.module.build_modules`).
     eps : float
@@ -75,6 +75,7 @@ def net_pieces(mesh, rounding, modules, solved, centres, samples, eps, sheet=Non
     -------
     list of Piece
     """
+    rounding, solved, centres = sol.rounding, sol.solved, sol.centres
     if tries is None:
         tries = 4 if mesh.n_vertices <= 60 else 2
     choices = [None]

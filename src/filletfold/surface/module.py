@@ -169,6 +169,16 @@ CHUNK = 2048
 _WIDTH = 6
 
 
+@dataclass
+class Modules:
+    """The module stage's result (:func:`build_modules` of every vertex): ``points``
+    (n_edges,) int, the samples on each edge's arc, and ``modules``, each vertex's list of
+    pieces (None once released for the layout)."""
+
+    points: np.ndarray
+    modules: list | None
+
+
 def build_modules(
     mesh, frames, centres, n_samples, apices, developed, progress=None
 ) -> list[list[Piece]]:

@@ -7,4 +7,4 @@ reductions over each vertex's sides of :mod:`.runs`;
 :mod:`.reference` the per-vertex SLSQP solver of the hard cases); :mod:`.solve` runs them,
 :mod:`.rescue` tries smaller radii on infeasible vertices and :mod:`.sharpen` keeps the corner
 of the vertices without a cone (sharp vertices), both on the state the apex stage shares with
-them (:mod:`.state`)."""
+them (:mod:`.state`); the stage's result is a :mod:`.solution`."""
