@@ -1,4 +1,10 @@
-"""Small array helpers shared by the stages."""
+"""Small array helpers shared by the stages, and the ragged arrays they all use.
+
+A *ragged array* holds ``n`` runs of different lengths (the corners of polygons, the sides of
+vertices, the samples of arcs) one run after another in one flat array. Its ``sizes`` (n,)
+give each run's length; :func:`run_starts` where each run starts (and the end),
+:func:`run_owners` which run each flat entry belongs to, :func:`split_runs` the runs as views.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +12,24 @@ import itertools
 
 import numpy as np
 
-__all__ = ["round_significant", "split_runs"]
+__all__ = ["round_significant", "run_owners", "run_starts", "split_runs"]
+
+
+def run_starts(sizes) -> np.ndarray:
+    """(n + 1,) int64: where each run of a ragged array with run lengths ``sizes`` (n,) starts
+    in the flat array, then the end (``run_starts(sizes)[:-1]`` the first entry of each
+    run, ``np.diff`` of it the sizes again)."""
+    sizes = np.asarray(sizes, dtype=np.int64).reshape(-1)
+    out = np.zeros(len(sizes) + 1, dtype=np.int64)
+    np.cumsum(sizes, out=out[1:])
+    return out
+
+
+def run_owners(sizes) -> np.ndarray:
+    """(sum(sizes),) int64: the run each entry of a ragged array with run lengths ``sizes``
+    (n,) belongs to (``[0, 0, 1, 2, 2, 2]`` for sizes ``[2, 1, 3]``)."""
+    sizes = np.asarray(sizes, dtype=np.int64).reshape(-1)
+    return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
 
 
 def split_runs(values: np.ndarray, cuts) -> list[np.ndarray]:

@@ -57,6 +57,7 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from .arrays import run_owners
 from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
@@ -305,7 +306,7 @@ class _Data:
             raise ParameterError("the pattern has no faces")
         if self.size_of.min() < 3 or self.flat.min() < 0 or self.flat.max() >= n:
             raise ParameterError("pattern faces must list at least 3 vertex indices in range")
-        self.face_of = np.repeat(np.arange(n_faces), self.size_of)
+        self.face_of = run_owners(self.size_of)
         self.nxt = np.arange(1, len(self.flat) + 1)
         self.nxt[self.start[1:] - 1] = self.start[:-1]
         self.prv = np.empty_like(self.nxt)

@@ -18,7 +18,7 @@ from json.encoder import encode_basestring_ascii as _quote
 
 import numpy as np
 
-from ..arrays import split_runs
+from ..arrays import run_owners, run_starts, split_runs
 from ..errors import ExportError, ParameterError
 from ..surface.pattern import Annotations, CreasePattern, LabelRows, edge_dihedrals, face_arrays
 from ..surface.validate import validated_faces
@@ -316,8 +316,8 @@ def hinge_refs(tab_points: np.ndarray, tab_size: np.ndarray, hinges: np.ndarray)
     if m == 0:
         return out
     size = np.asarray(tab_size[:m], dtype=np.int64)
-    first = np.concatenate([[0], np.cumsum(size)[:-1]])
-    owner = np.repeat(np.arange(m), size)
+    first = run_starts(size)[:-1]
+    owner = run_owners(size)
     local = np.arange(int(size.sum())) - np.repeat(first, size)
     pts = tab_points[: int(size.sum())]
     for end in (0, 1):

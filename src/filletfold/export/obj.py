@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 
+from ..arrays import run_starts
 from ..surface.pattern import CreasePattern, FaceRows
 from ..surface.validate import validated_faces
 from ..tolerances import tol
@@ -191,7 +192,7 @@ def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) 
     )
     order = np.argsort(group, kind="stable")
     size = np.diff(start)[order]
-    first = np.concatenate([[0], np.cumsum(size)])
+    first = run_starts(size)
     corner = np.repeat(start[:-1][order] - first[:-1], size) + np.arange(first[-1])
     ids = flat[corner] + 1
     if vertex_normals:

@@ -13,7 +13,7 @@ import itertools
 
 import numpy as np
 
-from ..arrays import split_runs
+from ..arrays import run_owners, run_starts, split_runs
 from ..surface.pattern import Annotations, CreasePattern, LabelRows, PointRows
 
 __all__ = [
@@ -309,7 +309,7 @@ def simplify_polylines(paths: list) -> list[np.ndarray]:
     size = np.fromiter(map(len, pts), dtype=np.int64, count=n)
     closed = np.fromiter((bool(c) for _, c in paths), dtype=bool, count=n)
     p = np.concatenate(pts)
-    owner = np.repeat(np.arange(n), size)
+    owner = run_owners(size)
     # repeated points go, and a closed path's last point where it repeats the first
     keep = np.ones(len(p), dtype=bool)
     keep[1:] = (owner[1:] != owner[:-1]) | np.any(p[1:] != p[:-1], axis=1)
@@ -326,7 +326,7 @@ def simplify_polylines(paths: list) -> list[np.ndarray]:
     least = np.where(closed, 3, 2)
     active = size > least
     while active.any():
-        first = np.cumsum(size) - size
+        first = run_starts(size)[:-1]
         at = np.arange(len(p)) - first[owner]
         on = active[owner]
         k = np.flatnonzero(on)
@@ -489,7 +489,7 @@ def tab_cut_paths(annotations: Annotations) -> list[tuple[np.ndarray, bool]]:
     else:
         hinges = [np.asarray(h, dtype=np.float64).reshape(2, 2) for h in list(rows)[:n]]
         hinges = np.array(hinges).reshape(-1, 2, 2)
-    first = np.concatenate([[0], np.cumsum(size)[:-1]])
+    first = run_starts(size)[:-1]
     # a closing point that repeats the first is dropped
     repeat = size > 1
     repeat[repeat] = (flat[first[repeat]] == flat[(first + size - 1)[repeat]]).all(axis=1)

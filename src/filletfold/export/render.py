@@ -23,6 +23,8 @@ import math
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
+
 __all__ = ["MARGIN", "png_bytes", "render", "view_frame"]
 
 #: Share of the image left blank on each side of the fitted picture.
@@ -122,8 +124,8 @@ def _zbuffer(px, py, depth, triangles, width, height):
     # one span of pixels per triangle and row: where the row's centre line is inside all
     # three edges (s >= 0, t >= 0, 1 - s - t >= 0, each a * x + b >= 0 along the row)
     ny = y1 - y0 + 1
-    k = np.repeat(np.arange(len(tri)), ny)
-    cy = y0[k] + np.arange(len(k)) - np.repeat(np.cumsum(ny) - ny, ny)
+    k = run_owners(ny)
+    cy = y0[k] + np.arange(len(k)) - np.repeat(run_starts(ny)[:-1], ny)
     fy = cy + 0.5
     lo_f = np.full(len(k), -np.inf)
     hi_f = np.full(len(k), np.inf)
@@ -270,8 +272,8 @@ def render(
             length = np.hypot(*(b - a)[:, :2].T)
             step = max(_LINE_STEP, 0.75 * 0.5 * lw * ss)  # a disc's radius: no gaps
             n = np.minimum(np.ceil(length / step).astype(np.int64), 4 * (w_ss + h_ss)) + 1
-        seg = np.repeat(np.arange(len(a)), n)
-        first = np.cumsum(n) - n
+        seg = run_owners(n)
+        first = run_starts(n)[:-1]
         u = (np.arange(len(seg)) - np.repeat(first, n)) / np.maximum(n[seg] - 1, 1)
         p = a[seg] + (b[seg] - a[seg]) * u[:, None]
         cx, cy = np.floor(p[:, 0]).astype(np.int64), np.floor(p[:, 1]).astype(np.int64)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
+
 #: Turns (sines of corner angles) this close to 0 count as straight in :func:`is_convex`.
 TURN_ROUNDOFF = 1e-12
 #: Turns beyond this are convex far above round-off (:func:`surely_valid`); nearer ones are
@@ -334,8 +336,8 @@ class BoxGrid:
         of every cell of every box."""
         w = np.maximum(c1 - c0 + 1, 0)
         count = w[:, 0] * w[:, 1]
-        item = np.repeat(np.arange(len(c0)), count)
-        k = np.arange(len(item)) - np.repeat(np.cumsum(count) - count, count)
+        item = run_owners(count)
+        k = np.arange(len(item)) - np.repeat(run_starts(count)[:-1], count)
         wy = np.maximum(w[item, 1], 1)
         dx, dy = k // wy, k % wy
         first = (dx == 0).astype(np.uint8) | ((dy == 0).astype(np.uint8) << 1)
@@ -358,7 +360,7 @@ class BoxGrid:
         keys, asked, low = self._entries(c0, c1, np.arange(len(lo)))
         first = self.start[keys]
         count = self.start[keys + 1] - first
-        which = np.repeat(np.arange(len(keys)), count)
+        which = run_owners(count)
         at = np.arange(len(which)) + np.repeat(first - np.cumsum(count) + count, count)
         # each pair once: in the cell of the low corner of the two boxes' overlap, which is
         # in the first column of one of them and in the first row of one of them

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import run_starts
+
 
 def shelf_layout(boxes: np.ndarray, gap: float, row_width: float | None = None) -> np.ndarray:
     """Translations that place axis-aligned boxes in rows, never overlapping.
@@ -50,6 +52,6 @@ def shelf_offsets(pieces: list, gap: float) -> np.ndarray:
         return shelf_layout(np.zeros((0, 4)), gap)
     p2 = np.concatenate(points)
     count = np.array([len(p) for p in points])
-    first = np.cumsum(count) - count
+    first = run_starts(count)[:-1]
     boxes = np.hstack([np.minimum.reduceat(p2, first), np.maximum.reduceat(p2, first)])
     return shelf_layout(boxes, gap)

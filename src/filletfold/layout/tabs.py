@@ -24,6 +24,7 @@ import shapely
 from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
+from ..arrays import run_owners
 from ..surface.pattern import (
     Annotations,
     CreasePattern,
@@ -448,9 +449,7 @@ class _Faces:
             corner = np.repeat(self.start[new] - np.cumsum(size) + size, size) + np.arange(
                 size.sum()
             )
-            ring = shapely.linearrings(
-                self.coords[self.flat[corner]], indices=np.repeat(np.arange(len(new)), size)
-            )
+            ring = shapely.linearrings(self.coords[self.flat[corner]], indices=run_owners(size))
             self.polys.update(zip(new.tolist(), shapely.polygons(ring), strict=True))
         return np.array([self.polys[f] for f in faces.tolist()], dtype=object)
 

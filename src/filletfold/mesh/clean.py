@@ -24,7 +24,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..arrays import split_runs
+from ..arrays import run_owners, run_starts, split_runs
 from ..errors import MeshError
 from ..tolerances import tol
 from .measures import newell_vectors
@@ -434,9 +434,9 @@ class _Flat:
     @classmethod
     def of(cls, face_list) -> _Flat:
         size = np.array([len(f) for f in face_list], dtype=np.int64)
-        start = np.concatenate([[0], np.cumsum(size)])
+        start = run_starts(size)
         index = np.concatenate(face_list).astype(np.int64)
-        face = np.repeat(np.arange(len(face_list)), size)
+        face = run_owners(size)
         local = np.arange(len(index)) - start[face]
         nxt = start[face] + (local + 1) % size[face]
         prv = start[face] + (local - 1) % size[face]

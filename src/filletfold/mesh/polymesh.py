@@ -18,6 +18,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from ..errors import MeshError
 from .measures import newell_vectors
 
@@ -79,11 +80,11 @@ class PolyMesh:
         he_from = np.concatenate(self.faces) if self.faces else np.zeros(0, np.int64)
         if len(he_from) and (he_from.min() < 0 or he_from.max() >= n):
             raise MeshError("a face refers to a vertex index outside the vertex list")
-        self.face_start = np.concatenate([[0], np.cumsum(face_size)])
+        self.face_start = run_starts(face_size)
         nxt = np.arange(1, len(he_from) + 1)  # the next corner of each face, cyclically
         nxt[self.face_start[1:] - 1] = self.face_start[:-1]
         he_to = he_from[nxt]
-        he_face = np.repeat(np.arange(len(self.faces)), face_size)
+        he_face = run_owners(face_size)
         self.halfedge_from = he_from
         self.halfedge_to = he_to
         self.halfedge_face = he_face

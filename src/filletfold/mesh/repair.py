@@ -38,7 +38,7 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ..arrays import split_runs
+from ..arrays import run_owners, run_starts, split_runs
 from ..errors import MeshError
 
 #: Added to the diagonal of planarize's normal equations (``A A^T``), which are singular when
@@ -199,7 +199,7 @@ def _faces_to_split(faces) -> np.ndarray:
     if not len(faces):
         return bad
     flat = np.concatenate(faces).astype(np.int64, copy=False)
-    face = np.repeat(np.arange(len(faces)), sizes)
+    face = run_owners(sizes)
     order = np.lexsort((flat, face))
     f, v = face[order], flat[order]
     twice = (f[1:] == f[:-1]) & (v[1:] == v[:-1])
@@ -322,9 +322,9 @@ def _degenerate(faces, v, rel_height: float) -> np.ndarray:
     if not faces:
         return np.zeros(0, dtype=np.int64)
     size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    start = np.concatenate([[0], np.cumsum(size)])
+    start = run_starts(size)
     idx = np.concatenate(faces)
-    face = np.repeat(np.arange(len(faces)), size)
+    face = run_owners(size)
     nxt = np.arange(len(idx)) + 1
     nxt[start[1:] - 1] = start[:-1]
     p = v[idx]
@@ -496,7 +496,7 @@ def _edge_counts(faces, n: int) -> tuple[np.ndarray, np.ndarray]:
     """The undirected edges of ``faces`` as ``min * n + max`` and how many faces use each."""
     frm = np.concatenate(faces).astype(np.int64)
     size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    start = np.concatenate([[0], np.cumsum(size)])
+    start = run_starts(size)
     nxt = np.arange(len(frm)) + 1
     nxt[start[1:] - 1] = start[:-1]
     to = frm[nxt]
@@ -531,9 +531,9 @@ def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=(), why
         Input index of each vertex (copies keep their original's).
     """
     size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    start = np.concatenate([[0], np.cumsum(size)])
+    start = run_starts(size)
     frm = np.concatenate(faces).astype(np.int64)
-    face = np.repeat(np.arange(len(faces)), size)
+    face = run_owners(size)
     nxt = np.arange(len(frm)) + 1
     nxt[start[1:] - 1] = start[:-1]
     to = frm[nxt]
@@ -897,9 +897,9 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 8, rel: float = 1e-15):
     if not len(poly):
         return v, residual
     size = np.array([len(faces[i]) for i in poly.tolist()])
-    start = np.concatenate([[0], np.cumsum(size)])
+    start = run_starts(size)
     idx = np.concatenate([faces[i] for i in poly.tolist()])
-    face = np.repeat(np.arange(len(poly)), size)
+    face = run_owners(size)
     nxt = np.arange(len(idx)) + 1
     nxt[start[1:] - 1] = start[:-1]
     x = v.copy()

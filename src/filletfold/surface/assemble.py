@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from ..tolerances import tol
 from .faces import flat_faces
 from .patch import Patch, patch_kinds
@@ -42,9 +43,9 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
     flats, sizes = zip(*(flat_faces(p.faces) for p in pieces), strict=True) if pieces else ((), ())
     size = np.concatenate([np.zeros(0, dtype=np.int64), *sizes])
     flat = np.concatenate([np.zeros(0, dtype=np.int64), *flats])
-    base = np.concatenate([[0], np.cumsum(n_points)[:-1]])
+    base = run_starts(n_points)[:-1]
     flat += np.repeat(np.repeat(base, n_faces), size)
-    start = np.concatenate([[0], np.cumsum(size)])
+    start = run_starts(size)
     faces = FaceRows(flat, start)  # (k,) int64 rows made when asked for
     patches = list(itertools.chain.from_iterable(piece.patches for piece in pieces))
     apex = np.array([-1 if p.apex_index is None else p.apex_index for p in pieces], dtype=np.int64)
@@ -55,7 +56,7 @@ def assemble_pattern(pieces: list[Piece], offsets: np.ndarray) -> CreasePattern:
         vertices_3d=v3,
         faces=faces,
         face_patch=patches,
-        face_piece=np.repeat(np.arange(len(pieces)), n_faces),
+        face_piece=run_owners(n_faces),
         piece_vertex=np.array([piece.vertex for piece in pieces], dtype=np.int64),
     )
 
@@ -87,7 +88,7 @@ def true_rulings(v2, v3, flat, size, face_apex, patches) -> None:
     cone &= face_apex >= 0
     if not cone.any():
         return
-    corner_face = np.repeat(np.arange(len(size)), size)
+    corner_face = run_owners(size)
     on = cone[corner_face]
     point, apex = flat[on], face_apex[corner_face[on]]
     keep = point != apex

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from ..arrays import run_owners
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh
 from ..rounding.edges import EdgeRounding
@@ -31,7 +32,7 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
     """
     half = 0.5 * rounding.strip_width
     start = np.asarray(mesh.face_start)
-    face_of = np.repeat(np.arange(mesh.n_faces), np.diff(start))
+    face_of = run_owners(np.diff(start))
     nxt = np.arange(len(face_of)) + 1
     nxt[start[1:] - 1] = start[:-1]  # the half-edge after the last one of a face is its first
     p = mesh.vertices[mesh.halfedge_from]

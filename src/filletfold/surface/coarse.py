@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from ..arrays import round_significant
+from ..arrays import round_significant, run_owners
 from ..errors import ParameterError
 from .patch import RULED_KINDS, patch_kinds
 from .pattern import Annotations, CreasePattern, edge_dihedrals, face_arrays
@@ -569,7 +569,7 @@ def _dropped_crease_points(
     kind = patch_kinds(names)
     cone = kind == "cone"
     corners = np.concatenate(faces) if faces else np.zeros(0, dtype=np.int64)
-    face_of = np.repeat(np.arange(len(faces)), [len(f) for f in faces])
+    face_of = run_owners([len(f) for f in faces])
     on_cone = np.zeros(n, dtype=bool)
     on_cone[corners[cone[face_of]]] = True
     on_ruled = np.zeros(n, dtype=bool)
@@ -973,7 +973,7 @@ def simulator_pattern(
     kind = patch_kinds(pattern.face_patch)
     # a vertex may go when all its faces are on cylinders and cones
     ruled = np.isin(kind, RULED_KINDS)
-    face_of = np.repeat(np.arange(len(faces)), np.diff(start))
+    face_of = run_owners(np.diff(start))
     droppable = np.ones(n, dtype=bool)
     droppable[flat[~ruled[face_of]]] = False
     edge_faces = pattern.faces_beside_edges()
@@ -1085,7 +1085,7 @@ def _crossing_groups(v2: np.ndarray, out: list) -> list[int]:
     import shapely
 
     tri = np.array([t for _, tris, _ in out for t in tris], dtype=np.int64).reshape(-1, 3)
-    group = np.repeat(np.arange(len(out)), [len(tris) for _, tris, _ in out])
+    group = run_owners([len(tris) for _, tris, _ in out])
     merged = np.array([len(going) > 0 for _, _, going in out], dtype=bool)
     if not merged.any():
         return []

@@ -7,6 +7,7 @@ import itertools
 import numpy as np
 import shapely
 
+from ..arrays import run_owners
 from .pattern import FlatFaces
 
 
@@ -56,7 +57,7 @@ def flat_faces(faces) -> tuple[np.ndarray, np.ndarray]:
 def face_polygons(points_2d: np.ndarray, faces) -> np.ndarray:
     """(n_faces,) shapely Polygons of faces given as index lists into ``points_2d`` (k, 2)."""
     idx, sizes = flat_faces(faces)
-    rings = shapely.linearrings(points_2d[idx], indices=np.repeat(np.arange(len(faces)), sizes))
+    rings = shapely.linearrings(points_2d[idx], indices=run_owners(sizes))
     return shapely.polygons(rings)
 
 

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..arrays import split_runs
+from ..arrays import run_owners, run_starts, split_runs
 from ..mesh.polymesh import PolyMesh
 from ..parallel import thread_map
 from ..rounding.tapered import perpendiculars, ruled_gluing_maps
@@ -62,8 +62,8 @@ def _arc_parameters(arc: np.ndarray, n: np.ndarray):
         Sample number along its side.
     s : (m,) float
     """
-    side = np.repeat(np.arange(len(n)), n)
-    first = np.cumsum(n) - n
+    side = run_owners(n)
+    first = run_starts(n)[:-1]
     k = np.arange(len(side)) - first[side]
     step = np.where(n > 1, arc / np.maximum(n - 1, 1), 0.0)
     s = k * step[side]
@@ -377,8 +377,8 @@ class _Chunk:
         sa = _stack([_ring_arrays(f) for f in frames])
         ne = np.array([f.n_sides for f in frames], dtype=np.int64)
         nf = np.array([len(f.ring.faces) for f in frames], dtype=np.int64)
-        side_first = np.concatenate([[0], np.cumsum(ne)])
-        sv = np.repeat(np.arange(len(frames)), ne)
+        side_first = run_starts(ne)
+        sv = run_owners(ne)
         cone = np.array([a is not None for a in apices], dtype=bool)
         apex = _or_nan(apices, 3).reshape(-1, 3)
         dev = _or_nan(
@@ -393,7 +393,7 @@ class _Chunk:
             frames=frames,
             sides=sa,
             side_first=side_first,
-            face_first=np.concatenate([[0], np.cumsum(nf)]),
+            face_first=run_starts(nf),
             side_vertex=sv,
             rounded=np.concatenate([f.rounded for f in frames]),
             samples=np.where(sa.arc > 0, n, 1).astype(np.int64),
@@ -571,8 +571,8 @@ class _Layout:
         """The layout of ``runs`` (n_runs, 3) int: ``(vertex, j0, j1)`` rows."""
         rv, j0, j1 = runs.T
         count = j1 - j0 + 1
-        run = np.repeat(np.arange(len(rv)), count)
-        q0 = np.cumsum(count) - count
+        run = run_owners(count)
+        q0 = run_starts(count)[:-1]
         i = j0[run] + np.arange(len(run)) - q0[run]
         v = rv[run]
         side = chunk.side_first[v] + i
@@ -584,8 +584,8 @@ class _Layout:
         tee = chunk.tee[face]
         block = lead + 3 + tee
         size = chunk.cone[rv] + np.add.reduceat(block, q0)
-        first = np.concatenate([[0], np.cumsum(size)])
-        cb = np.cumsum(block) - block
+        first = run_starts(size)
+        cb = run_starts(block)[:-1]
         at = first[run] + chunk.cone[v] + cb - cb[q0][run]
         start = at + lead
         sample_share, k, s = _arc_parameters(chunk.sides.arc[side], n)
@@ -643,7 +643,7 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
     # the checks of build_module: merge_coincident changes nothing (nothing merges, no face is
     # too small, every point is used), and the proof that the piece does not overlap itself
     n_runs = len(runs)
-    point_run = np.repeat(np.arange(n_runs), np.diff(lay.first))
+    point_run = run_owners(np.diff(lay.first))
     eps = chunk.eps[lay.vertex]
     good = _nothing_merges(P2, P3, point_run, eps)
     good[face_run[~(area > 2 * (eps * eps)[face_run])]] = False
@@ -654,11 +654,11 @@ def _run_pieces(chunk: _Chunk, runs: np.ndarray):
     proved = faces_interior_disjoint_many(P2, flat, size, face_run, n_runs)
     local = (corners - lay.first[face_run][:, None])[np.arange(_WIDTH) < size[:, None]]
     patches = list(map(chunk.patch.__getitem__, code.tolist()))
-    fb = np.concatenate([[0], np.cumsum(np.bincount(face_run, minlength=n_runs))]).tolist()
-    cb = np.concatenate([[0], np.cumsum(size)])[fb].tolist()  # each run's first corner
+    fb = run_starts(np.bincount(face_run, minlength=n_runs)).tolist()
+    cb = run_starts(size)[fb].tolist()  # each run's first corner
     pb = lay.first.tolist()
     count = runs[:, 2] - runs[:, 1] + 1
-    sector = face_share - (np.cumsum(count) - count)[face_run]  # the share within its run
+    sector = face_share - (run_starts(count)[:-1])[face_run]  # the share within its run
     sectors = split_runs(sector, fb[1:-1])
     pieces = []
     for r, v in enumerate(lay.vertex.tolist()):
@@ -758,7 +758,7 @@ def _run_faces(chunk: _Chunk, lay: _Layout):
     """
     cone = chunk.cone[lay.vertex[lay.run]].astype(np.int64)
     count = np.maximum(lay.n - 1, 0) * (1 + cone) + 1 + cone
-    fpos = np.cumsum(count) - count
+    fpos = run_starts(count)[:-1]
     corners = np.zeros((int(count.sum()), _WIDTH), dtype=np.int64)
     size = np.empty(len(corners), dtype=np.int64)
     code = np.empty(len(corners), dtype=np.int64)
@@ -787,7 +787,7 @@ def _run_faces(chunk: _Chunk, lay: _Layout):
     corners[share[c] + 1, :3] = np.stack([apex[c], t0[c], b1[c] + 1], axis=1)
     size[share[c] + 1] = 3
     code[share[c] + 1] = n_sides + vertex[c]
-    return corners, size, code, np.repeat(np.arange(len(count)), count)
+    return corners, size, code, run_owners(count)
 
 
 def _oriented(P2: np.ndarray, corners: np.ndarray, size: np.ndarray):
@@ -837,7 +837,7 @@ def _nothing_merges(
     order = np.lexsort((p2[:, 0], piece))
     x, pc = p2[order, 0], piece[order]
     link = (np.diff(x) <= reach[pc[1:]]) & (pc[1:] == pc[:-1])
-    chain = np.concatenate([[0], np.cumsum(~link)])  # chain of each sorted point
+    chain = run_starts(~link)  # chain of each sorted point
     for d in range(1, len(x)):
         same = np.flatnonzero(chain[d:] == chain[:-d])
         if not len(same):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from ..arrays import run_owners
 from ..tolerances import tol
 from .faces import face_polygons, flat_faces
 
@@ -236,6 +237,6 @@ def faces_interior_disjoint_many(
     term = ring[:, 0] * nr[:, 1] - nr[:, 0] * ring[:, 1]
     pieces = bp[r_start]
     oriented = np.add.reduceat(term, r_start) > tol.area * np.add.reduceat(np.abs(term), r_start)
-    rings = shapely.linearrings(ring, indices=np.repeat(np.arange(len(r_start)), r_size))
+    rings = shapely.linearrings(ring, indices=run_owners(r_size))
     ok[pieces[~(oriented & shapely.is_valid(shapely.polygons(rings)))]] = False
     return ok | empty

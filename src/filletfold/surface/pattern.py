@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arrays import split_runs
+from ..arrays import run_owners, run_starts, split_runs
 from ..mesh.measures import dihedral_turns
 from ..tolerances import tol
 from .patch import patch_indices, patch_kinds
@@ -67,7 +67,7 @@ class FlatFaces(Sequence):
     @classmethod
     def of_sizes(cls, flat: np.ndarray, size: np.ndarray):
         """The faces of ``size`` (n_faces,) corners each, their corners ``flat``."""
-        return cls(flat, np.concatenate([[0], np.cumsum(size, dtype=np.int64)]))
+        return cls(flat, run_starts(size))
 
     def __len__(self) -> int:
         return len(self.start) - 1
@@ -237,7 +237,7 @@ def edge_faces_of(edges: np.ndarray, faces, n_vertices: int) -> np.ndarray:
     nxt = np.arange(len(a)) + 1
     nxt[start[1:] - 1] = start[:-1]
     b = a[nxt]
-    face_of = np.repeat(np.arange(len(start) - 1), np.diff(start))
+    face_of = run_owners(np.diff(start))
     n = n_vertices
     lo, hi = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
     keys = lo * n + hi
@@ -530,7 +530,7 @@ class CreasePattern:
         front, V otherwise, with the fold angle between the two faces' 3D normals.
         """
         a, b, start, _ = halfedges = self._halfedges()
-        face_of = np.repeat(np.arange(len(self.faces)), np.diff(start))
+        face_of = run_owners(np.diff(start))
         lo, hi = np.minimum(a, b), np.maximum(a, b)
         n = len(self.vertices_2d)
         key = lo * n + hi

@@ -8,6 +8,7 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 
+from ..arrays import run_owners, run_starts
 from ..tolerances import tol
 from .faces import FaceLists, face_polygons, flat_faces, polygon_area2
 from .overlap import faces_overlap
@@ -188,8 +189,8 @@ def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: floa
     n_faces = len(faces)
     flat, size = flat_faces(faces)
     idx = root[flat]
-    face = np.repeat(np.arange(n_faces), size)
-    start = np.concatenate([[0], np.cumsum(size)])
+    face = run_owners(size)
+    start = run_starts(size)
     keep = np.ones(len(idx), dtype=bool)
     keep[1:] = idx[1:] != idx[:-1]
     keep[start[:-1][size > 0]] = True  # a face's first point
@@ -201,7 +202,7 @@ def _merged_faces(points_2d: np.ndarray, faces, root: np.ndarray, min_area: floa
     keep[last[pop]] = False
     count[pop] -= 1
     idx, face = idx[keep], face[keep]
-    start = np.concatenate([[0], np.cumsum(count)])
+    start = run_starts(count)
     area = np.full(n_faces, np.nan)
     for k in np.unique(count[count >= 3]).tolist():
         which = np.flatnonzero(count == k)

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arrays import split_runs
+from ..arrays import run_owners, split_runs
 from ..rounding.tapered import arc_points, cone_rulings, developed_angles
 from ..vertex.frame import VertexFrame, to_chart
 from .patch import Patch
@@ -59,7 +59,7 @@ def _side_points(frames: list, conical, n_samples) -> list[list[tuple]]:
     if not rows:
         return out
     count = np.array([len(s) for _, _, s in rows])
-    which = np.repeat(np.arange(len(rows)), count)
+    which = run_owners(count)
     sides = [frames[k].sides[i] for k, i, _ in rows]
     s = np.concatenate([s for _, _, s in rows])
     O, N0, B = (np.array([getattr(x, a) for x in sides])[which] for a in ("O", "N0", "B"))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from ..tolerances import tol
 from .pattern import face_arrays
 
@@ -89,7 +90,7 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
     flat = flat.astype(np.int64, copy=False)
     sizes, start = np.diff(offsets), offsets[:-1]
     count = np.maximum(sizes - 2, 0)
-    t_start = np.cumsum(count) - count
+    t_start = run_starts(count)[:-1]
     triangles = np.zeros((int(count.sum()), 3), dtype=np.int64)
     for k in np.unique(sizes[sizes >= 3]).tolist():
         which = np.flatnonzero(sizes == k)
@@ -103,7 +104,7 @@ def triangulate_faces(points_2d: np.ndarray, faces) -> tuple[np.ndarray, np.ndar
         triangles[rows[convex]] = f[convex][:, fan]
         for row, at in zip(f[~convex], rows[~convex], strict=True):
             triangles[at] = row[triangulate_polygon_2d(p[row])]
-    return triangles, np.repeat(np.arange(len(sizes)), count)
+    return triangles, run_owners(count)
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:

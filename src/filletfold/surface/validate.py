@@ -9,6 +9,7 @@ import operator
 
 import numpy as np
 
+from ..arrays import run_starts
 from ..errors import ExportError
 from ..tolerances import tol
 from .pattern import CreasePattern, FlatFaces, face_arrays
@@ -137,7 +138,7 @@ def validated_faces(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
             if idx.min() < 0 or idx.max() >= n:
                 raise ExportError(f"pattern face {i} refers to a vertex outside 0..{n - 1}")
         sizes = np.fromiter(map(len, pattern.faces), dtype=np.int64, count=n_faces)
-        start = np.concatenate([[0], np.cumsum(sizes)])
+        start = run_starts(sizes)
         flat = np.concatenate([np.asarray(f, dtype=np.int64) for f in pattern.faces] or [[]])
         checked = flat.astype(np.int64), start
     if len(pattern.face_patch) != n_faces:

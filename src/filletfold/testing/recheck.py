@@ -55,6 +55,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
+
 __all__ = [
     "CREASE_LIMIT_DEG",
     "DEFAULT_ARC_STEP_DEG",
@@ -287,7 +289,7 @@ def _closed_by_edge_count(faces, vertices=None) -> bool:
     if vertices is not None:
         _, weld = np.unique(np.asarray(vertices, dtype=np.float64), axis=0, return_inverse=True)
         flat = weld.ravel()[flat]
-    start = np.concatenate([[0], np.cumsum(sizes)])
+    start = run_starts(sizes)
     nxt = np.arange(len(flat)) + 1
     nxt[start[1:] - 1] = start[:-1]
     a, b = flat, flat[nxt]
@@ -529,9 +531,9 @@ def recheck_fold(fold_path, mesh_path=None, *, arc_step_deg: float | None = None
     coord_max = float(max(np.abs(v2).max(initial=0.0), np.abs(v3).max(initial=0.0)))
     q = 4 * 10.0 ** (1 - FILE_DIGITS) * coord_max  # file rounding of one length
 
-    start = np.concatenate([[0], np.cumsum(sizes)])
+    start = run_starts(sizes)
     nh = len(flat)
-    he_face = np.repeat(np.arange(nf), sizes)
+    he_face = run_owners(sizes)
     pos = np.arange(nh)
     nxt = pos + 1
     nxt[start[1:] - 1] = start[:-1]
@@ -578,7 +580,7 @@ def recheck_fold(fold_path, mesh_path=None, *, arc_step_deg: float | None = None
     hv = np.nonzero(he_edge >= 0)[0]
     count = np.bincount(he_edge[hv], minlength=m) if m else np.zeros(0, np.int64)
     o = hv[np.argsort(he_edge[hv], kind="stable")]
-    off = np.concatenate([[0], np.cumsum(count)])[:-1]
+    off = run_starts(count)[:-1]
     h1 = np.full(m, -1, np.int64)
     h2 = np.full(m, -1, np.int64)
     h1[count >= 1] = o[off[count >= 1]]

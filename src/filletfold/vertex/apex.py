@@ -31,6 +31,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from ..tolerances import tol
 from .crease import (
     chart_apex,
@@ -224,7 +225,7 @@ def build_constraints_many(
     arrays = [frame.arrays for frame in frames]
     sa = _stack(arrays)
     k = np.array([len(a.arc) for a in arrays])  # sides (= ring faces) per vertex
-    so, sv = np.cumsum(k) - k, np.repeat(np.arange(n), k)  # first side, vertex of each side
+    so, sv = run_starts(k)[:-1], run_owners(k)  # first side, vertex of each side
     side, first, last, s, C, N = sa.samples(np.repeat(np.asarray(n_samples).reshape(n), k))
     cone = sa.conical
     extras = [] if extras is None else [(j, x) for j, x in enumerate(extras) if x is not None]
@@ -237,12 +238,12 @@ def build_constraints_many(
         side, s = np.concatenate([side, x_side])[order], np.concatenate([s, x_s])[order]
         C, N = np.vstack([C, x_C])[order], np.vstack([N, x_N])[order]
         n_x = np.bincount(x_vert, minlength=n)
-        shift = (np.cumsum(n_x) - n_x)[sv]  # extra samples of the vertices before
+        shift = (run_starts(n_x)[:-1])[sv]  # extra samples of the vertices before
         first, last = first + shift, last + shift
     if cone.any():  # a fillet's surface normal is the cone's, not the cylinder's
         N = sa.surface_normal(side, s, N=N)
     m = np.bincount(sv[side], minlength=n)  # samples per vertex
-    mo, mv = np.cumsum(m) - m, np.repeat(np.arange(n), m)  # first sample, vertex of each
+    mo, mv = run_starts(m)[:-1], run_owners(m)  # first sample, vertex of each
     margin = np.asarray(margins, dtype=float).reshape(n)
     sigma = np.asarray(sigmas).reshape(n)
     scale = run_means(sa.length, k)
@@ -294,7 +295,7 @@ def build_constraints_many(
     chord = np.flatnonzero(sa.arc > 0)
     c = np.bincount(sv[chord], minlength=n)
     l_count = m + c + 4 * k
-    l_start = np.cumsum(l_count) - l_count
+    l_start = run_starts(l_count)[:-1]
     along = sa.R[chord]
     if cone.any():  # the chord plane of a fillet passes through its apex
         along = np.where(cone[chord, None], C[first[chord]] - sa.S[chord], along)
@@ -306,7 +307,7 @@ def build_constraints_many(
     lin_a, lin_b = np.empty((lin_rows, 3)), np.empty(lin_rows)
     l_kind = np.empty(lin_rows, dtype=_KIND_TYPE)
     l_element = np.empty(lin_rows, dtype=np.int64)
-    chord_rank = np.arange(len(chord)) - (np.cumsum(c) - c)[sv[chord]]
+    chord_rank = np.arange(len(chord)) - (run_starts(c)[:-1])[sv[chord]]
     ring_faces = np.concatenate([np.asarray(f.ring.faces, dtype=np.int64) for f in frames])
     face_row = sides - so[sv] + l_start[sv] + m[sv] + c[sv]
     nxt = so[sv] + (sides - so[sv] + 1) % k[sv]
@@ -601,9 +602,9 @@ def validate_apices(
     sa = _stack(arrs)  # the sides of every vertex, vertex after vertex
     n_sides = np.array([len(a.arc) for a in arrs])
     n_faces = np.array([len(f.ring.faces) for f in frames])
-    vert = np.repeat(np.arange(n), n_sides)  # (K,) vertex of each side
-    fvert = np.repeat(np.arange(n), n_faces)  # (F,) vertex of each face
-    offset = np.concatenate([[0], np.cumsum(n_sides)[:-1]])  # first side of each vertex
+    vert = run_owners(n_sides)  # (K,) vertex of each side
+    fvert = run_owners(n_faces)  # (F,) vertex of each face
+    offset = run_starts(n_sides)[:-1]  # first side of each vertex
     scale = run_means(sa.length, n_sides)
     eps = tol.validate * scale  # (n,)
     sigma = np.asarray(sigmas).reshape(n)
@@ -657,7 +658,7 @@ def validate_apices(
     e_side = eps[vert][:, None]
     bad = np.where(strict, checks < e_side, checks < -e_side)
     # faces: side i of a vertex ends on its face i, side i + 1 starts on it
-    local = np.arange(len(faces)) - np.repeat(np.cumsum(n_faces) - n_faces, n_faces)
+    local = np.arange(len(faces)) - np.repeat(run_starts(n_faces)[:-1], n_faces)
     fside = offset[fvert] + local  # (F,) side ending on each face
     nxt = offset[fvert] + (local + 1) % n_sides[fvert]  # (F,) side starting on it
     nrm = sa.face_normal
@@ -799,7 +800,7 @@ def _refined_min(sa, V, values, s, first, *, vi=None, dn=None, sigma=1):
     ok = (r > 0) & ~sa.conical  # a conical fillet's closed form is not this one: samples only
     # the first sample of each side that attains its smallest value (the side's first sample
     # where none does: a NaN)
-    side = np.repeat(np.arange(len(first)), ends - first)
+    side = run_owners(ends - first)
     hit = np.flatnonzero(values == best[side])
     lead = np.ones(len(hit), dtype=bool)
     lead[1:] = side[hit[1:]] != side[hit[:-1]]

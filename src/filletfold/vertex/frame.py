@@ -25,6 +25,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
 from ..rounding.edges import EdgeRounding
@@ -357,8 +358,8 @@ class SideArrays:
             Base-curve points and normals.
         """
         ks = np.where(self.arc > 0, n_samples, 1)
-        side = np.repeat(np.arange(len(ks)), ks)
-        first = np.concatenate([[0], np.cumsum(ks)[:-1]])
+        side = run_owners(ks)
+        first = run_starts(ks)[:-1]
         s = self.arc[side] * (np.arange(len(side)) - first[side]) / np.maximum(ks[side] - 1, 1)
         return side, first, first + ks - 1, s, *self.base_normal(side, s)
 
@@ -674,7 +675,7 @@ def closed_ring_sides(mesh: PolyMesh, verts):
     idx = np.flatnonzero(closed)
     count = nf[idx]
     sv = np.repeat(idx, count)
-    sp = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    sp = np.arange(int(count.sum())) - np.repeat(run_starts(count)[:-1], count)
     h = he[sv, sp]
     d = mesh.vertices[verts][sv] - mesh.vertices[mesh.halfedge_to[h]]
     R = d / norm_rows(d)[:, None]
@@ -801,11 +802,11 @@ def vertex_frames(
         shift = np.where(hit.any(axis=1), hit.argmax(axis=1), 0)
 
     # ---- flat (vertex, ring position) pairs: sides (one per edge) and faces
-    so = np.concatenate([[0], np.cumsum(ne)])
-    fo = np.concatenate([[0], np.cumsum(nf)])
-    sv = np.repeat(np.arange(n), ne)  # (P,) vertex of each side
+    so = run_starts(ne)
+    fo = run_starts(nf)
+    sv = run_owners(ne)  # (P,) vertex of each side
     sp = np.arange(so[-1]) - so[sv]  # (P,) its ring position
-    fv = np.repeat(np.arange(n), nf)  # (F,) vertex of each face
+    fv = run_owners(nf)  # (F,) vertex of each face
     fp = np.arange(fo[-1]) - fo[fv]
     nfs = nf[sv]
     fh = he[fv, (fp + shift[fv]) % nf[fv]]  # (F,) half-edge u -> q in face f_i

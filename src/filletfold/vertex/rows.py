@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from .apex import ApexConstraints
 from .crease import (
     chart_apex,
@@ -95,7 +96,7 @@ def pack_problems(problems: Sequence[ApexConstraints], targets: np.ndarray, n: i
     nq = np.array([len(p.quad_s) for p in problems])
     nl = np.array([len(p.lin_b) for p in problems])
     L = np.array([p.scale for p in problems])
-    qb, lb = np.repeat(np.arange(B), nq), np.repeat(np.arange(B), nl)  # problem of each row
+    qb, lb = run_owners(nq), run_owners(nl)  # problem of each row
 
     def cat(name: str) -> np.ndarray:
         return np.concatenate([getattr(p, name) for p in problems])
@@ -126,8 +127,8 @@ def pack_problems(problems: Sequence[ApexConstraints], targets: np.ndarray, n: i
         np.zeros((B, R), dtype=bool),
     )
     # each row's place in the padded block, as a flat index (b * R + place in its problem)
-    q_at = np.arange(len(qb)) + (qb * R - (np.cumsum(nq) - nq)[qb])
-    l_at = np.arange(len(lb)) + (lb * R - (np.cumsum(nl) - nl)[lb] + nq[lb])
+    q_at = np.arange(len(qb)) + (qb * R - (run_starts(nq)[:-1])[qb])
+    l_at = np.arange(len(lb)) + (lb * R - (run_starts(nl)[:-1])[lb] + nq[lb])
     a, alpha, mask = out.a.reshape(-1), out.alpha.reshape(-1), out.mask.reshape(-1)  # views
     A = out.A.reshape(-1, n)
     a[q_at], a[l_at] = quad / Lq, lin / L[lb]

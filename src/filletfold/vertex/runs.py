@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import run_starts
+
 __all__ = ["run_means", "run_sums"]
 
 
@@ -14,7 +16,7 @@ def run_sums(values: np.ndarray, counts: np.ndarray) -> np.ndarray:
     by row, as numpy reduces a run alone; ``np.add.reduceat`` would sum in another order).
     """
     out = np.empty(len(counts))
-    first = np.cumsum(counts) - counts
+    first = run_starts(counts)[:-1]
     for c in np.unique(counts).tolist():
         which = np.flatnonzero(counts == c)
         out[which] = values[first[which, None] + np.arange(c)].sum(axis=1)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..arrays import run_owners, run_starts
 from ..mesh.polymesh import PolyMesh, mesh_size
 from ..parallel import thread_map
 from ..rounding.conical import vertex_cone_axes
@@ -196,8 +197,7 @@ def classify_vertices(
     )
     developable = is_developable(res.angle_sum[u_closed])
     unrounded = (
-        np.maximum.reduceat(np.concatenate([a.radius for a in sides]), np.cumsum(count) - count)
-        == 0
+        np.maximum.reduceat(np.concatenate([a.radius for a in sides]), run_starts(count)[:-1]) == 0
     )
     for j, (k, u, b) in enumerate(zip(closed, u_closed.tolist(), bound.tolist(), strict=True)):
         if unrounded[j]:
@@ -243,8 +243,8 @@ def _ring_normals(mesh: PolyMesh, R: np.ndarray, faces: np.ndarray, count: np.nd
     """:func:`~filletfold.vertex.normal.vertex_normals` of closed rings given flat: their
     sides' directions ``R`` (P, 3) and faces (P,), ``count`` (c,) per ring. Returns the
     normals, max-min bounds and sides (sigma) of the rings."""
-    row = np.repeat(np.arange(len(count)), count)
-    col = np.arange(len(row)) - np.repeat(np.cumsum(count) - count, count)
+    row = run_owners(count)
+    col = np.arange(len(row)) - np.repeat(run_starts(count)[:-1], count)
     edge_dir = np.zeros((len(count), int(count.max()), 3))
     face_normal = np.zeros_like(edge_dir)
     edge_dir[row, col] = R
@@ -264,7 +264,7 @@ def saddle_vertices(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
     if not len(closed):
         return out
     _, bound, _ = _ring_normals(mesh, R, face, count)
-    start = np.cumsum(count) - count
+    start = run_starts(count)[:-1]
     rounded = np.logical_or.reduceat(rounding.radius[edge] > 0, start)
     developable = is_developable(mesh.vertex_angle_sum[closed])
     out[closed] = rounded & ~developable & (bound <= tol.normal_bound)
@@ -457,10 +457,10 @@ def _set_up(
     # per vertex over its sides and faces: reflex corner, shortest l_max, lengths, arcs
     sa = [f.arrays for f in fr]
     k = np.array([len(x.arc) for x in sa])
-    first = np.cumsum(k) - k
+    first = run_starts(k)[:-1]
     nf = np.array([len(f.corner_angle) for f in fr])
     corner = np.concatenate([f.corner_angle for f in fr])
-    reflex = np.maximum.reduceat(corner, np.cumsum(nf) - nf) > np.pi
+    reflex = np.maximum.reduceat(corner, run_starts(nf)[:-1]) > np.pi
     lmax = np.fmin(
         np.concatenate([f.lmax_start for f in fr]), np.concatenate([f.lmax_end for f in fr])
     )
