@@ -184,6 +184,37 @@ PIPELINE = ["design.py", "pipeline.py", "parameters.py", "vertex/state.py", "ver
             "vertex/sharpen.py"]  # fmt: skip
 
 
+#: The functions of more than 8 parameters the library keeps, and why: the public API (the
+#: command line's options, the writers' formats, the solver's documented entry points) and
+#: the numba kernel's compiled functions, which take arrays one by one.
+MANY_PARAMETERS = {
+    "cli.py:round_cmd": "the command's options",
+    "export/render.py:render": "public: the picture's options",
+    "export/cutfiles.py:cut_files": "public: the cut files' options",
+    "export/outputs.py:export_design": "public: Design.export's options",
+    "vertex/solve.py:solve_apices": "public: the apex solver's entry point",
+    "vertex/batch.py:interior_point_numpy": "public: the solver, twin of the kernel's",
+    "vertex/batch_kernel.py:interior_point_numba": "public: the kernel, twin of numpy's",
+    "vertex/batch_kernel.py:_status": "numba: arrays one by one",
+    "vertex/batch_kernel.py:_kernel": "numba: arrays one by one",
+    "vertex/batch_kernel.py:_start": "numba: arrays one by one",
+    "vertex/batch_kernel.py:_step": "numba: arrays one by one",
+    "vertex/batch_kernel.py:_settle": "numba: arrays one by one",
+}
+
+
+def test_no_function_takes_more_than_8_parameters_but_the_listed():
+    """Outside the public API and the compiled kernel, what a function needs travels in a
+    record (Parameters, Job, VertexState, a stage's result), not in a dozen arguments."""
+    found = {
+        f"{path.relative_to(ROOT)}:{name}"
+        for path in sorted(ROOT.rglob("*.py"))
+        for name, n in parameter_counts(path).items()
+        if n > 8
+    }
+    assert found == set(MANY_PARAMETERS)
+
+
 def test_the_orchestrator_is_short_and_the_stages_take_few_parameters():
     """round_mesh reads in one screen (under 80 lines with its docstring), and no function of
     the pipeline takes more than 8 parameters (state travels in Job, VertexState and the

@@ -21,6 +21,7 @@ from scipy.integrate import quad
 from filletfold.mesh import load_mesh
 from filletfold.rounding.edges import round_edges
 from filletfold.rounding.tapered import (
+    FilletRows,
     arc_points,
     cone_rulings,
     crease_height_ruled,
@@ -68,7 +69,7 @@ class Chart:
         rows = side_rows(side, s)
         if self.conical:
             S = np.repeat(sharp_end(side)[None], len(s), 0)
-            C, R, c, r, _ = fillet_chart(*rows, S, s)
+            C, R, c, r, _ = fillet_chart(FilletRows(*rows, S), s)
         else:
             C = arc_points(*rows, s)[0]
             R = np.repeat(side.R[None], len(s), 0)
@@ -140,7 +141,9 @@ def test_a_conical_fillet_is_tangent_to_both_faces_and_develops_isometrically(na
     for i, side in enumerate(frame.sides):
         S = sharp_end(side)
         s = np.linspace(0, side.arc, 401)
-        C, R, c, r, q = fillet_chart(*side_rows(side, s), np.repeat(S[None], len(s), 0), s)
+        C, R, c, r, q = fillet_chart(
+            FilletRows(*side_rows(side, s), np.repeat(S[None], len(s), 0)), s
+        )
         dC = arc_points(*side_rows(side, s), s)[1]
         # the rulings run from S through the base curve, toward W
         assert (R @ side.R > 0).all()
@@ -196,7 +199,7 @@ def test_the_developed_angle_is_integrated_to_round_off(radius, gamma, half_leng
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # quad's own round-off notice at 1e-15
         want = quad(rate, 0, a, epsabs=1e-16, epsrel=1e-15, limit=200)[0]
-    got = developed_angles(O, N0, B, kappa, r, S, np.array([a]))[0]
+    got = developed_angles(FilletRows(O, N0, B, kappa, r, S), np.array([a]))[0]
     assert abs(got - want) <= 1e-13 * want
     # inside the arc, with a second fillet (the mirror image) in the same call: each row gets
     # its own fillet's integral from 0 to its s
@@ -204,14 +207,13 @@ def test_the_developed_angle_is_integrated_to_round_off(radius, gamma, half_leng
     fill = np.array([0, 0, 0, 1, 1, 1, 0])
     mirror = np.diag([1.0, -1.0, 1.0])
     rows = [np.vstack([x, x @ mirror])[fill] for x in (O, N0, B)]
-    both = developed_angles(*rows, np.ones(7), np.full(7, radius), np.vstack([S, S])[fill], s)
+    both_rows = FilletRows(*rows, np.ones(7), np.full(7, radius), np.vstack([S, S])[fill])
+    both = developed_angles(both_rows, s)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         each = [quad(rate, 0, x, epsabs=1e-16, epsrel=1e-15, limit=200)[0] for x in s]
     assert_allclose(both, each, rtol=0, atol=1e-13 * want)
-    named = developed_angles(
-        *rows, np.ones(7), np.full(7, radius), np.vstack([S, S])[fill], s, fillet=fill
-    )
+    named = developed_angles(both_rows, s, fillet=fill)
     assert_allclose(named, both, rtol=0, atol=1e-15 * want)
     # the ends of the arc lie on the faces through the edge (the set-up is an edge's)
     C = arc_points(O, N0, B, kappa, r, np.array([0.0, a]))[0]
@@ -260,7 +262,9 @@ def test_the_crease_closes_tangent_continuously_around_a_vertex_with_conical_sid
     for i in sharp:
         sd = frame.sides[i]
         psi = np.arctan2(sd.radius * np.tan(sd.gamma), 0.5 * sd.length)
-        theta = developed_angles(*side_rows(sd, [sd.arc]), sharp_end(sd)[None], [sd.arc])[0]
+        theta = developed_angles(
+            FilletRows(*side_rows(sd, [sd.arc]), sharp_end(sd)[None]), [sd.arc]
+        )[0]
         turn += 2 * psi - theta
     assert_allclose(np.arctan2(rho[1, 0], rho[0, 0]), turn, atol=1e-13)
     ends = []
@@ -338,6 +342,6 @@ def test_the_sector_apex_is_the_image_of_s_at_the_start_of_the_arc(seed, m):
     radius = rng.uniform(0.01, 2.0, m)
     S = O + rng.normal(size=(m, 3)) * 3.0
     s = rng.uniform(-1.0, 1.0, m) * radius
-    q = fillet_chart(O, N0, B, kappa, radius, S, s, theta=np.zeros(m))[4]
+    q = fillet_chart(FilletRows(O, N0, B, kappa, radius, S), s, theta=np.zeros(m))[4]
     C0 = arc_points(O, N0, B, kappa, radius, np.zeros(m))[0]
     assert np.array_equal(q[:, 1], -cone_rulings(C0, S)[1]) and not q[:, 0].any()

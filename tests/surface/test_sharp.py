@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 
 from filletfold.mesh import load_mesh
 from filletfold.rounding.edges import round_edges
-from filletfold.rounding.tapered import developed_angles
+from filletfold.rounding.tapered import FilletRows, developed_angles
 from filletfold.surface.centres import face_piece_centres
 from filletfold.surface.overlap import faces_interior_disjoint
 from filletfold.surface.sharp import SEAM_MARGIN, fan_angle, sharp_module, sharp_modules
@@ -98,7 +98,8 @@ def test_the_fan_is_the_corner_less_the_wedges_the_fillets_replace(case):
                     [side.radius],
                 )
                 theta = developed_angles(
-                    *(np.asarray(r, dtype=float) for r in rows), S, np.array([side.arc])
+                    FilletRows(*(np.asarray(r, dtype=float) for r in rows), S),
+                    np.array([side.arc]),
                 )[0]
                 want -= 2 * psi - theta
         assert_allclose(fan_angle(frame, centres, conical), want, atol=1e-12)

@@ -18,6 +18,7 @@ import logging
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -704,27 +705,37 @@ def _orient(he: _HalfEdges, face_list, v, face_origin, strict: bool, *, log=None
     parity = parity ^ invert[component].astype(np.int64)
     out = [_flip(f) if parity[i] else f for i, f in enumerate(face_list)]
     if log is not None and not log.strict and parity.any():
-        _report_flips(
-            log,
-            parity,
-            component,
-            comp_size,
-            is_open,
-            inner,
-            same,
-            fa,
-            fb,
-            he,
-            face_origin,
-            vert_orig,
-        )
+        comps = _Components(component, comp_size, is_open)
+        pairs = _InnerEdges(inner, same, fa, fb)
+        _report_flips(log, parity, comps, pairs, he, face_origin, vert_orig)
     return out, int(parity.sum()), []
 
 
+class _Components(NamedTuple):
+    """The connected components of the faces (:func:`_orient`): each face's component, each
+    component's number of faces, and whether it has a border."""
+
+    of_face: np.ndarray
+    size: np.ndarray
+    is_open: np.ndarray
+
+
+class _InnerEdges(NamedTuple):
+    """The edges with two faces (:func:`_orient`): their indices among the edges, 1 where both
+    faces use the edge in the same direction, and the two faces."""
+
+    edge: np.ndarray
+    same: np.ndarray
+    fa: np.ndarray
+    fb: np.ndarray
+
+
 def _report_flips(
-    log, parity, component, comp_size, is_open, inner, same, fa, fb, he, face_origin, vert_orig
+    log, parity, comps: _Components, pairs: _InnerEdges, he, face_origin, vert_orig
 ) -> None:
     """One ``flip-face`` repair per component with reversed faces (see :func:`_orient`)."""
+    component, comp_size, is_open = comps
+    inner, same, fa, fb = pairs
     flipped = np.flatnonzero(parity)
     comps = component[flipped]
     order = np.argsort(comps, kind="stable")

@@ -34,6 +34,7 @@ place of the constants (:func:`crease_height_ruled`).
 from __future__ import annotations
 
 from functools import cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -123,7 +124,26 @@ def _chebyshev(nodes: int) -> tuple[np.ndarray, np.ndarray]:
     return x, T
 
 
-def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None):
+class FilletRows(NamedTuple):
+    """Rows of conical fillets, one per point asked of them: the arc of each row's edge
+    (:func:`arc_points`: its centre ``O``, unit ``N0`` and ``B``, ``kappa`` and ``radius``)
+    and the apex ``S`` its rulings come from.
+
+    Attributes
+    ----------
+    O, N0, B, S : (m, 3) float
+    kappa, radius : (m,) float
+    """
+
+    O: np.ndarray
+    N0: np.ndarray
+    B: np.ndarray
+    kappa: np.ndarray
+    radius: np.ndarray
+    S: np.ndarray
+
+
+def developed_angles(rows: FilletRows, s, nodes: int = QUADRATURE_NODES, fillet=None):
     """(m,) float: the developed angle ``theta(s)`` a conical fillet sweeps from ``0`` to ``s``.
 
     The rows of one fillet (equal ``O``, ``N0``, ``B``, ``kappa``, ``radius``, ``S``) share one
@@ -135,10 +155,8 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
 
     Parameters
     ----------
-    O, N0, B : (m, 3) float
-    kappa, radius, s : (m,) float
-    S : (m, 3) float
-        Apex of each row's fillet.
+    rows : FilletRows
+    s : (m,) float
     nodes : int
         Chebyshev points per fillet.
     fillet : (m,) int, optional
@@ -149,6 +167,7 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     s = np.asarray(s, dtype=float)
     if not len(s):
         return np.zeros(0)
+    O, N0, B, kappa, radius, S = rows
     parts = (O, N0, B, np.asarray(kappa, float)[:, None], np.asarray(radius, float)[:, None], S)
     if fillet is None:
         key, inv = np.unique(np.concatenate(parts, 1), axis=0, return_inverse=True)
@@ -159,23 +178,27 @@ def developed_angles(O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODE
     h = np.zeros(len(key))
     np.maximum.at(h, inv, s)
     series = angle_series(
-        key[:, 0:3], key[:, 3:6], key[:, 6:9], key[:, 9], key[:, 10], key[:, 11:14], h, nodes
+        FilletRows(key[:, 0:3], key[:, 3:6], key[:, 6:9], key[:, 9], key[:, 10], key[:, 11:14]),
+        h,
+        nodes,
     )
     return series_angles(series, h, inv, s)
 
 
-def angle_series(O, N0, B, kappa, radius, S, span, nodes: int = QUADRATURE_NODES) -> np.ndarray:
+def angle_series(rows: FilletRows, span, nodes: int = QUADRATURE_NODES) -> np.ndarray:
     """(k, L) float: per fillet, the Chebyshev series on ``[0, span]`` of its developed angle
     ``theta(s)`` (0 at ``s = 0``), evaluated by :func:`series_angles`.
 
     Parameters
     ----------
-    O, N0, B, S : (k, 3) float
-    kappa, radius, span : (k,) float
-        One row per fillet; ``span`` the largest ``s`` it will be evaluated at (its arc).
+    rows : FilletRows
+        One row per fillet (k rows).
+    span : (k,) float
+        The largest ``s`` each fillet will be evaluated at (its arc).
     nodes : int
         Chebyshev points per fillet.
     """
+    O, N0, B, kappa, radius, S = rows
     x, T = _chebyshev(nodes)
     t = 0.5 * np.asarray(span, dtype=float)[:, None] * (x + 1.0)  # (fillets, nodes)
     C, dC = arc_points(
@@ -218,9 +241,7 @@ def _integrated(c: np.ndarray) -> np.ndarray:
     return out[:, : (live[-1] + 1 if len(live) else 1)]
 
 
-def fillet_chart(
-    O, N0, B, kappa, radius, S, s, nodes: int = QUADRATURE_NODES, fillet=None, theta=None
-):
+def fillet_chart(rows: FilletRows, s, nodes: int = QUADRATURE_NODES, fillet=None, theta=None):
     """A conical fillet's base curve and rulings, in 3D and in the side's developed chart.
 
     The chart is a cylinder's at ``s = 0`` (``c(0) = (0, 0)``, ``r(0) = (0, 1)``); the sector's
@@ -228,9 +249,8 @@ def fillet_chart(
 
     Parameters
     ----------
-    O, N0, B : (m, 3) float
-    kappa, radius, s : (m,) float
-    S : (m, 3) float
+    rows : FilletRows
+    s : (m,) float
     nodes, fillet
         See :func:`developed_angles`.
     theta : (m,) float, optional
@@ -245,13 +265,14 @@ def fillet_chart(
     q : (m, 2) float
         The image of ``S``.
     """
+    O, N0, B, kappa, radius, S = rows
     C, _ = arc_points(O, N0, B, kappa, radius, s)
     R, rho = cone_rulings(C, S)
     # C(0) = O + kappa r N0 (arc_points at s = 0 to the bit, but for the signs of zeros)
     k_r = np.asarray(kappa, dtype=float) * np.asarray(radius, dtype=float)
     rho0 = cone_rulings(O + k_r[..., None] * N0, S)[1]
     if theta is None:
-        theta = developed_angles(O, N0, B, kappa, radius, S, s, nodes, fillet)
+        theta = developed_angles(rows, s, nodes, fillet)
     r = np.stack([np.sin(theta), np.cos(theta)], axis=-1)
     q = np.stack([np.zeros_like(rho0), -rho0], axis=-1)
     return C, R, q + rho[:, None] * r, r, q

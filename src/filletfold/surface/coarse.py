@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -664,14 +665,15 @@ def _clean_slivers(
                 at[v].add(f)
         moves = 0
         sides = _FlatSides(tri, v2, current.edges[current.edge_assignment == "B"])
+        live = _Triangles(tri, alive, at, v2, v3, is_feature, fdeg, patch, shift, sides)
         for t in bad[np.argsort(quality[bad], kind="stable")].tolist():
             if not alive[t]:
                 continue
-            move = _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle, sides)
+            move = _best_move(live, t, min_angle)
             if move is None:
                 continue
             moves += 1
-            _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n)
+            _apply_move(live, move)
             sides.add(_new_sides(tri, move), tri[alive])
         tri, patch = tri[alive], [p for p, a in zip(patch, alive, strict=True) if a]
         piece = piece[alive]
@@ -691,12 +693,51 @@ def _clean_slivers(
     )
 
 
-def _apply_move(move, tri, alive, at, v2, v3, is_feature, fdeg, n) -> None:
-    """Make the move of :func:`_best_move` on the triangles ``tri`` and keep the faces at
-    each point (``at``), the creases and borders (``is_feature``, keyed by the edge's
-    ``lo * n + hi``) and their count at each point (``fdeg``) up to date: an edge that a
-    collapse makes of two is a crease or border when either of them was; a flip's new
-    diagonal lies inside one smooth patch."""
+@dataclass
+class _Triangles:
+    """The triangles of one round of :func:`_clean_slivers`, which its moves change in place.
+
+    Attributes
+    ----------
+    tri : (m, 3) int
+        The triangles (a removed one keeps its corners, and ``alive`` is False).
+    alive : (m,) bool
+    at : list of set of int
+        Each point's live triangles.
+    v2, v3 : (n, 2), (n, 3) float
+        The points, flat and folded.
+    is_feature : dict of int to bool
+        Whether the edge keyed ``lo * n + hi`` is a crease or a border.
+    fdeg : (n,) int
+        How many creases and borders meet at each point.
+    patch : list of str
+        Each triangle's patch name.
+    shift : (n,) float
+        The most a side at each point may change length, flat to folded
+        (:func:`_shift_bound`).
+    flat : _FlatSides
+        The pattern's sides in the flat layout, which no collapse may cross.
+    """
+
+    tri: np.ndarray
+    alive: np.ndarray
+    at: list
+    v2: np.ndarray
+    v3: np.ndarray
+    is_feature: dict
+    fdeg: np.ndarray
+    patch: list
+    shift: np.ndarray
+    flat: _FlatSides | None = None
+
+
+def _apply_move(live: _Triangles, move) -> None:
+    """Make the move of :func:`_best_move` on the triangles and keep the faces at each point
+    (``at``), the creases and borders (``is_feature``) and their count at each point
+    (``fdeg``) up to date: an edge that a collapse makes of two is a crease or border when
+    either of them was; a flip's new diagonal lies inside one smooth patch."""
+    tri, alive, at, v2, v3 = live.tri, live.alive, live.at, live.v2, live.v3
+    is_feature, fdeg, n = live.is_feature, live.fdeg, len(live.v2)
     changed, new, moved, collapse = move
     ring = {v for f in changed for v in tri[f].tolist()}
     if moved is not None:
@@ -805,17 +846,18 @@ def _new_sides(tri: np.ndarray, move) -> np.ndarray:
     return _triangle_sides(tri[kept].reshape(-1, 3))
 
 
-def _best_move(tri, at, t, v2, v3, shift, is_feature, fdeg, patch, min_angle, flat=None):
+def _best_move(live: _Triangles, t: int, min_angle: float):
     """The best collapse or flip for the sliver ``t`` (see :func:`_clean_slivers`): the
     changed faces, their new corners (None: removed), the point moved (None, or (vertex,
     flat, folded position)) and, for a collapse, the point removed and the one that takes
-    its place (None for a flip); None when nothing improves. ``at`` lists each point's
-    faces.
+    its place (None for a flip); None when nothing improves.
 
     A side shorter than ``tan(min_angle)`` times the longest, whose ends both lie on creases
     or borders, may also be collapsed to its midpoint (the one move that moves a point). With
-    ``flat`` (:class:`_FlatSides`), a collapse whose sides would cross a side of the pattern
-    in the flat layout is not taken."""
+    ``live.flat`` (:class:`_FlatSides`), a collapse whose sides would cross a side of the
+    pattern in the flat layout is not taken."""
+    tri, at, v2, v3, shift = live.tri, live.at, live.v2, live.v3, live.shift
+    is_feature, fdeg, patch, flat = live.is_feature, live.fdeg, live.patch, live.flat
     n = len(v2)
     corners = tri[t].tolist()
     around = {v: np.array(sorted(at[v]), dtype=np.int64) for v in corners}

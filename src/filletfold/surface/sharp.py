@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..arrays import run_owners, split_runs
-from ..rounding.tapered import arc_points, cone_rulings, developed_angles
+from ..rounding.tapered import FilletRows, arc_points, cone_rulings, developed_angles
 from ..vertex.frame import VertexFrame, to_chart
 from .patch import Patch
 from .piece import Piece
@@ -68,7 +68,7 @@ def _side_points(frames: list, conical, n_samples) -> list[list[tuple]]:
     S = np.array([frames[k].U for k, _, _ in rows])[which]
     C = arc_points(O, N0, B, kappa, radius, s)[0]
     rho = cone_rulings(C, S)[1]
-    theta = developed_angles(O, N0, B, kappa, radius, S, s, fillet=which)
+    theta = developed_angles(FilletRows(O, N0, B, kappa, radius, S), s, fillet=which)
     bounds = np.cumsum(count)[:-1]
     for (k, i, _), c, r, th in zip(
         rows, split_runs(C, bounds), split_runs(rho, bounds), split_runs(theta, bounds), strict=True

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
+from typing import NamedTuple
 
 import numpy as np
 
@@ -614,7 +615,8 @@ def validate_apices(
     lmax_end = np.concatenate([f.lmax_end for f in frames])
     faces = np.concatenate([f.ring.faces for f in frames])  # (F,) mesh faces
     T_face = np.concatenate([f.T_end[:nf] for f, nf in zip(frames, n_faces, strict=True)])
-    side, first, last, s, C, N = sa.samples(n_samples)
+    samples = _Samples(*sa.samples(n_samples))
+    side, first, last, s, C, N = samples
     vi = chart_apex(sa.Q, sa.t, v)  # developed apex in each cylinder's chart
     d = V[side] - C
     if sa.conical.any():  # a fillet's chart turns with s: eq. (1) row by row, dn varies
@@ -639,11 +641,11 @@ def validate_apices(
         # each side's smallest one
         cone = np.flatnonzero(sa.conical)
         for values, best, at, kind in ((l, l_min, l_at, "l"), (nonint, nonint_min, nonint_at, "n")):
-            b, t = _conical_dense_min(sa, V, v, sigma[vert], cone, values, s, first, last, kind)
+            b, t = _conical_dense_min(sa, V, v, sigma[vert], cone, values, samples, kind)
             lower = b < best[cone]
             best[cone[lower]], at[cone[lower]] = b[lower], t[lower]
     floor = np.zeros(n) if floors is None else np.asarray(floors, dtype=float).reshape(n)
-    crease = _curved_crease_fold(sa, V, vi, dn, side, s, C, N, l, nonint, valid)
+    crease = _curved_crease_fold(sa, V, vi, dn, samples._replace(N=N), l, nonint, valid)
     checks = np.stack(
         [
             dn,
@@ -708,7 +710,20 @@ def validate_apices(
     ]
 
 
-def _curved_crease_fold(sa, V, vi, dn, side, s, C, N, l, nonint, valid) -> np.ndarray:
+class _Samples(NamedTuple):
+    """The samples along every side's arc (:meth:`SideArrays.samples`): ``side`` (m,) the
+    side of each, ``first`` / ``last`` (k,) each side's first and last sample, ``s`` (m,) the
+    arc parameter, ``C`` (m, 3) the base-curve point, ``N`` (m, 3) the surface normal."""
+
+    side: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
+    s: np.ndarray
+    C: np.ndarray
+    N: np.ndarray
+
+
+def _curved_crease_fold(sa, V, vi, dn, samples: _Samples, l, nonint, valid) -> np.ndarray:
     """(m,) slack of the curved crease's fold at every sample (length units, >= 0 valid):
     the cone meets the cylinder along ``F(s)`` at an interior angle of at least ``tol.fold``,
     so that no curved crease folds by more than 180 degrees less that angle.
@@ -719,6 +734,7 @@ def _curved_crease_fold(sa, V, vi, dn, side, s, C, N, l, nonint, valid) -> np.nd
     along ``R``, normal to ``N``). With ``alpha`` the angle from ``h`` to ``w``, the slack is
     ``|w| sin(alpha - fold) = cos(fold) (w . sigma N) - sin(fold) (w . h)``. A conical side
     (its chart turns with ``s``) is not measured here (``inf``)."""
+    side, s, C = samples.side, samples.s, samples.C
     out = np.full(len(s), np.inf)
     rows = np.flatnonzero(~sa.conical[side] & (sa.radius[side] > 0) & valid[side])
     if not len(rows):
@@ -754,10 +770,11 @@ def _stack(arrays: Sequence[SideArrays]) -> SideArrays:
 CONICAL_DENSE = 33
 
 
-def _conical_dense_min(sa, V, v, sigma, sides, values, s, first, last, kind):
+def _conical_dense_min(sa, V, v, sigma, sides, values, samples: _Samples, kind):
     """(k,) smallest value and where, of ``l(s)`` (``kind`` "l") or ``sigma (V - C) . N``
     ("n") on conical ``sides`` (k,), over :data:`CONICAL_DENSE` points between the samples
     beside each side's smallest sample. ``V``, ``v``, ``sigma`` per side."""
+    s, first, last = samples.s, samples.first, samples.last
     lo = np.empty(len(sides))
     hi = np.empty(len(sides))
     for j, i in enumerate(sides.tolist()):

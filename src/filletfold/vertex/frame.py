@@ -30,6 +30,7 @@ from ..errors import MeshError
 from ..mesh.polymesh import PolyMesh, VertexRing
 from ..rounding.edges import EdgeRounding
 from ..rounding.tapered import (
+    FilletRows,
     angle_series,
     fillet_chart,
     perpendiculars,
@@ -232,10 +233,16 @@ class SideArrays:
             k = i[cone]
             theta = series_angles(self.angle_series(), self.arc, k, s[cone])
             _, R[cone], c[cone], r[cone], _ = fillet_chart(
-                self.O[k], self.N0[k], self.B[k], self.kappa[k], self.radius[k], self.S[k], s[cone],
-                theta=theta,
-            )  # fmt: skip
+                self.fillet_rows(k), s[cone], theta=theta
+            )
         return C, R, c, r
+
+    def fillet_rows(self, i: np.ndarray) -> FilletRows:
+        """The conical fillets of sides ``i`` (k,) int, as rows
+        (:class:`~filletfold.rounding.tapered.FilletRows`)."""
+        return FilletRows(
+            self.O[i], self.N0[i], self.B[i], self.kappa[i], self.radius[i], self.S[i]
+        )
 
     def angle_series(self) -> np.ndarray:
         """(k, L) float: per side, the series of its conical fillet's developed angle over its
@@ -246,10 +253,7 @@ class SideArrays:
             cone = np.flatnonzero(self.conical)
             series = np.zeros((len(self.edge), 1))
             if len(cone):
-                found = angle_series(
-                    self.O[cone], self.N0[cone], self.B[cone], self.kappa[cone],
-                    self.radius[cone], self.S[cone], self.arc[cone],
-                )  # fmt: skip
+                found = angle_series(self.fillet_rows(cone), self.arc[cone])
                 series = np.zeros((len(self.edge), found.shape[1]))
                 series[cone] = found
             self.__dict__["_angle_series"] = series
