@@ -159,12 +159,12 @@ def test_quads_sharing_a_diagonal_are_split_along_their_other_ones(tmp_path):
 def test_a_polygon_whose_every_diagonal_is_taken_is_split_around_a_new_vertex():
     """A non-planar quad (0, 1, 2, 3) whose diagonals (0, 2) and (1, 3) are both edges of
     other faces already: split around a new vertex at its middle."""
-    from filletfold.mesh.repair import RepairLog, edge_keys, triangulate_faces
+    from filletfold.mesh.repair import RepairLog, edge_keys, split_into_triangles
 
     v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0.3], [0, 1, 0], [0.5, 0.5, -1.0]], dtype=float)
     faces = [np.array(f) for f in ([0, 1, 2, 3], [0, 2, 4], [1, 3, 4])]
     log = RepairLog()
-    out, origin, v2 = triangulate_faces(
+    out, origin, v2 = split_into_triangles(
         faces, np.arange(3), v, [0], log, lambda i: "bent", lambda o, i: ""
     )
     assert len(v2) == 6 and len(out) == 6 and origin.tolist() == [0, 0, 0, 0, 1, 2]

@@ -41,8 +41,8 @@ from .repair import (
     plane_axes,
     polygon_normal,
     split_face_loops,
+    split_into_triangles,
     split_non_manifold,
-    triangulate_faces,
     triangulate_polygon_3d,
 )
 
@@ -230,7 +230,7 @@ def clean_mesh(
         rest = np.flatnonzero(residual > tol.flat)
         if len(rest):  # polygons the planes of their neighbours do not let be planar
             n_v = len(v)
-            face_list, face_origin, v = triangulate_faces(
+            face_list, face_origin, v = split_into_triangles(
                 face_list,
                 face_origin,
                 v,
@@ -911,7 +911,7 @@ def _split_non_planar(face_list, face_origin, v, log: RepairLog):
     fl = _Flat.of(face_list)
     dist, diam = _face_planarity(fl, v)
     bad = np.flatnonzero((dist > tol.planar * diam) & (fl.size > 3))
-    return triangulate_faces(
+    return split_into_triangles(
         face_list,
         face_origin,
         v,
@@ -933,7 +933,7 @@ def _split_non_convex(face_list, face_origin, v, log: RepairLog):
     fl = _Flat.of(face_list)
     reflex = _corner_angles(fl, v) > np.pi + tol.collinear
     bad = np.flatnonzero(np.bincount(fl.face[reflex], minlength=len(fl.size)) > 0)
-    return triangulate_faces(
+    return split_into_triangles(
         face_list,
         face_origin,
         v,

@@ -20,7 +20,7 @@ vertices carry ``vorig`` (their input index), so that every message names input 
   manifold neighbourhood: the faces around the edge are paired by their angular order (CGAL's
   ``duplicate_non_manifold_vertices`` does the first, trimesh's and MeshLab's cleaning the
   second only by deleting faces);
-* :func:`triangulate_faces` -- a polygon that is not planar, or not convex, is triangulated in
+* :func:`split_into_triangles` -- a polygon that is not planar, or not convex, is triangulated in
   its plane, along diagonals that are no edge of the mesh yet (the coplanar merge then
   regroups coplanar triangles into convex parts).
 
@@ -735,7 +735,7 @@ def triangulate_polygon_3d(p: np.ndarray) -> list[tuple[int, int, int]]:
     return [(0, i, i + 1) for i in range(1, k - 1)]
 
 
-def triangulate_faces(faces, origin, v, which, log: RepairLog, why, error):
+def split_into_triangles(faces, origin, v, which, log: RepairLog, why, error):
     """Replace the faces ``which`` (indices) by their triangles, choosing diagonals that are
     no edge of the mesh yet (:func:`triangulate_avoiding`).
 
