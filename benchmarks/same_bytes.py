@@ -3,7 +3,8 @@
 Run from the repository root:
 
     .venv/bin/python benchmarks/same_bytes.py --base REV [--corpus] [--max-faces F]
-                                              [--keep-parameters] [--match TEXT ...]
+                                              [--format FMT] [--keep-parameters]
+                                              [--match TEXT ...]
 
 A refactor (issue 28: "behaviour unchanged, same bytes out") is checked against the tree it
 started from: ``REV`` (a commit, tag or branch) is checked out into a temporary ``git
@@ -13,6 +14,7 @@ checkout's. Then per case: the same exit status, the same file names, and every 
 bytes, except ``timings.json`` (seconds) and, unless ``--keep-parameters``, the ``parameters``
 object of ``report.json`` (which a change may extend; the rest of the report must be the
 same). A case whose two runs both fail counts as the same when their last stderr line is.
+``--format FMT`` is passed to every run (``--format all`` compares every writer's file).
 
 Cases: every built-in example with the defaults, the option sets of :data:`OPTION_SETS`
 (material loss, nets, sheets, strict, per-vertex depth, clamp, sharp kinds), and with
@@ -117,6 +119,7 @@ def main(argv=None) -> int:
     ap.add_argument("--corpus", action="store_true", help="add the corpus's default tier")
     ap.add_argument("--max-faces", type=int, default=3000)
     ap.add_argument("--keep-parameters", action="store_true")
+    ap.add_argument("--format", help="passed to every run (e.g. all)")
     ap.add_argument("--match", nargs="*", default=[], help="only cases whose name has TEXT")
     args = ap.parse_args(argv)
     # a kill (SIGTERM) still removes the worktree and the temporary folder
@@ -127,6 +130,8 @@ def main(argv=None) -> int:
         cases += corpus_meshes(args.max_faces)
     if args.match:
         cases = [c for c in cases if any(m in c[0] for m in args.match)]
+    if args.format:
+        cases = [(name, [*case, "--format", args.format]) for name, case in cases]
     rev = subprocess.run(
         ["git", "-C", str(ROOT), "rev-parse", "--short", args.base],
         capture_output=True, text=True, check=True,

@@ -99,7 +99,7 @@ settings.load_profile("repeatable")
 
 
 def patch_faces(pattern, kind):
-    return [i for i, p in enumerate(pattern.face_patch) if p.split()[0] == kind]
+    return [i for i, p in enumerate(pattern.face_patch) if p.kind == kind]
 
 
 def check_contraction_everywhere(d):
@@ -118,7 +118,7 @@ def check_ruling_lengths_are_isometric(d):
     apex = {tuple(np.round(d.vertices.apex[u], 12)) for u in range(m.n_vertices)}
     checked = 0
     for i, face in enumerate(p.faces):
-        kind, idx = p.face_patch[i].split()
+        kind, idx = p.face_patch[i]
         pairs = list(zip(face, np.roll(face, -1), strict=True))
         if kind == "face":  # flat piece: every edge and diagonal
             pairs = [(a, b) for a in face for b in face if a < b]
@@ -149,7 +149,7 @@ def check_pieces_lie_on_their_planes_and_cylinders(d):
     d = example_design
     p, m, rd = d.pattern, d.mesh, d.rounding
     for i, face in enumerate(p.faces):
-        kind, idx = p.face_patch[i].split()
+        kind, idx = p.face_patch[i]
         pts = p.vertices_3d[face]
         if kind == "face":
             f = int(idx)
@@ -170,8 +170,8 @@ def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
     angle, a mountain where the edge is convex."""
     d = example_design
     p, m, rd = d.pattern, d.mesh, d.rounding
-    cone_of = np.array([int(s.split()[1]) if s.startswith("cone") else -1 for s in p.face_patch])
-    face_of = np.array([int(s.split()[1]) if s.startswith("face") else -1 for s in p.face_patch])
+    cone_of = np.array([s.index if s.kind == "cone" else -1 for s in p.face_patch])
+    face_of = np.array([s.index if s.kind == "face" else -1 for s in p.face_patch])
     crease = np.isin(p.edge_assignment, ["M", "V"])
     assert np.all(
         np.sign(p.edge_fold_angle[crease]) == np.where(p.edge_assignment[crease] == "M", -1, 1)
@@ -226,7 +226,7 @@ def check_faces_counter_clockwise_in_2d_and_front_facing_in_3d(d):
     for i, face in enumerate(p.faces):
         q = p.vertices_2d[face]
         assert np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]) > 0
-        kind, idx = p.face_patch[i].split()
+        kind, idx = p.face_patch[i]
         if kind == "face":
             assert normals[i] @ m.face_normal[int(idx)] > 1 - 1e-9
 
@@ -238,7 +238,7 @@ def check_crease_loop_closes_around_every_cone(d):
     for u in range(d.mesh.n_vertices):
         if d.vertices.status[u] != "ok":
             continue
-        faces = [i for i, s in enumerate(p.face_patch) if s == f"cone {u}"]
+        faces = [i for i, s in enumerate(p.face_patch) if s == ("cone", u)]
         if len(set(p.face_piece[faces])) != 1:
             continue  # a module split in several pieces
         inner = np.isin(p.edge_faces, faces).all(axis=1)  # rulings to sharp edges

@@ -76,7 +76,7 @@ def test_design_of_a_compas_mesh_is_valid(design, dodecahedron):
 def test_compas_meshes_per_patch_kind(design):
     meshes = compas_meshes(design)
     pattern = design.pattern
-    kinds = {p.split()[0] for p in pattern.face_patch}
+    kinds = {p.kind for p in pattern.face_patch}
     assert set(meshes) == kinds
     assert sum(m.number_of_faces() for m in meshes.values()) == len(pattern.faces)
     area = 0.0

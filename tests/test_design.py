@@ -134,8 +134,8 @@ def test_arc_points_bound_the_turn_between_samples(step):
     # a cylinder patch of edge e has n[e] - 1 quads on each of its two modules' halves
     quads = {}
     for patch, face in zip(d.pattern.face_patch, d.pattern.faces, strict=True):
-        if patch.startswith("cylinder ") and len(face) == 4:
-            e = int(patch.split()[1])
+        if patch.kind == "cylinder" and len(face) == 4:
+            e = patch.index
             quads[e] = quads.get(e, 0) + 1
     for e, count in quads.items():
         assert count <= 2 * (n[e] - 1)
@@ -361,7 +361,7 @@ def test_conical_fillets_are_sampled_by_their_normal_too():
 
     case = case_by_name("hull-10/collapse-edge+quantise#0240")
     d = filletfold.round_mesh((np.asarray(case.vertices), [np.asarray(f) for f in case.faces]))
-    assert any(p.startswith("fillet ") for p in d.pattern.face_patch)
+    assert any(p.kind == "fillet" for p in d.pattern.face_patch)
     assert d.certificate["facet folds"].ok, d.certificate["facet folds"].line()
     assert d.certificate["facet folds"].value <= 10.0
 

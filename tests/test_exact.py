@@ -109,7 +109,7 @@ def test_hole_borders_keep_the_face_shares_simple(ring):
             poly = shapely.Polygon(p2[list(face)])
             assert poly.is_valid, (patch, shapely.is_valid_reason(poly))
             assert poly.exterior.is_ccw
-            n_faces += patch.startswith("face")
+            n_faces += patch.kind == "face"
         assert _largest_shared_area(piece) <= 1e-9
     assert n_faces == len(frame.ring.faces)
     (batched,) = build_modules(mesh, [frame], centres, 24, [None], [None])

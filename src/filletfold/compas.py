@@ -163,7 +163,7 @@ def compas_meshes(design) -> dict:
             pattern.vertices_3d[used].tolist(), [f.tolist() for f in np.split(local, sizes)]
         )
         for key, i in zip(mesh.faces(), ids, strict=True):
-            mesh.face_attribute(key, "patch", pattern.face_patch[i])
+            mesh.face_attribute(key, "patch", str(pattern.face_patch[i]))
         out[kind] = mesh
     return out
 

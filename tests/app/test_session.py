@@ -284,7 +284,7 @@ def test_scene_meshes_number_their_points_in_order():
     design = design_of("resch")
     arrays = scene_arrays(design)
     tris, owner = triangulate_faces(design.pattern.vertices_2d, design.pattern.faces)
-    kinds = np.array([p.split()[0] for p in design.pattern.face_patch])[owner]
+    kinds = np.array([p.kind for p in design.pattern.face_patch])[owner]
     v3 = arrays.to_scene(design.pattern.vertices_3d)
     assert list(arrays.folded) == [k for k in ("cone", "cylinder", "face") if k in kinds]
     for kind, (v, t) in arrays.folded.items():

@@ -186,7 +186,7 @@ def test_every_pattern_face_is_drawn(cube):
     their area: the flat pattern at ``scale * pattern_scale``, the folded form at ``scale``."""
     design, s = cube
     p = design.pattern
-    kinds = [patch.split()[0] for patch in p.face_patch]
+    kinds = [patch.kind for patch in p.face_patch]
     assert set(kinds) == set(s.folded)
     k2 = (s.scale * s.pattern_scale) ** 2
     for kind in s.folded:

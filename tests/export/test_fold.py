@@ -47,7 +47,7 @@ def test_fold_keys_and_types(pattern):
     assert len(doc["edges_assignment"]) == len(doc["edges_foldAngle"]) == m
     assert set(doc["edges_assignment"]) <= {"M", "V", "B", "F"}
     assert len(doc["faces_vertices"]) == nf
-    assert doc["filletfold:faces_patch"] == list(pattern.face_patch)
+    assert doc["filletfold:faces_patch"] == list(map(str, pattern.face_patch))
     assert doc["filletfold:faces_piece"] == pattern.face_piece.tolist()
     # every key without a namespace is a FOLD key
     for key in doc:

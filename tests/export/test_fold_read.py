@@ -67,7 +67,7 @@ def assert_same_pattern(a: CreasePattern, b: CreasePattern) -> None:
     assert_allclose(a.vertices_2d, b.vertices_2d, atol=1e-9)
     assert_allclose(a.vertices_3d, b.vertices_3d, atol=1e-9)
     assert [list(f) for f in a.faces] == [list(f) for f in b.faces]
-    assert list(a.face_patch) == list(b.face_patch)
+    assert list(map(str, a.face_patch)) == list(map(str, b.face_patch))
     assert a.face_piece.tolist() == b.face_piece.tolist()
     assert a.piece_vertex.tolist() == b.piece_vertex.tolist()
     assert a.edges.tolist() == b.edges.tolist()

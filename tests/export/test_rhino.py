@@ -20,6 +20,7 @@ from filletfold.export.rhino import (
     pattern_3dm,
     require_rhino3dm,
 )
+from filletfold.surface.patch import patch_kind
 
 from ..conftest import folded_area
 from .conftest import arc_pattern, layer_lengths_of
@@ -122,12 +123,12 @@ def test_folded_3dm_meshes_per_patch_and_creases(pattern):
     scale = 10.0
     model = read(folded_3dm(pattern, units="cm", scale=scale))
     assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Centimeters
-    kinds = sorted({p.split()[0] for p in pattern.face_patch})
+    kinds = sorted({patch_kind(p) for p in pattern.face_patch})
     names = [layer.Name for layer in model.Layers]
     assert sorted(names[:-2]) == sorted(k.upper() for k in kinds)
     assert names[-2:] == ["MOUNTAIN", "VALLEY"]
     layers = by_layer(model)
-    patches = Counter(p.split()[0].upper() for p in dict.fromkeys(pattern.face_patch))
+    patches = Counter(patch_kind(p).upper() for p in dict.fromkeys(pattern.face_patch))
     area = 0.0
     seen = set()
     for layer, count in patches.items():
@@ -144,7 +145,7 @@ def test_folded_3dm_meshes_per_patch_and_creases(pattern):
                 n = np.cross(corners - corners[0], np.roll(corners, -1, axis=0) - corners[0])
                 area += 0.5 * np.linalg.norm(n.sum(axis=0))
             assert len(mesh.Normals) == len(v)
-    assert seen == set(pattern.face_patch)
+    assert seen == set(map(str, pattern.face_patch))
     assert area == pytest.approx(folded_area(pattern) * scale**2, rel=1e-9)
     v3 = pattern.vertices_3d * scale
     for code in ("M", "V"):

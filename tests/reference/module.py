@@ -21,6 +21,7 @@ from filletfold.surface.module import (
     merge_distance,
 )
 from filletfold.surface.overlap import faces_interior_disjoint, run_overlaps
+from filletfold.surface.patch import Patch
 from filletfold.surface.piece import Piece
 from filletfold.vertex.apex import crease_length
 from filletfold.vertex.frame import VertexFrame, apply, stack_sides, to_chart
@@ -238,7 +239,7 @@ def _build_run(
     heights = hole_heights(frame)
     piece = Piece(vertex=u)
     top_name = "cr" if apex is not None else "hole"
-    cone = f"cone {u}"
+    cone = Patch("cone", int(u))
     if apex is not None:
         piece.apex_index = piece.point(("apex",), dev_apex, apex)
     rounded = [i for i in range(j0, j1 + 1) if frame.sides[i].rounded]
@@ -296,7 +297,7 @@ def _build_run(
             strip = strips[i]
             bs = _curve_points(piece, ("side", i, "bs"), strip.base_2d, strip.base_3d)
             tp = _curve_points(piece, ("side", i, top_name), strip.top_2d, strip.top_3d)
-            _add_strip(piece, bs, tp, strip, f"cylinder {side.edge}", cone)
+            _add_strip(piece, bs, tp, strip, Patch("cylinder", int(side.edge)), cone)
         # the share of face f_i, between side i (end) and side i + 1 (start)
         face = int(ring.faces[i])
         b0, t0 = line_points(i, i, start=False)
@@ -311,7 +312,7 @@ def _build_run(
             # a straight hole border would leave the face or cross the share: go through T
             T3 = frame.T_end[i]
             corner.append(piece.point(("T", i), apply(frame.face_map[i], to_chart(fr, T3)), T3))
-        piece.face(corner, f"face {face}")
+        piece.face(corner, Patch("face", int(face)))
         if apex is not None:
             piece.face([piece.apex_index, t0, t1], cone)
         sector += [i - j0] * (len(piece.faces) - n_before)

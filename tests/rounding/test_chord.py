@@ -63,7 +63,7 @@ def cylinder_chord_errors(design):
     v3 = p.vertices_3d
     out = []
     for face, patch in zip(p.faces, p.face_patch, strict=True):
-        kind, _, index = patch.partition(" ")
+        kind, index = patch
         if kind != "cylinder":
             continue
         e = int(index)

@@ -66,12 +66,12 @@ def test_assembled_cone_rulings_are_isometric_to_round_off(name, tmp_path):
     flat, start = pat.faces.flat, pat.faces.start
     size = np.diff(start)
     face = np.repeat(np.arange(len(size)), size)
-    cone = np.array([p.startswith("cone") for p in pat.face_patch])[face]
+    cone = np.array([p.kind == "cone" for p in pat.face_patch])[face]
     piece = pat.face_piece[face]
     assert cone.any()
     # the apex of a cone face is the corner shared by all the cone faces of its piece
     apex = {}
-    for f in np.flatnonzero(np.array([p.startswith("cone") for p in pat.face_patch])):
+    for f in np.flatnonzero(np.array([p.kind == "cone" for p in pat.face_patch])):
         corners = set(flat[start[f] : start[f + 1]].tolist())
         k = pat.face_piece[f]
         apex[k] = apex.get(k, corners) & corners

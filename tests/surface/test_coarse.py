@@ -357,7 +357,7 @@ def test_a_fillet_of_one_triangle_has_its_rulings_at_its_tapered_corner():
         for s in strips
         if len(s[0]) == 1
         and len(faces[s[0][0]]) == 3
-        and pattern.face_patch[s[0][0]].startswith("fillet")
+        and pattern.face_patch[s[0][0]].kind == "fillet"
     ]
     assert single
     v2 = pattern.vertices_2d

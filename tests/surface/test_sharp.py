@@ -32,7 +32,7 @@ def face_pairs(piece, kind):
     for fillet triangles the rulings from ``S`` (index 0 of the piece) and the chords apart."""
     a, b = [], []
     for f, patch in zip(piece.faces, piece.patches, strict=True):
-        if patch.split()[0] != kind:
+        if patch.kind != kind:
             continue
         for x in range(len(f)):
             for y in range(x + 1, len(f)):
@@ -111,7 +111,7 @@ def test_fillet_points_lie_on_their_arcs_and_face_points_on_their_faces(case):
         for piece in sharp_module(frame, centres, conical, 7):
             p3 = np.asarray(piece.points_3d)
             for f, patch in zip(piece.faces, piece.patches, strict=True):
-                kind, idx = patch.split()
+                kind, idx = patch
                 if kind == "face":
                     n = m.face_normal[int(idx)]
                     assert_allclose((p3[f] - frame.U) @ n, 0, atol=1e-12)

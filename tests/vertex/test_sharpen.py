@@ -41,7 +41,7 @@ def test_every_example_is_closed_by_default_and_has_holes_without(name):
 def fillet_edge_lengths(d):
     """(k,) flat and (k,) folded length of every pattern edge of a fillet face."""
     p = d.pattern
-    patch = np.array([x.split()[0] for x in p.face_patch])
+    patch = np.array([x.kind for x in p.face_patch])
     ef = p.edge_faces
     on = (patch[ef[:, 0]] == "fillet") | (patch[np.maximum(ef[:, 1], 0)] == "fillet")
     e = p.edges[on]
@@ -55,7 +55,7 @@ def join_angles(d, kind):
     (``fillet`` or ``cylinder``) and a face piece: 0 for exact tangency, the sampling's error
     otherwise."""
     p = d.pattern
-    patch = np.array([x.split()[0] for x in p.face_patch])
+    patch = np.array([x.kind for x in p.face_patch])
     ef = p.edge_faces
     inner = np.flatnonzero((ef >= 0).all(axis=1))
     a, b = patch[ef[inner, 0]], patch[ef[inner, 1]]

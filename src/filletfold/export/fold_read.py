@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ExportError, MeshReadError
+from ..surface.patch import as_patch
 from ..surface.pattern import Annotations, CreasePattern, Label, LabelRows
 from ..surface.validate import validate_pattern
 from .fold import ANNOTATIONS_FILE, NAMESPACE, design_counts
@@ -163,7 +164,11 @@ def pattern_from_fold(doc: dict) -> CreasePattern:
         if len(angle) == len(assign):  # borders are null and facets bent in the file: 0 here
             angle = np.where((assign == "B") | (assign == "F"), 0.0, angle)
         face_piece = np.asarray(doc[NAMESPACE + "faces_piece"], dtype=np.int64).reshape(-1)
-        patches = [str(p) for p in doc[NAMESPACE + "faces_patch"]]
+        names = {}  # each distinct name read once: a pattern has many faces per patch
+        patches = [
+            names.setdefault(p, as_patch(p)) if isinstance(p, str) else as_patch(str(p))
+            for p in doc[NAMESPACE + "faces_patch"]
+        ]
     except (TypeError, ValueError) as exc:
         raise MeshReadError(f"not a filletfold FOLD file: malformed arrays ({exc})") from None
     if v2.ndim != 2 or v2.shape[1] != 2:

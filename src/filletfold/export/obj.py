@@ -33,9 +33,9 @@ _NORMAL_DECIMALS = 9
 OBJ_RTOL = 1e-9
 
 
-def obj_group_name(patch: str) -> str:
+def obj_group_name(patch) -> str:
     """OBJ group name of a patch: whitespace runs replaced by ``_`` (``"cone 3"`` -> ``cone_3``)."""
-    name = re.sub(r"\s+", "_", patch.strip())
+    name = re.sub(r"\s+", "_", str(patch).strip())
     return name or "patch"
 
 
@@ -185,7 +185,7 @@ def _folded_obj(pattern: CreasePattern, faces, *, vertex_normals: bool = False) 
         parts.append(_xyz_lines("vn", normals, max(decimals, _NORMAL_DECIMALS)))
     # groups in order of their first face; faces in pattern order within a group
     group_id: dict[str, int] = {}
-    for p, name in zip(patches, _group_names(list(patches)), strict=True):
+    for p, name in zip(patches, _group_names(list(map(str, patches))), strict=True):
         patches[p] = group_id.setdefault(name, len(group_id))
     group = np.fromiter(
         map(patches.__getitem__, pattern.face_patch), dtype=np.int64, count=len(pattern.face_patch)

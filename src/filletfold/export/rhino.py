@@ -388,7 +388,7 @@ def _folded_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> b
             mesh.Faces.AddFace(*local[at : at + len(c)])
             at += len(c)
         mesh.Normals.ComputeNormals()
-        attr = model.attributes(kind_layer(patch_kind(name, "patch")), name)
+        attr = model.attributes(kind_layer(patch_kind(name, "patch")), str(name))
         model.file.Objects.AddMesh(mesh, attr)
     for layer, runs in crease_runs(pattern).items():
         for ids, spline, closed in runs:

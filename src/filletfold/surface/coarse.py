@@ -46,7 +46,7 @@ import numpy as np
 
 from ..arrays import round_significant, run_owners
 from ..errors import ParameterError
-from .patch import RULED_KINDS, patch_kinds
+from .patch import RULED_KINDS, patch_ids, patch_kinds
 from .pattern import Annotations, CreasePattern, edge_dihedrals, face_arrays
 
 __all__ = [
@@ -235,7 +235,7 @@ def _ruled_strips(pattern: CreasePattern, faces: list[np.ndarray], edge_faces: n
     which of them are inner edges, each ruling's place across the strip (0 to 1), the strip's
     width across the rulings and their mean length."""
     kind = patch_kinds(pattern.face_patch)
-    patch = np.array(pattern.face_patch or [""])
+    patch = patch_ids(pattern.face_patch)
     inner = (edge_faces >= 0).all(axis=1)
     fa, fb = edge_faces[:, 0], edge_faces[:, 1]
     ruled = np.isin(kind, ["cylinder", "fillet"])
@@ -1069,7 +1069,7 @@ def _merged_patches(
     ParameterError
         When a face of ``pattern`` itself has no triangles (it is not simple).
     """
-    patch = np.array(pattern.face_patch or [""])
+    patch = patch_ids(pattern.face_patch)
     inner = (edge_faces >= 0).all(axis=1)
     fa, fb = edge_faces[:, 0], edge_faces[:, 1]
     same = inner & (patch[fa] == patch[fb])
@@ -1093,8 +1093,8 @@ def _merged_patches(
                     )
                     if made[key] is None:
                         raise ParameterError(
-                            f"simulator.fold: {patch[group[0]]} of the pattern has a face "
-                            f"that is not simple (face {int(group[0])})",
+                            f"simulator.fold: {pattern.face_patch[group[0]]} of the pattern has "
+                            f"a face that is not simple (face {int(group[0])})",
                             name="pattern",
                         )
                 else:

@@ -46,7 +46,7 @@ from ..vertex.crease import chart_apex, crease_denominator, crease_height, creas
 from ..vertex.frame import SideArrays, VertexFrame, dot_rows, gluing_maps, stack_sides
 from .faces import FaceLists, polygon_area2
 from .overlap import faces_interior_disjoint, faces_interior_disjoint_many, run_overlaps
-from .patch import Patch, patch_names
+from .patch import Patch, patches_of
 from .piece import Piece
 from .sharp import sharp_modules
 
@@ -415,11 +415,11 @@ class _Chunk:
                 np.abs(np.array([f.U for f in frames])).max(axis=1),
             ),
             patch=[
-                str(Patch("fillet" if cone_side else "cylinder", e))
+                Patch("fillet" if cone_side else "cylinder", e)
                 for e, cone_side in zip(sa.edge.tolist(), sa.conical.tolist(), strict=True)
             ]
-            + patch_names("cone", [f.vertex for f in frames])
-            + patch_names("face", ring_face.tolist()),
+            + patches_of("cone", [f.vertex for f in frames])
+            + patches_of("face", ring_face.tolist()),
             tee=np.concatenate(
                 [
                     hole_corners(f, centres) if a is None else np.zeros(len(f.ring.faces), bool)

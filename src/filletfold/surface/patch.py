@@ -2,11 +2,11 @@
 
 Every face of a crease pattern lies on one smooth patch of the folded surface: the cylinder of
 a mesh edge, the conical fillet of an edge beside a sharp vertex, the cone of a mesh vertex, or
-the flat piece of a mesh face. :class:`Patch` is that record, ``(kind, index)``. A pattern
-keeps each face's patch by its name, ``str(patch)`` (``"cone 3"``, ``"cylinder 12"``), the form
-FOLD files carry under ``filletfold:faces_patch``; this module is the one place that makes
-names and reads them back (:meth:`Patch.parse`, and :func:`patch_kinds` /
-:func:`patch_indices` for a whole pattern's faces at once).
+the flat piece of a mesh face. :class:`Patch` is that record, ``(kind, index)``, and pieces and
+patterns keep one per face. Its name, ``str(patch)`` (``"cone 3"``, ``"cylinder 12"``), is what
+files carry (FOLD's ``filletfold:faces_patch``, OBJ groups, 3dm objects); :func:`as_patch` reads
+a name back. :func:`patch_kinds`, :func:`patch_indices` and :func:`patch_ids` give a whole
+pattern's faces at once.
 """
 
 from __future__ import annotations
@@ -49,29 +49,54 @@ class Patch(NamedTuple):
         return cls(parts[0], int(parts[1]))
 
 
-def patch_names(kind: str, indices) -> list[str]:
-    """The names of the patches of one ``kind`` with ``indices`` (ints)."""
-    return [f"{kind} {int(i)}" for i in indices]
+def patches_of(kind: str, indices) -> list[Patch]:
+    """The patches of one ``kind`` with ``indices`` (ints)."""
+    return [Patch(kind, int(i)) for i in indices]
 
 
-def patch_kind(name: str, default: str = "") -> str:
-    """The kind of a patch name: its first word (``"cone 3"`` -> ``"cone"``); ``default`` for
-    an empty name."""
-    words = str(name).split()
+def patch_kind(patch, default: str = "") -> str:
+    """The kind of a patch, or of a patch name: its first word (``"cone 3"`` -> ``"cone"``);
+    ``default`` for an empty name."""
+    if isinstance(patch, Patch):
+        return patch.kind
+    words = str(patch).split()
     return words[0] if words else default
 
 
-def patch_kinds(names) -> np.ndarray:
-    """(n,) str: the kind of each of ``names`` (:func:`patch_kind`; each distinct name read
+def patch_kinds(patches) -> np.ndarray:
+    """(n,) str: the kind of each of ``patches`` (:func:`patch_kind`; each distinct one read
     once, a pattern has many faces per patch)."""
-    kind = {name: patch_kind(name) for name in dict.fromkeys(names)}
-    return np.array([kind[name] for name in names], dtype="<U8")
+    kind = {p: patch_kind(p) for p in dict.fromkeys(patches)}
+    return np.array([kind[p] for p in patches], dtype="<U8")
 
 
-def patch_indices(names) -> np.ndarray:
-    """(n,) int64: the element index of each of ``names`` (-1 where a name has none)."""
+def patch_indices(patches) -> np.ndarray:
+    """(n,) int64: the element index of each of ``patches`` (-1 where a name has none)."""
     index = {}
-    for name in dict.fromkeys(names):
-        parts = str(name).split()
-        index[name] = int(parts[1]) if len(parts) == 2 and parts[1].isdigit() else -1
-    return np.fromiter((index[name] for name in names), dtype=np.int64, count=len(names))
+    for p in dict.fromkeys(patches):
+        if isinstance(p, Patch):
+            index[p] = p.index
+            continue
+        parts = str(p).split()
+        index[p] = int(parts[1]) if len(parts) == 2 and parts[1].isdigit() else -1
+    return np.fromiter((index[p] for p in patches), dtype=np.int64, count=len(patches))
+
+
+def patch_ids(patches) -> np.ndarray:
+    """(n,) int64: the same number for equal patches, numbered in order of their first face
+    (records or names alike: a pattern read from a file holds the names it carries)."""
+    ids: dict = {}
+    return np.fromiter(
+        (ids.setdefault(p, len(ids)) for p in patches), dtype=np.int64, count=len(patches)
+    )
+
+
+def as_patch(value) -> Patch | str:
+    """``value`` as a :class:`Patch` when it is one or names one (``"cone 3"``), else the
+    string itself (a foreign file's patch name, which the certificate names as wrong)."""
+    if isinstance(value, Patch):
+        return value
+    try:
+        return Patch.parse(value)
+    except ValueError:
+        return str(value)

@@ -15,7 +15,7 @@ import numpy as np
 from ..arrays import run_owners, run_starts, split_runs
 from ..mesh.measures import dihedral_turns
 from ..tolerances import tol
-from .patch import patch_indices, patch_kinds
+from .patch import patch_ids, patch_indices, patch_kinds
 
 #: Faces whose folded normals are computed together (bounds the temporaries).
 NORMAL_CHUNK = 16_384
@@ -455,7 +455,7 @@ class CreasePattern:
             Distance within which a point is the apex, or on an edge.
         """
         ef = self.edge_faces
-        patch = np.asarray(self.face_patch, dtype=str)
+        patch = patch_ids(self.face_patch)
         kind = patch_kinds(self.face_patch)
         cand = np.flatnonzero((self.edge_assignment == "F") & (ef >= 0).all(axis=1))
         fa, fb = ef[cand, 0], ef[cand, 1]
@@ -464,7 +464,7 @@ class CreasePattern:
         sharp = np.flatnonzero(np.asarray(unrounded, dtype=bool))
         if not len(cand) or not len(sharp):
             return 0
-        u = patch_indices(patch[fa].tolist())
+        u = patch_indices(self.face_patch)[fa]
         apex = np.asarray(vertex_apex, dtype=float)[u]
         a, b = self.vertices_3d[self.edges[cand, 0]], self.vertices_3d[self.edges[cand, 1]]
         at_a = np.linalg.norm(a - apex, axis=1) <= eps
@@ -546,12 +546,8 @@ class CreasePattern:
         inner = (ef >= 0).all(axis=1)
         fa, fb = ef[inner, 0], ef[inner, 1]
         theta = self._convexity(normals[fa], normals[fb], edges[inner])
-        ids = dict.fromkeys(self.face_patch)  # patch name -> number, in order of first face
-        for k, name in enumerate(ids):
-            ids[name] = k
-        patch = np.fromiter(
-            map(ids.__getitem__, self.face_patch), dtype=np.int64, count=len(self.face_patch)
-        )
+        ids = dict.fromkeys(self.face_patch)  # each patch, in order of its first face
+        patch = patch_ids(self.face_patch)
         kind = patch_kinds(list(ids))
         cyl = ((kind == "cylinder") | (kind == "fillet"))[patch]  # tangent to the faces
         face = (kind == "face")[patch]

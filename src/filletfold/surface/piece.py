@@ -16,7 +16,7 @@ from .overlap import faces_overlap
 
 @dataclass
 class Piece:
-    """One flat piece: points in 2D (piece frame) and 3D, polygon faces, patch names.
+    """One flat piece: points in 2D (piece frame) and 3D, polygon faces, their patches.
 
     Attributes
     ----------
@@ -26,7 +26,7 @@ class Piece:
     points_3d : (k, 3) float
     faces : list of list of int, or FaceLists
         Counter-clockwise in 2D.
-    patches : list of str
+    patches : list of Patch
     apex_index : int or None
         Index of the apex point (cone modules).
     """
@@ -77,7 +77,7 @@ class Piece:
         self.points_3d.extend(p3)
         return np.arange(start, start + len(p2))
 
-    def face(self, idx, patch: str, min_area: float = 0.0):
+    def face(self, idx, patch, min_area: float = 0.0):
         """Add a polygon (duplicate consecutive indices dropped), made counter-clockwise.
 
         A polygon with fewer than 3 distinct corners or twice-area ``<= 2 min_area`` is dropped.

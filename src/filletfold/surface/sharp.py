@@ -147,7 +147,7 @@ def _module(frame: VertexFrame, centres: np.ndarray, sides: list) -> list[Piece]
             C, rho, theta = sides[i]
             flat = _polar(phi + theta, rho)
             idx = [piece.point(("side", i, k), flat[k], C[k]) for k in range(len(C))]
-            patch = str(Patch("fillet", ring.edges[i]))
+            patch = Patch("fillet", int(ring.edges[i]))
             for k in range(len(idx) - 1):
                 piece.face([apex, idx[k], idx[k + 1]], patch)
             phi += theta[-1]
@@ -163,7 +163,7 @@ def _module(frame: VertexFrame, centres: np.ndarray, sides: list) -> list[Piece]
             if j == 0 and ring.closed:
                 last_start = ("seam",)  # the cut: side 0's start again, at the fan's end
             p_next = piece.point(last_start, rot[2], sides[j][0][0])
-            piece.face([apex, p_end, p_c, p_next], str(Patch("face", ring.faces[i])))
+            piece.face([apex, p_end, p_c, p_next], Patch("face", int(ring.faces[i])))
             phi += wedge[i]
     return [p.compact() for p in pieces]
 

@@ -12,6 +12,7 @@ import numpy as np
 from ..arrays import run_starts
 from ..errors import ExportError
 from ..tolerances import tol
+from .patch import Patch
 from .pattern import CreasePattern, FlatFaces, face_arrays
 
 #: The edge assignments a pattern may have: the FOLD ``edges_assignment`` values written.
@@ -145,8 +146,8 @@ def validated_faces(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
         raise ExportError(
             f"pattern has {n_faces} faces but {len(pattern.face_patch)} face_patch names"
         )
-    if not all(isinstance(p, str) for p in pattern.face_patch):
-        raise ExportError("pattern face_patch entries must be strings")
+    if not all(isinstance(p, Patch | str) for p in pattern.face_patch):
+        raise ExportError("pattern face_patch entries must be patches (or their names)")
     if pattern.face_piece.shape != (n_faces,):
         raise ExportError(
             f"pattern has {n_faces} faces but face_piece has shape {pattern.face_piece.shape}"
