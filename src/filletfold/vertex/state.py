@@ -94,40 +94,9 @@ class VertexState:
         rounding : EdgeRounding
         centres : (n_faces, 3) float
         """
-        return reround(
-            self.mesh, radius, self.rounding.half_angle, self.face_centres, self.flat_deg,
-            self.floor, self.min_width,
-        )  # fmt: skip
-
-
-def reround(
-    mesh: PolyMesh,
-    radius: np.ndarray,
-    half_angle: np.ndarray,
-    face_centres,
-    flat_deg: float,
-    floor: float,
-    min_width: float,
-) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
-    """The rounding of new radii, and its face piece centres.
-
-    Parameters
-    ----------
-    mesh : PolyMesh
-    radius : (n_edges,) float
-        The new radii.
-    half_angle : (n_edges,) float
-        The edges' half angles (:attr:`EdgeRounding.half_angle`).
-    face_centres : callable
-        ``face_centres(mesh, rounding) -> (n_faces, 3)``.
-    flat_deg, floor, min_width : float
-        Passed to :func:`~filletfold.rounding.edges.round_edges`.
-
-    Returns
-    -------
-    radius, rounding, centres
-        As :meth:`VertexState.reround`.
-    """
-    radius = shrink_broken(mesh, radius, half_angle)
-    rounding = round_edges(mesh, radius, flat_deg=flat_deg, floor=floor, min_width=min_width)
-    return radius, rounding, face_centres(mesh, rounding)
+        mesh = self.mesh
+        radius = shrink_broken(mesh, radius, self.rounding.half_angle)
+        rounding = round_edges(
+            mesh, radius, flat_deg=self.flat_deg, floor=self.floor, min_width=self.min_width
+        )
+        return radius, rounding, self.face_centres(mesh, rounding)
