@@ -164,11 +164,9 @@ def pattern_from_fold(doc: dict) -> CreasePattern:
         if len(angle) == len(assign):  # borders are null and facets bent in the file: 0 here
             angle = np.where((assign == "B") | (assign == "F"), 0.0, angle)
         face_piece = np.asarray(doc[NAMESPACE + "faces_piece"], dtype=np.int64).reshape(-1)
-        names = {}  # each distinct name read once: a pattern has many faces per patch
-        patches = [
-            names.setdefault(p, as_patch(p)) if isinstance(p, str) else as_patch(str(p))
-            for p in doc[NAMESPACE + "faces_patch"]
-        ]
+        names = {str(p) for p in doc[NAMESPACE + "faces_patch"]}
+        read = {name: as_patch(name) for name in names}  # each distinct name parsed once
+        patches = [read[str(p)] for p in doc[NAMESPACE + "faces_patch"]]
     except (TypeError, ValueError) as exc:
         raise MeshReadError(f"not a filletfold FOLD file: malformed arrays ({exc})") from None
     if v2.ndim != 2 or v2.shape[1] != 2:
