@@ -297,29 +297,26 @@ def edge_stage(job: Job, st: Stages | None) -> Edges:
     p, pm = job.params, job.mesh
     ref = pm.mean_edge_length
     loss, conical, floor, min_width = None, False, job.floor, job.min_width
-    requested = np.broadcast_to(
-        np.asarray(parse_length(p.radius, ref, "radius", count=pm.n_edges), dtype=float),
-        (pm.n_edges,),
-    ).copy()
+    given = parse_length(p.radius, ref, "radius", count=pm.n_edges)  # a length or (n_edges,)
+    requested = np.broadcast_to(np.asarray(given, dtype=float), (pm.n_edges,)).copy()
     if p.material_loss:
         cap = None if p.max_loss is None else float(parse_length(p.max_loss, ref, "max loss"))
         developable = np.all(
             np.abs(pm.vertex_angle_sum[~pm.is_boundary_vertex] - 2 * np.pi) < tol.developable
         )
         conical = not developable and is_conical(pm)
-        r_cap = parse_length(p.radius, ref, "radius", count=pm.n_edges)
         if conical:
             loss, _ = conical_material_loss(
-                pm, max_loss=cap, max_radius=r_cap, flat_deg=p.coplanar_deg
+                pm, max_loss=cap, max_radius=given, flat_deg=p.coplanar_deg
             )
         else:
-            loss = solve_material_loss(pm, max_loss=cap, max_radius=r_cap, flat_deg=p.coplanar_deg)
+            loss = solve_material_loss(pm, max_loss=cap, max_radius=given, flat_deg=p.coplanar_deg)
         if not loss.ok:
             raise SolverError(loss.message)
         r = loss.edge_radius
         floor = min_width = 0.0  # consistent losses need every edge rounded
     else:
-        r = parse_length(p.radius, ref, "radius", count=pm.n_edges)
+        r = given
         if p.clamp:
             r = clamp_radii(pm, r, flat_deg=p.coplanar_deg)
     rounding = round_edges(pm, r, flat_deg=p.coplanar_deg, floor=floor, min_width=min_width)
@@ -630,8 +627,7 @@ def _input_key(mesh, coplanar_deg, strict) -> tuple | None:
     on, for a :class:`PolyMesh` (its vertices and faces by their bytes); None otherwise."""
     if not isinstance(mesh, PolyMesh):
         return None
-    faces = (mesh.face_start.astype(np.int64), mesh.halfedge_from.astype(np.int64))
-    return (mesh.vertices.tobytes(), *(f.tobytes() for f in faces), repr(coplanar_deg), strict)
+    return (*_mesh_key(mesh), repr(coplanar_deg), strict)
 
 
 def _stage_key(pm: PolyMesh, *params) -> tuple:
@@ -645,9 +641,17 @@ def _stage_key(pm: PolyMesh, *params) -> tuple:
             return (a.shape, a.tobytes())
         return repr(x)
 
-    # the faces: each face's first corner and the corners' vertices, in order
-    faces = (pm.face_start.astype(np.int64).tobytes(), pm.halfedge_from.astype(np.int64).tobytes())
-    return (pm.vertices.tobytes(), faces, *(plain(p) for p in params))
+    return (*_mesh_key(pm), *(plain(p) for p in params))
+
+
+def _mesh_key(pm: PolyMesh) -> tuple:
+    """A mesh's vertices and faces (each face's first corner and the corners' vertices, in
+    order) by their bytes."""
+    return (
+        pm.vertices.tobytes(),
+        pm.face_start.astype(np.int64).tobytes(),
+        pm.halfedge_from.astype(np.int64).tobytes(),
+    )
 
 
 def conical_sides(frames, n_edges: int) -> np.ndarray:
