@@ -187,7 +187,7 @@ class Parameters:
             "material_loss" in changes
             and bool(changes["material_loss"]) != bool(self.material_loss)
             and "sharp" not in changes
-            and self.sharp == _auto_sharp(self.material_loss)
+            and self.sharp == _sharp_text(_auto_kinds(self.material_loss))
         ):
             changes["sharp"] = DEFAULT_SHARP
         return dataclasses.replace(self, **changes)
@@ -292,19 +292,16 @@ class Parameters:
 
     def sharp_kinds(self) -> frozenset:
         """The kinds of cone-less vertices kept sharp (``"auto"`` resolved)."""
-        from .vertex.sharpen import SHARP_KINDS, parse_sharp
+        from .vertex.sharpen import parse_sharp
 
         if self.sharp == "auto":
-            return frozenset(SHARP_KINDS) - ({"boundary"} if self.material_loss else set())
+            return _auto_kinds(self.material_loss)
         return parse_sharp(self.sharp)
 
     def resolved(self) -> Parameters:
         """These parameters with what ``strict`` and ``material_loss`` decide filled in: the
         parameters a design was made with (``design.params``), which give it again."""
-        from .vertex.sharpen import SHARP_KINDS
-
         strict = bool(self.strict)
-        kinds = self.sharp_kinds()
         return dataclasses.replace(
             self,
             samples=int(self.samples),
@@ -313,7 +310,7 @@ class Parameters:
             material_loss=bool(self.material_loss),
             fit_vertices=(not strict) if self.fit_vertices is None else bool(self.fit_vertices),
             strict=strict,
-            sharp=",".join(k for k in SHARP_KINDS if k in kinds) or "none",
+            sharp=_sharp_text(self.sharp_kinds()),
             tabs=bool(self.tabs),
         )
 
@@ -380,11 +377,20 @@ def _json_type(value) -> str:
     return type(value).__name__
 
 
-def _auto_sharp(material_loss: bool) -> str:
-    """The resolved ``sharp`` of ``"auto"``."""
+def _auto_kinds(material_loss: bool) -> frozenset:
+    """The kinds of cone-less vertices ``sharp="auto"`` keeps sharp: all of them, but the
+    boundary vertices with ``material_loss`` (one uncut sheet ends at its border)."""
     from .vertex.sharpen import SHARP_KINDS
 
-    return ",".join(k for k in SHARP_KINDS if not (material_loss and k == "boundary"))
+    return frozenset(SHARP_KINDS) - ({"boundary"} if material_loss else set())
+
+
+def _sharp_text(kinds) -> str:
+    """``sharp`` as the resolved parameters write it: the kinds in :data:`SHARP_KINDS` order,
+    or ``"none"``."""
+    from .vertex.sharpen import SHARP_KINDS
+
+    return ",".join(k for k in SHARP_KINDS if k in kinds) or "none"
 
 
 def resolve_chord_tol(value, reference: float) -> float:
