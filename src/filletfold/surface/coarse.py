@@ -876,7 +876,7 @@ def _best_move(live: _Triangles, t: int, min_angle: float):
             for keep in sorted(ring):
                 if is_feature.get(min(go, keep) * n + max(go, keep), False):
                     tries.append((keep, go, keep, go, True, 0.0))
-    collapses = []  # (quality, move, its triangles), each better than the sliver
+    candidates = []  # (move, its triangles, moved): every collapse the link condition allows
     for keep, go, a, b, edge_feature, length in tries:
         moved = None
         if go == -1:  # both ends on features: the midpoint, for a short side only
@@ -907,16 +907,9 @@ def _best_move(live: _Triangles, t: int, min_angle: float):
         ring_keep = set(tri[keep_faces].ravel().tolist()) - {keep}
         if len(ring_go & ring_keep) != sum(c is None for c in new):
             continue
-        q = _move_quality(k, v2, v3, moved, shift)
-        if q > best_q:
-            collapses.append((q, (faces.tolist(), new, moved, (go, keep)), k))
-    # the best collapse whose sides cross none of the pattern's
-    for q, move, k in sorted(collapses, key=lambda c: -c[0]):
-        go, keep = move[3]
-        if flat is None or not _crosses(flat, k, keep, go, move[2]):
-            best, best_q = move, q
-            break
-    # flip the longest side inside one smooth patch
+        candidates.append(((faces.tolist(), new, moved, (go, keep)), k, moved))
+    # the flip of the longest side inside one smooth patch, when there is one
+    flip = None
     a, b = sides[int(np.argmax(lengths))]
     if not is_feature.get(min(a, b) * n + max(a, b), True):
         c = next(v for v in corners if v not in (a, b))
@@ -932,9 +925,23 @@ def _best_move(live: _Triangles, t: int, min_angle: float):
             i = corners.index(a)
             if corners[(i + 1) % 3] != b:  # keep the orientation of t
                 new = [np.array([c, d, a]), np.array([c, b, d])]
-            q = _move_quality(np.array(new), v2, v3, None, shift)
-            if q > best_q:
-                best, best_q = ([t, o], new, None, None), q
+            flip = ([t, o], new, None, None)
+            candidates.append((flip, np.array(new), None))
+    # every candidate's quality in one call (each triangle's is its own: the same numbers)
+    qualities = _move_qualities([(k, moved) for _, k, moved in candidates], v2, v3, shift)
+    if flip is not None:
+        candidates, flip_q = candidates[:-1], qualities.pop()
+    collapses = [  # (quality, move, its triangles), each better than the sliver
+        (q, move, k) for q, (move, k, _) in zip(qualities, candidates, strict=True) if q > best_q
+    ]
+    # the best collapse whose sides cross none of the pattern's
+    for q, move, k in sorted(collapses, key=lambda c: -c[0]):
+        go, keep = move[3]
+        if flat is None or not _crosses(flat, k, keep, go, move[2]):
+            best, best_q = move, q
+            break
+    if flip is not None and flip_q > best_q:
+        best, best_q = flip, flip_q
     return best
 
 
@@ -965,6 +972,25 @@ def _move_quality(
     if shift is None:
         return float(_triangle_quality(p2, p3, math.inf).min())
     return float(_triangle_quality(p2, p3, SIM_MAX_STRETCH, shift[k[:, 0]]).min())
+
+
+def _move_qualities(moves: list, v2: np.ndarray, v3: np.ndarray, shift: np.ndarray) -> list:
+    """:func:`_move_quality` of many moves at once: ``moves`` a list of (triangles (j, 3),
+    moved); their triangles in one call of :func:`_triangle_quality` (each triangle's
+    quality is computed alone, so the numbers are those of one call per move)."""
+    if not moves:
+        return []
+    k = np.concatenate([m[0] for m in moves])
+    p2, p3 = v2[k], v3[k]
+    count = np.array([len(m[0]) for m in moves])
+    start = np.concatenate([[0], np.cumsum(count)[:-1]])
+    for (tris, moved), lo, m in zip(moves, start.tolist(), count.tolist(), strict=True):
+        if moved is not None:
+            at = (tris == moved[0])[:, :, None]
+            p2[lo : lo + m] = np.where(at, moved[1], p2[lo : lo + m])
+            p3[lo : lo + m] = np.where(at, moved[2], p3[lo : lo + m])
+    quality = _triangle_quality(p2, p3, SIM_MAX_STRETCH, shift[k[:, 0]])
+    return np.minimum.reduceat(quality, start).tolist()
 
 
 def simulator_pattern(
