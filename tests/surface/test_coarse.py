@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.spatial import cKDTree
 
@@ -430,3 +432,89 @@ def test_crossing_groups_names_the_merged_group_whose_chord_crosses():
     assert _crossing_groups(v2, [(0, [[0, 1, 2]], np.array([], dtype=np.int64)), crossing]) == []
     apart = (1, [[1, 4, 5]], np.array([], dtype=np.int64))  # shares point 1 only
     assert _crossing_groups(v2, [merged, apart]) == []
+
+
+def _triangulate_chord_by_chord(loop, p):
+    """The dynamic programme of :func:`~filletfold.surface.coarse._triangulate` one chord at a
+    time, as it was written before the chords of a length were taken together: the
+    reference its results must equal."""
+    import math
+
+    from filletfold.surface.coarse import _diagonals
+
+    k = len(loop)
+    if k == 3:
+        return [list(loop)]
+    q = p[np.asarray(loop)]
+    ok = _diagonals(q)
+    best = np.full((k, k), -math.inf)
+    split = -np.ones((k, k), dtype=np.int64)
+    for i in range(k - 1):
+        best[i, i + 1] = math.inf
+    for gap in range(2, k):
+        for i in range(k - gap):
+            j = i + gap
+            if not ok[i, j]:
+                continue
+            m = np.arange(i + 1, j)
+            m = m[ok[i, m] & ok[m, j]]
+            if not len(m):
+                continue
+            angle = triangle_min_angles(q, np.c_[np.full(len(m), i), m, np.full(len(m), j)])
+            value = np.minimum(np.minimum(best[i, m], best[m, j]), angle)
+            at = int(np.argmax(value))
+            if value[at] > -math.inf:
+                best[i, j], split[i, j] = value[at], m[at]
+    if split[0, k - 1] < 0:
+        return None
+    tris, stack = [], [(0, k - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j - i < 2:
+            continue
+        m = int(split[i, j])
+        tris.append([loop[i], loop[m], loop[j]])
+        stack += [(i, m), (m, j)]
+    return tris
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    k=st.integers(3, 16),
+    seed=st.integers(0, 2**32 - 1),
+    grid=st.sampled_from([0, 1, 2]),  # rounded corners: collinear corners and equal angles
+)
+def test_triangulate_takes_the_chords_of_a_length_together_with_the_same_result(k, seed, grid):
+    from filletfold.surface.coarse import _triangulate
+
+    rng = np.random.default_rng(seed)
+    angle = np.sort(rng.uniform(0, 2 * np.pi, k))
+    radius = rng.uniform(0.2, 1.0, k)
+    p = np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=1)
+    if grid:
+        p = np.round(p, grid)
+    loop = [int(x) for x in rng.permutation(3 * k)[:k]]
+    points = np.zeros((3 * k, 2))
+    points[loop] = p
+    assert _triangulate(loop, points) == _triangulate_chord_by_chord(loop, points)
+
+
+@settings(max_examples=100, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n_moves=st.integers(1, 8))
+def test_move_qualities_are_each_moves_own_quality(seed, n_moves):
+    """The candidate moves of a sliver rated in one call give each move's own number."""
+    from filletfold.surface.coarse import _move_qualities, _move_quality
+
+    rng = np.random.default_rng(seed)
+    v2 = rng.normal(size=(12, 2))
+    v3 = np.c_[v2, rng.normal(scale=0.05, size=12)]
+    shift = rng.uniform(0.01, 1.0, 12)
+    moves = []
+    for _ in range(n_moves):
+        k = np.array([rng.permutation(12)[:3] for _ in range(int(rng.integers(1, 5)))])
+        moved = None
+        if rng.random() < 0.5:
+            moved = (int(k[0, 0]), rng.normal(size=2), rng.normal(size=3))
+        moves.append((k, moved))
+    one_by_one = [_move_quality(k, v2, v3, moved, shift) for k, moved in moves]
+    np.testing.assert_array_equal(_move_qualities(moves, v2, v3, shift), one_by_one)

@@ -127,20 +127,19 @@ def _triangulate(loop: list[int], p: np.ndarray) -> list[list[int]] | None:
     split = -np.ones((k, k), dtype=np.int64)
     for i in range(k - 1):
         best[i, i + 1] = math.inf
-    for gap in range(2, k):
-        for i in range(k - gap):
-            j = i + gap
-            if not ok[i, j]:
-                continue
-            m = np.arange(i + 1, j)
-            m = m[ok[i, m] & ok[m, j]]
-            if not len(m):
-                continue
-            angle = triangle_min_angles(q, np.c_[np.full(len(m), i), m, np.full(len(m), j)])
-            value = np.minimum(np.minimum(best[i, m], best[m, j]), angle)
-            at = int(np.argmax(value))
-            if value[at] > -math.inf:
-                best[i, j], split[i, j] = value[at], m[at]
+    for gap in range(2, k):  # the chords (i, i + gap) all at once, each from shorter ones
+        i = np.arange(k - gap)[:, None]  # (c, 1)
+        j = i + gap
+        m = i + np.arange(1, gap)[None, :]  # (c, gap - 1): the corners between
+        use = ok[i, j] & ok[i, m] & ok[m, j]
+        corners = np.stack(np.broadcast_arrays(i, m, j), axis=-1).reshape(-1, 3)
+        angle = triangle_min_angles(q, corners).reshape(m.shape)  # each triangle alone
+        value = np.where(use, np.minimum(np.minimum(best[i, m], best[m, j]), angle), -math.inf)
+        at = np.argmax(value, axis=1)  # the first best: the split at the earliest corner
+        top = value[np.arange(len(at)), at]
+        found = top > -math.inf
+        best[i[found, 0], j[found, 0]] = top[found]
+        split[i[found, 0], j[found, 0]] = m[found, at[found]]
     if split[0, k - 1] < 0:  # no triangulation (the outline is not simple)
         return None
     tris, stack = [], [(0, k - 1)]
