@@ -41,7 +41,7 @@ from .rounding.material_loss import MaterialLoss
 from .surface.pattern import CreasePattern
 from .tolerances import tol
 from .vertex.rescue import Rescue
-from .vertex.solve import STATUSES, VertexResult
+from .vertex.solve import STATUSES, VertexResult, cones_by_fallback
 
 
 @dataclass
@@ -84,7 +84,10 @@ class Design:
         ``tol.fillet_floor`` of the edge); ``rescued`` (dict vertex -> factor), the vertices
         whose edges' radii were scaled by ``factor`` to make their cone feasible (applied when
         ``rescue_applied``, else only reported in their reason); ``sharpened``, the vertices
-        no radius rescued whose edges were left sharp instead (sharp vertices).
+        no radius rescued whose edges were left sharp instead (sharp vertices);
+        ``cones_by_lp`` and ``cones_by_fallback`` (dict fallback -> int), the cones whose
+        feasible point a fallback of the apex solver found
+        (:data:`~filletfold.vertex.settings.FALLBACKS`).
     """
 
     mesh: PolyMesh
@@ -283,11 +286,13 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
 def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res) -> dict:
     """What :attr:`Design.fitting` holds: the radii asked for, the edges reduced to fit their
     limits, the edges left sharp, the vertices rescued (:mod:`filletfold.vertex.rescue`), the
-    cones whose apex needed the solver's linear programmes."""
+    cones whose apex needed the solver's linear programmes, and those each fallback of the
+    solver found (:func:`~filletfold.vertex.solve.cones_by_fallback`)."""
     bent = rounding.half_angle > 0  # rounded or left sharp (not boundary, not flat)
     asked = np.where(bent, requested, 0.0)
     sharp = rounding.sharp if rounding.sharp is not None else np.zeros(len(bent), dtype=bool)
     reduced = np.flatnonzero(bent & ~sharp & (fitted < asked * (1 - tol.roundoff)))
+    by_fallback = cones_by_fallback(res)
     return {
         "radius_requested": asked,
         "fitted_radius": fitted,
@@ -296,7 +301,6 @@ def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res) -> 
         "rescued": dict(sorted(rescue.rescued.items())),
         "rescue_applied": rescue.applied,
         "sharpened": sorted(rescue.sharpened),
-        "cones_by_lp": sum(
-            1 for st, s in zip(res.status, res.solver, strict=True) if st == "ok" and "lp" in s
-        ),
+        "cones_by_lp": by_fallback["lp"],
+        "cones_by_fallback": by_fallback,
     }

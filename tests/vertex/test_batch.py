@@ -232,3 +232,43 @@ def test_a_problem_the_linear_programmes_solve_is_labelled(mesh, monkeypatch):
     ]
     without = solve_apex_batch(cons, targets, starts, thorough=True, lp=False)
     assert not any(s.ok for s in without)
+
+
+@pytest.mark.parametrize("fallback", ["starts", "again", "long"])
+def test_a_problem_a_phase1_fallback_solves_is_labelled_and_off_when_left_out(
+    fallback, monkeypatch
+):
+    """Phase 1 made to succeed only in the chosen fallback's run (the other starts, the quick
+    restart from the best point, the long run without the give-up rule; the first run, from
+    the best start, returns its start): the solution names that fallback
+    (``<fallback>+ipm``, what ``fitting.cones_by_fallback`` counts), and with the fallback left
+    out of ``settings.FALLBACKS`` the problem is not solved."""
+    from filletfold.vertex import settings as solver_settings
+
+    real = batch._phase1
+    monkeypatch.setattr(batch, "_phase1", lambda rows, y0, *a, **k: y0)
+    problems = [  # those no start solves without phase 1
+        (c, t, s)
+        for c, t, s in first_attempts("blob", 0.1, 0.3)
+        if len(s) and not solve_apex_batch([c], [t], [s], lp=False)[0].ok
+    ][:2]
+    assert problems, "no problem that needs phase 1"
+    calls = []
+
+    def phase1_only_in_the_fallback(rows, y0, groups, max_iter, give_up=True):
+        calls.append(give_up)
+        chosen = not give_up if fallback == "long" else give_up and len(calls) == 2
+        return real(rows, y0, groups, max_iter, give_up) if chosen else y0
+
+    monkeypatch.setattr(batch, "_phase1", phase1_only_in_the_fallback)
+    cons, targets, starts = zip(*problems, strict=True)
+    thorough = fallback != "again"  # the quick restart is for quick solves only
+    solved = solve_apex_batch(cons, targets, starts, thorough=thorough, lp=False)
+    assert all(s.ok and s.solver.startswith(f"{fallback}+ipm") for s in solved), [
+        (s.ok, s.solver) for s in solved
+    ]
+    calls.clear()
+    others = tuple(f for f in solver_settings.FALLBACKS if f != fallback)
+    monkeypatch.setattr(solver_settings, "FALLBACKS", others)
+    unsolved = solve_apex_batch(cons, targets, starts, thorough=thorough, lp=False)
+    assert not any(s.ok for s in unsolved)

@@ -225,6 +225,7 @@ def _fitting_report(design) -> dict:
         "rescued": [{"vertex": int(u), "factor": float(f)} for u, f in fit["rescued"].items()],
         "sharpened": sharpened,
         "cones_by_lp": int(fit.get("cones_by_lp", 0)),
+        "cones_by_fallback": {k: int(v) for k, v in fit.get("cones_by_fallback", {}).items()},
     }
 
 

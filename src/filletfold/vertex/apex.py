@@ -434,8 +434,10 @@ class ApexSolution:
         True when the target itself was feasible.
     solver : str
         What found it: ``"target"``, ``"ipm"`` (the batched interior-point method),
-        ``"lp+ipm"`` (its feasibility phase needed the linear programmes), either with
-        ``"+slsqp"`` (finished by SLSQP), ``"slsqp"`` (the reference solver).
+        ``"<fallback>+ipm"`` (a fallback of its feasibility phase found the feasible point:
+        ``starts``, ``again``, ``lp`` (the linear programmes) or ``long``, see
+        :data:`~filletfold.vertex.settings.FALLBACKS`), either with ``"+slsqp"`` (finished
+        by SLSQP), ``"slsqp"`` (the reference solver).
     """
 
     ok: bool

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FilletfoldError
+from . import settings
 from .apex import ApexConstraints, ApexSolution
 from .reference import project_slsqp
 from .rows import RowBlock, matvec, pack, pack_problems, row_values
@@ -492,7 +493,10 @@ def solve_apex_batch(
         on two public meshes of 2,903 and 6,475 vertices, at a third of the apex stage's
         time.) Without it only the
         :data:`PARALLEL_STARTS` best starts are tried and a problem is given up once it looks
-        infeasible: for attempts that have a more permissive one after them.
+        infeasible (after one more run from its best point): for attempts that have a more
+        permissive one after them. Only the fallbacks named in
+        :data:`~filletfold.vertex.settings.FALLBACKS` are tried; each solution's ``solver``
+        names the one that found its feasible point.
     lp : bool
         Whether a thorough solve tries the linear programmes (:func:`phase1_lp`). On a
         2,904-vertex scan they made 3 of 590 problems of the first solve feasible in 2.0 s
@@ -591,17 +595,23 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
     best = cand[ar, order[:, 0]]
     best_g = gmin[ar, order[:, 0]]
     need = ~at_target
+    fallbacks = settings.FALLBACKS
+    found = np.full(B, "", dtype=object)  # the step that made each problem feasible
 
-    def keep_best(idx: np.ndarray, y: np.ndarray) -> None:
+    def keep_best(idx: np.ndarray, y: np.ndarray, step: str) -> None:
         """Take the phase-1 points ``y`` of problems ``idx`` (repeats allowed) that beat
-        their problem's best point."""
+        their problem's best point; note ``step`` for those it makes feasible."""
         g_y = rows.take(idx).min_slack(y)
         for k in np.argsort(g_y):  # ascending: the best point per problem wins
             if g_y[k] > best_g[idx[k]]:
                 best[idx[k]], best_g[idx[k]] = y[k], g_y[k]
+        made = idx[(g_y > 0) & (found[idx] == "")]
+        found[made] = step
 
     # phase 1 from the PARALLEL_STARTS best starts first, then from the others
     for lo, hi in ((0, PARALLEL_STARTS), (PARALLEL_STARTS, n_s)):
+        if lo and "starts" not in fallbacks:
+            break
         feasible = need & (best_g > 0)
         todo_b, todo_j = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]
         for j in range(lo, min(hi, n_s)):
@@ -611,23 +621,24 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         todo_b, todo_j = np.concatenate(todo_b), np.concatenate(todo_j)
         if len(todo_b) == 0:
             continue
-        keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter))
+        step = "starts" if lo else "ipm"
+        keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter), step)
     # a quick solve gives up early: once more from the best point (fresh multipliers)
     again = np.nonzero(need & (best_g <= 0) & ~thorough)[0]
-    if len(again):
-        keep_best(again, _phase1(rows.take(again), best[again], again, max_iter))
+    if len(again) and "again" in fallbacks:
+        keep_best(again, _phase1(rows.take(again), best[again], again, max_iter), "again")
     # the interior-point phase 1 can stall short of a thin window: linear programmes next
     stalled = np.nonzero(need & (best_g <= 0) & thorough)[0]
-    by_lp = np.zeros(B, dtype=bool)  # made feasible by the linear programmes
-    if len(stalled) and lp:
+    if len(stalled) and lp and "lp" in fallbacks:
         y_lp, t_lp = phase1_lp(rows.take(stalled), best[stalled])
         up = t_lp > best_g[stalled]
         best[stalled[up]], best_g[stalled[up]] = y_lp[up], t_lp[up]
-        by_lp[stalled[up & (t_lp > 0)]] = True
+        found[stalled[up & (t_lp > 0)]] = "lp"
     # the give-up rule is only a hint here: the rest continue from their best point, longer
     rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
-    if len(rest):
-        keep_best(rest, _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False))
+    if len(rest) and "long" in fallbacks:
+        y_long = _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False)
+        keep_best(rest, y_long, "long")
     feasible = need & (best_g > 0)
     solve = np.nonzero(feasible)[0]
     y = np.zeros((B, n))
@@ -643,7 +654,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         if at_target[b]:
             result.append(ApexSolution(True, T[b].copy(), [], True, "target"))
         elif feasible[b]:
-            x, how = X[b], "lp+ipm" if by_lp[b] else "ipm"
+            x, how = X[b], "ipm" if found[b] in ("", "ipm") else f"{found[b]}+ipm"
             if not converged[b] and not kkt_point(p, T[b], x):
                 # rare: finish with SLSQP from the feasible point
                 x_s = project_slsqp(p, T[b], x)

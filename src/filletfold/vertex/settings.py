@@ -33,6 +33,15 @@ LP_ROUNDS = 12
 LP_STALL = 1e-10
 #: Starts tried at once in phase 1 before the remaining ones.
 PARALLEL_STARTS = 1
+#: The fallbacks of a problem whose phase 1 from its best start ends short of feasibility
+#: (:func:`~filletfold.vertex.batch.solve_apex_batch`), in the order they are tried:
+#: ``"starts"`` phase 1 from each other start (thorough), ``"again"`` once more from the best
+#: point with fresh multipliers (quick), ``"lp"`` sequential linear programmes (thorough, with
+#: ``lp``), ``"long"`` phase 1 three times as long without the give-up rule (thorough). Each
+#: cone's ``solver`` names the one that found its feasible point, and the report counts them
+#: (``fitting.cones_by_fallback``); ``benchmarks/fallbacks.py`` measures what each one pays
+#: for, on the corpus.
+FALLBACKS = ("starts", "again", "lp", "long")
 #: The start of a closed development's developed apex is where two consecutive central rulings
 #: cross (sec. 3.2), taken from the first pair whose directions are further than this from
 #: parallel (``|det|``, unit directions): nearer pairs cross too far away to start from.

@@ -27,7 +27,7 @@ from .batch import solve_apex_batch
 from .frame import VertexFrame, closed_ring_sides, developed_apices, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
-from .settings import START_PARALLEL
+from .settings import FALLBACKS, START_PARALLEL
 
 STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable", "sharp")
 
@@ -68,8 +68,10 @@ class VertexResult:
         vertex); ``""`` until the apex stage has run.
     solver : list of str
         What found each cone's apex (:attr:`~filletfold.vertex.apex.ApexSolution.solver`:
-        ``"target"``, ``"ipm"``, ``"lp+ipm"`` when the feasibility phase needed the linear
-        programmes, with ``"+slsqp"`` when SLSQP finished it); ``""`` without a cone.
+        ``"target"``, ``"ipm"``, or ``"<fallback>+ipm"`` when a fallback of the feasibility
+        phase found its feasible point (``starts``, ``again``, ``lp``, ``long``: see
+        :data:`~filletfold.vertex.settings.FALLBACKS`), with ``"+slsqp"`` when SLSQP finished
+        it); ``""`` without a cone.
     """
 
     kind: list
@@ -127,6 +129,18 @@ class VertexResult:
             apex_2d=np.full((n, 2), np.nan),
             margin=nan.copy(),
         )
+
+
+def cones_by_fallback(res: VertexResult) -> dict:
+    """The cones (status ``ok``) whose feasible point a fallback of the solver found, per
+    fallback of :data:`~filletfold.vertex.settings.FALLBACKS` (0 for those that found none):
+    what each one paid for in this design."""
+    out = dict.fromkeys(FALLBACKS, 0)
+    for status, solver in zip(res.status, res.solver, strict=True):
+        name = solver.split("+", 1)[0]
+        if status == "ok" and name in out:
+            out[name] += 1
+    return out
 
 
 def classify_vertices(

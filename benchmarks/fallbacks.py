@@ -1,0 +1,164 @@
+"""What each fallback of the apex solver pays for, on real meshes (issue 27: "no fallback that
+does not pay for itself").
+
+Run from the repository root:
+
+    .venv/bin/python benchmarks/fallbacks.py [--max-faces F] [--match TEXT ...] [--json FILE]
+                                             [cases ...]
+
+When the interior-point feasibility phase from a vertex's best start ends short of a feasible
+point, :func:`filletfold.vertex.batch.solve_apex_batch` tries the fallbacks of
+:data:`filletfold.vertex.settings.FALLBACKS` in turn (``starts``, ``again``, ``lp``,
+``long``). Per mesh this runs the default design (``round_mesh`` with the defaults, in this
+process, one thread of work after another) with all of them, then once without each, and
+prints one row per run: the cones (vertices with status ``ok``), the vertices rescued by
+smaller radii, those left sharp and infeasible, the apex problems solved
+(``solve_apex_batch``'s problems) and the phase-1 problems (the interior-point feasibility
+runs, every start counted), the apex stage's seconds, the certificate, and with all
+fallbacks the cones each one found (``fitting.cones_by_fallback``). Then a summary per
+fallback over all meshes: the cones it found, the cones lost and the vertices rescued more
+(radii halved) without it, and the phase-1 problems and apex seconds it cost.
+
+Cases: meshes of the public corpus (``benchmarks/corpus_manifest.json``, fetched into
+``out/corpus-meshes`` by ``benchmarks/fetch_corpus.py``), as ``collection/name`` or by file
+stem, or mesh files; default: every mesh of the corpus's default tier of at most
+``--max-faces`` faces (default 3000) whose name has one of the ``--match`` texts.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from examples import machine  # noqa: E402
+from real_meshes import corpus_files  # noqa: E402
+
+import filletfold  # noqa: E402
+import filletfold.vertex.batch as batch  # noqa: E402
+import filletfold.vertex.settings as settings  # noqa: E402
+import filletfold.vertex.solve as solve  # noqa: E402
+
+ALL = tuple(settings.FALLBACKS)
+
+
+def default_cases(max_faces: int, match: list[str]) -> list[Path]:
+    """The corpus meshes of the default tier with at most ``max_faces`` faces."""
+    manifest = json.loads((HERE / "corpus_manifest.json").read_text())
+    files = corpus_files()
+    out = []
+    for item in manifest["meshes"]:
+        if item.get("tier", "default") != "default" or item.get("faces", 0) > max_faces:
+            continue
+        path = files.get(f"{item['collection']}/{item['name']}")
+        if path is None or (match and not any(m in str(path) for m in match)):
+            continue
+        out.append(path)
+    return out
+
+
+def run(path: Path, fallbacks: tuple) -> dict:
+    """One default design of ``path`` with only ``fallbacks`` on: counts and seconds."""
+    seen = collections.Counter()
+    solve_batch, phase1 = solve.solve_apex_batch, batch._phase1
+
+    def counting_solve(problems, *args, **kwargs):
+        seen["problems"] += len(problems)
+        return solve_batch(problems, *args, **kwargs)
+
+    def counting_phase1(rows, y0, *args, **kwargs):
+        seen["phase1"] += len(y0)
+        return phase1(rows, y0, *args, **kwargs)
+
+    settings.FALLBACKS = fallbacks
+    solve.solve_apex_batch, batch._phase1 = counting_solve, counting_phase1
+    try:
+        design = filletfold.round_mesh(str(path))
+    finally:
+        settings.FALLBACKS = ALL
+        solve.solve_apex_batch, batch._phase1 = solve_batch, phase1
+    counts = design.status_counts()
+    return {
+        "cones": counts["ok"],
+        "rescued": len(design.fitting["rescued"]),
+        "sharp": counts["sharp"],
+        "infeasible": counts["infeasible"],
+        "problems": seen["problems"],
+        "phase1": seen["phase1"],
+        "apices_s": design.timings.get("apices", float("nan")),
+        "valid": bool(design.certificate is not None and design.certificate.ok),
+        "by_fallback": dict(design.fitting.get("cones_by_fallback", {})),
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("cases", nargs="*")
+    ap.add_argument("--max-faces", type=int, default=3000)
+    ap.add_argument("--match", nargs="*", default=[])
+    ap.add_argument("--json", help="write the rows here too")
+    args = ap.parse_args(argv)
+    files = corpus_files()
+    paths = [files.get(c, Path(c)) for c in args.cases] or default_cases(args.max_faces, args.match)
+    batch.warm_kernel()  # its loading is not any fallback's cost
+    print(f"# {' '.join(['benchmarks/fallbacks.py', *(argv or sys.argv[1:])])}")
+    print(f"# {machine()}")
+    print("| mesh | without | cones | rescued | sharp | infeasible | problems | phase 1 "
+          "| apices s | valid | cones found by |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
+    total = collections.defaultdict(collections.Counter)
+    for path in paths:
+        name = f"{path.parent.name}/{path.name}"
+        base = None
+        for off in ("", *ALL):
+            t0 = time.perf_counter()
+            try:
+                r = run(path, tuple(f for f in ALL if f != off))
+            except Exception as exc:  # a refused mesh: say so, go on
+                print(f"| {name} | {off or '-'} | {type(exc).__name__}: {exc} |")
+                break
+            r.update(mesh=name, without=off or None, wall_s=time.perf_counter() - t0)
+            rows.append(r)
+            found = (
+                ", ".join(f"{k} {v}" for k, v in r["by_fallback"].items() if v) if not off else ""
+            )
+            print(
+                f"| {name} | {off or '-'} | {r['cones']} | {r['rescued']} | {r['sharp']} "
+                f"| {r['infeasible']} | {r['problems']} | {r['phase1']} | {r['apices_s']:.2f} "
+                f"| {'yes' if r['valid'] else 'NO'} | {found} |",
+                flush=True,
+            )
+            if not off:
+                base = r
+                for k, v in r["by_fallback"].items():
+                    total[k]["found"] += v
+                continue
+            t = total[off]
+            t["cones lost"] += base["cones"] - r["cones"]
+            t["rescued more"] += r["rescued"] - base["rescued"]
+            t["phase1 saved"] += base["phase1"] - r["phase1"]
+            t["apex ms saved"] += round(1000 * (base["apices_s"] - r["apices_s"]))
+            t["invalid"] += not r["valid"]
+    print()
+    print("| fallback | cones found | cones lost without | rescued more without "
+          "| phase-1 problems it costs | apex s it costs | invalid without |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    for f in ALL:
+        t = total[f]
+        cost = t["apex ms saved"] / 1000
+        print(f"| {f} | {t['found']} | {t['cones lost']} | {t['rescued more']} "
+              f"| {t['phase1 saved']} | {cost:.1f} | {t['invalid']} |")  # fmt: skip
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
