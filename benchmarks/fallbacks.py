@@ -54,7 +54,7 @@ def default_cases(max_faces: int, match: list[str]) -> list[Path]:
     files = corpus_files()
     out = []
     for item in manifest["meshes"]:
-        if item.get("tier", "default") != "default" or item.get("faces", 0) > max_faces:
+        if item.get("tier", "default") != "default" or (item.get("faces") or 0) > max_faces:
             continue
         path = files.get(f"{item['collection']}/{item['name']}")
         if path is None or (match and not any(m in str(path) for m in match)):
