@@ -8,16 +8,19 @@ Run from the repository root:
 
 When the interior-point feasibility phase from a vertex's best start ends short of a feasible
 point, :func:`filletfold.vertex.batch.solve_apex_batch` tries the fallbacks of
-:data:`filletfold.vertex.settings.FALLBACKS` in turn (``starts``, ``again``, ``lp``,
-``long``). Per mesh this runs the default design (``round_mesh`` with the defaults, in this
-process, one thread of work after another) with all of them, then once without each, and
-prints one row per run: the cones (vertices with status ``ok``), the vertices rescued by
-smaller radii, those left sharp and infeasible, the apex problems solved
+:data:`filletfold.vertex.settings.FALLBACKS` in turn (of ``starts``, ``again``, ``lp``,
+``long``: :data:`~filletfold.vertex.settings.KNOWN_FALLBACKS`). Per mesh this runs the default
+design (``round_mesh`` with the defaults, in this process) with the default fallbacks, then
+once with each known fallback toggled (``-lp``: the default ones less ``lp``; ``+starts``:
+plus ``starts``, in its place in the order), and prints one row per run: the cones
+(vertices with status ``ok``), the vertices rescued by smaller radii, those left sharp and
+infeasible, the apex problems solved
 (``solve_apex_batch``'s problems) and the phase-1 problems (the interior-point feasibility
-runs, every start counted), the apex stage's seconds, the certificate, and with all
+runs, every start counted), the apex stage's seconds, the certificate, and with the default
 fallbacks the cones each one found (``fitting.cones_by_fallback``). Then a summary per
-fallback over all meshes: the cones it found, the cones lost and the vertices rescued more
-(radii halved) without it, and the phase-1 problems and apex seconds it cost.
+fallback over all meshes: the cones it found (as a default one), and what it pays for: the
+cones more and the vertices rescued fewer (radii halved) with it than without, and the
+phase-1 problems and apex seconds it costs.
 
 Cases: meshes of the public corpus (``benchmarks/corpus_manifest.json``, fetched into
 ``out/corpus-meshes`` by ``benchmarks/fetch_corpus.py``), as ``collection/name`` or by file
@@ -45,7 +48,14 @@ import filletfold.vertex.batch as batch  # noqa: E402
 import filletfold.vertex.settings as settings  # noqa: E402
 import filletfold.vertex.solve as solve  # noqa: E402
 
-ALL = tuple(settings.FALLBACKS)
+DEFAULT = tuple(settings.FALLBACKS)
+KNOWN = tuple(settings.KNOWN_FALLBACKS)
+
+
+def toggled(name: str) -> tuple:
+    """The default fallbacks with ``name`` turned off (a default one) or on (another one)."""
+    on = set(DEFAULT) ^ {name}
+    return tuple(f for f in KNOWN if f in on)
 
 
 def default_cases(max_faces: int, match: list[str]) -> list[Path]:
@@ -81,7 +91,7 @@ def run(path: Path, fallbacks: tuple) -> dict:
     try:
         design = filletfold.round_mesh(str(path))
     finally:
-        settings.FALLBACKS = ALL
+        settings.FALLBACKS = DEFAULT
         solve.solve_apex_batch, batch._phase1 = solve_batch, phase1
     counts = design.status_counts()
     return {
@@ -109,52 +119,52 @@ def main(argv=None) -> int:
     batch.warm_kernel()  # its loading is not any fallback's cost
     print(f"# {' '.join(['benchmarks/fallbacks.py', *(argv or sys.argv[1:])])}")
     print(f"# {machine()}")
-    print("| mesh | without | cones | rescued | sharp | infeasible | problems | phase 1 "
+    print("| mesh | fallbacks | cones | rescued | sharp | infeasible | problems | phase 1 "
           "| apices s | valid | cones found by |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     total = collections.defaultdict(collections.Counter)
     for path in paths:
-        name = f"{path.parent.name}/{path.name}"
+        mesh = f"{path.parent.name}/{path.name}"
         base = None
-        for off in ("", *ALL):
+        for name in ("", *KNOWN):
+            label = "default" if not name else ("-" if name in DEFAULT else "+") + name
             t0 = time.perf_counter()
             try:
-                r = run(path, tuple(f for f in ALL if f != off))
+                r = run(path, toggled(name) if name else DEFAULT)
             except Exception as exc:  # a refused mesh: say so, go on
-                print(f"| {name} | {off or '-'} | {type(exc).__name__}: {exc} |")
+                print(f"| {mesh} | {label} | {type(exc).__name__}: {exc} |")
                 break
-            r.update(mesh=name, without=off or None, wall_s=time.perf_counter() - t0)
+            r.update(mesh=mesh, fallbacks=label, wall_s=time.perf_counter() - t0)
             rows.append(r)
-            found = (
-                ", ".join(f"{k} {v}" for k, v in r["by_fallback"].items() if v) if not off else ""
-            )
+            found = ", ".join(f"{k} {v}" for k, v in r["by_fallback"].items() if v)
             print(
-                f"| {name} | {off or '-'} | {r['cones']} | {r['rescued']} | {r['sharp']} "
+                f"| {mesh} | {label} | {r['cones']} | {r['rescued']} | {r['sharp']} "
                 f"| {r['infeasible']} | {r['problems']} | {r['phase1']} | {r['apices_s']:.2f} "
-                f"| {'yes' if r['valid'] else 'NO'} | {found} |",
+                f"| {'yes' if r['valid'] else 'NO'} | {found if not name else ''} |",
                 flush=True,
             )
-            if not off:
+            if not name:
                 base = r
                 for k, v in r["by_fallback"].items():
                     total[k]["found"] += v
                 continue
-            t = total[off]
-            t["cones lost"] += base["cones"] - r["cones"]
-            t["rescued more"] += r["rescued"] - base["rescued"]
-            t["phase1 saved"] += base["phase1"] - r["phase1"]
-            t["apex ms saved"] += round(1000 * (base["apices_s"] - r["apices_s"]))
+            with_it, without = (base, r) if name in DEFAULT else (r, base)
+            t = total[name]
+            t["cones more"] += with_it["cones"] - without["cones"]
+            t["rescued fewer"] += without["rescued"] - with_it["rescued"]
+            t["phase1 cost"] += with_it["phase1"] - without["phase1"]
+            t["apex ms cost"] += round(1000 * (with_it["apices_s"] - without["apices_s"]))
             t["invalid"] += not r["valid"]
     print()
-    print("| fallback | cones found | cones lost without | rescued more without "
-          "| phase-1 problems it costs | apex s it costs | invalid without |")  # fmt: skip
-    print("|---|---|---|---|---|---|---|")
-    for f in ALL:
+    print("| fallback | default | cones found | cones more with it | rescued fewer with it "
+          "| phase-1 problems it costs | apex s it costs | invalid when toggled |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    for f in KNOWN:
         t = total[f]
-        cost = t["apex ms saved"] / 1000
-        print(f"| {f} | {t['found']} | {t['cones lost']} | {t['rescued more']} "
-              f"| {t['phase1 saved']} | {cost:.1f} | {t['invalid']} |")  # fmt: skip
+        cost = t["apex ms cost"] / 1000
+        head = f"| {f} | {'yes' if f in DEFAULT else 'no'} | {t['found']} | {t['cones more']} "
+        print(f"{head}| {t['rescued fewer']} | {t['phase1 cost']} | {cost:.1f} | {t['invalid']} |")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
     return 0

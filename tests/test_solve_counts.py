@@ -1,9 +1,11 @@
 """How much work the apex stage does, in counts rather than seconds (issue 27).
 
-Seconds depend on the machine; the number of apex problems solved per vertex and of linear
-programmes run does not. These bounds are today's counts on real meshes of the corpus plus a
-tenth: a change that makes the pipeline solve vertices again, or go back to one programme per
-problem, fails here before anyone times it.
+Seconds depend on the machine; the number of apex problems solved per vertex, of linear
+programmes run and of interior-point feasibility (phase-1) runs does not. These bounds are
+today's counts on real meshes of the corpus plus a tenth: a change that makes the pipeline
+solve vertices again, go back to one programme per problem, or add feasibility runs (a
+fallback that does not pay for itself: ``benchmarks/fallbacks.py``), fails here before anyone
+times it.
 """
 
 from __future__ import annotations
@@ -19,15 +21,16 @@ import filletfold.vertex.solve as solve
 
 CORPUS = Path(__file__).parent / "data" / "corpus"
 
-#: mesh -> (apex problems, linear programmes) measured when the bounds were set (2026-12-04:
-#: saddles sharp before the apices, one block LP per round, rescue factors probed;
-#: 2026-12-05: no LP in the first solve when a rescue follows, fox 7 -> 5, bunny 9 -> 7;
+#: mesh -> (apex problems, linear programmes, phase-1 problems) measured when the bounds were
+#: set (2026-12-04: saddles sharp before the apices, one block LP per round, rescue factors
+#: probed; 2026-12-05: no LP in the first solve when a rescue follows, fox 7 -> 5, bunny 9 -> 7;
 #: 2026-12-06: a vertex solved again starts with the samples its solves added, fox 1054 ->
-#: 957 problems and 5 -> 4 programmes, bunny 1092 -> 994).
+#: 957 problems and 5 -> 4 programmes, bunny 1092 -> 994; 2026-12-07: phase-1 problems counted,
+#: no ``starts`` fallback where a rescue follows, fox 1915 -> 1419, bunny 1676 -> 1292).
 MEASURED = {
-    "geometry-central-sphere_small.ply": (162, 0),
-    "geometry-central-fox.ply": (957, 4),
-    "meshio-bun_zipper_res4.ply": (994, 7),
+    "geometry-central-sphere_small.ply": (162, 0, 0),
+    "geometry-central-fox.ply": (957, 4, 1419),
+    "meshio-bun_zipper_res4.ply": (994, 7, 1292),
 }
 
 
@@ -43,8 +46,15 @@ def _counted(monkeypatch, path: Path):
         seen["programmes"] += 1
         return lp(rows, y)
 
+    phase1 = batch._phase1
+
+    def counting_phase1(rows, y0, *args, **kwargs):
+        seen["phase1"] += len(y0)
+        return phase1(rows, y0, *args, **kwargs)
+
     monkeypatch.setattr(solve, "solve_apex_batch", counting_solve)
     monkeypatch.setattr(batch, "phase1_lp", counting_lp)
+    monkeypatch.setattr(batch, "_phase1", counting_phase1)
     design = filletfold.round_mesh(str(path))
     return design, seen
 
@@ -52,9 +62,10 @@ def _counted(monkeypatch, path: Path):
 @pytest.mark.parametrize("name", sorted(MEASURED))
 def test_apex_work_does_not_grow(monkeypatch, name):
     design, seen = _counted(monkeypatch, CORPUS / name)
-    problems, programmes = MEASURED[name]
+    problems, programmes, phase1 = MEASURED[name]
     assert seen["problems"] <= 1.1 * problems, seen
     assert seen["programmes"] <= 1.1 * programmes + 1, seen
+    assert seen["phase1"] <= 1.1 * phase1, seen
     assert design.certificate.ok
 
 
@@ -64,3 +75,4 @@ def test_a_convex_mesh_solves_each_vertex_once(monkeypatch):
     assert design.status_counts()["ok"] == design.mesh.n_vertices
     assert seen["problems"] == design.mesh.n_vertices
     assert seen["programmes"] == 0
+    assert seen["phase1"] == 0  # a start of each is feasible

@@ -301,6 +301,6 @@ def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res) -> 
         "rescued": dict(sorted(rescue.rescued.items())),
         "rescue_applied": rescue.applied,
         "sharpened": sorted(rescue.sharpened),
-        "cones_by_lp": by_fallback["lp"],
+        "cones_by_lp": by_fallback.get("lp", 0),
         "cones_by_fallback": by_fallback,
     }

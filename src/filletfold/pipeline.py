@@ -396,8 +396,8 @@ class ApexStage:
         pending = self.take_kept()
         _stage("apices")
         # thorough even with the rescue to come: a quick solve calls vertices infeasible that
-        # are not, and the rescue would shrink their radii for nothing; but without the linear
-        # programmes when the rescue follows (they pay for themselves only there)
+        # are not, and the rescue would shrink their radii for nothing; but without the other
+        # starts and the linear programmes when the rescue follows (they pay only there)
         p, state = self.job.params, self.state
         state.apices = self.solve(pending, lp=not (p.fit_vertices and not p.material_loss))
         if not p.material_loss and any(state.res.status[u] == "infeasible" for u in pending):

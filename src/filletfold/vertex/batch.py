@@ -498,10 +498,13 @@ def solve_apex_batch(
         :data:`~filletfold.vertex.settings.FALLBACKS` are tried; each solution's ``solver``
         names the one that found its feasible point.
     lp : bool
-        Whether a thorough solve tries the linear programmes (:func:`phase1_lp`). On a
-        2,904-vertex scan they made 3 of 590 problems of the first solve feasible in 2.0 s
-        (the vertex rescue then finds those with smaller radii), and 126 of 236 of the
-        rescue's last factors in 0.6 s: the design skips them where a rescue follows.
+        Whether a thorough solve tries the fallbacks that a rescue would redo with smaller
+        radii: phase 1 from every other start (``starts``) and the linear programmes
+        (:func:`phase1_lp`). On a 2,904-vertex scan the programmes made 3 of 590 problems of
+        the first solve feasible in 2.0 s (the vertex rescue then finds those with smaller
+        radii), and 126 of 236 of the rescue's last factors in 0.6 s; the other starts found
+        no cone more there, for a quarter of its phase-1 runs: the design skips both where a
+        rescue follows.
     max_iter : int
         Interior-point iterations per phase.
 
@@ -610,7 +613,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
 
     # phase 1 from the PARALLEL_STARTS best starts first, then from the others
     for lo, hi in ((0, PARALLEL_STARTS), (PARALLEL_STARTS, n_s)):
-        if lo and "starts" not in fallbacks:
+        if lo and not (lp and "starts" in fallbacks):  # a rescue follows: it redoes them
             break
         feasible = need & (best_g > 0)
         todo_b, todo_j = [np.zeros(0, dtype=int)], [np.zeros(0, dtype=int)]

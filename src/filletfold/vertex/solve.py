@@ -16,7 +16,7 @@ from ..parallel import thread_map
 from ..rounding.conical import vertex_cone_axes
 from ..rounding.edges import EdgeRounding
 from ..tolerances import tol
-from . import batch
+from . import batch, settings
 from .apex import (
     KINDS,
     build_constraints,
@@ -27,7 +27,7 @@ from .batch import solve_apex_batch
 from .frame import VertexFrame, closed_ring_sides, developed_apices, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
-from .settings import FALLBACKS, START_PARALLEL
+from .settings import START_PARALLEL
 
 STATUSES = ("ok", "saddle", "infeasible", "boundary", "developable", "sharp")
 
@@ -133,9 +133,9 @@ class VertexResult:
 
 def cones_by_fallback(res: VertexResult) -> dict:
     """The cones (status ``ok``) whose feasible point a fallback of the solver found, per
-    fallback of :data:`~filletfold.vertex.settings.FALLBACKS` (0 for those that found none):
-    what each one paid for in this design."""
-    out = dict.fromkeys(FALLBACKS, 0)
+    fallback tried (:data:`~filletfold.vertex.settings.FALLBACKS`; 0 for those that found
+    none): what each one paid for in this design."""
+    out = dict.fromkeys(settings.FALLBACKS, 0)
     for status, solver in zip(res.status, res.solver, strict=True):
         name = solver.split("+", 1)[0]
         if status == "ok" and name in out:
@@ -608,8 +608,9 @@ def solve_apices(
         programmes of the last attempts): faster, and a vertex may be called infeasible that
         the thorough solve would solve (the vertex rescue's trial rounds use it).
     lp : bool
-        Whether a thorough solve tries linear programmes before it calls a vertex infeasible
-        (see :func:`~filletfold.vertex.batch.solve_apex_batch`); off where a rescue follows.
+        Whether a thorough solve tries the other starts and linear programmes before it calls a
+        vertex infeasible (see :func:`~filletfold.vertex.batch.solve_apex_batch`); off where a
+        rescue follows.
     size : float, optional
         The mesh's size (:func:`mesh_size`): every crease stays ``tol.ruling`` of it above its
         base curve (or a quarter of the vertex's shortest ``l_max``), so that no cylinder
