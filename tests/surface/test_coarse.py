@@ -440,7 +440,7 @@ def _triangulate_chord_by_chord(loop, p):
     reference its results must equal."""
     import math
 
-    from filletfold.surface.coarse import _diagonals
+    from filletfold.surface.coarse import _diagonals, _split_triangles
 
     k = len(loop)
     if k == 3:
@@ -465,17 +465,7 @@ def _triangulate_chord_by_chord(loop, p):
             at = int(np.argmax(value))
             if value[at] > -math.inf:
                 best[i, j], split[i, j] = value[at], m[at]
-    if split[0, k - 1] < 0:
-        return None
-    tris, stack = [], [(0, k - 1)]
-    while stack:
-        i, j = stack.pop()
-        if j - i < 2:
-            continue
-        m = int(split[i, j])
-        tris.append([loop[i], loop[m], loop[j]])
-        stack += [(i, m), (m, j)]
-    return tris
+    return _split_triangles(loop, split)
 
 
 @settings(max_examples=300, deadline=None)

@@ -140,9 +140,16 @@ def _triangulate(loop: list[int], p: np.ndarray) -> list[list[int]] | None:
         found = top > -math.inf
         best[i[found, 0], j[found, 0]] = top[found]
         split[i[found, 0], j[found, 0]] = m[found, at[found]]
-    if split[0, k - 1] < 0:  # no triangulation (the outline is not simple)
+    return _split_triangles(loop, split)
+
+
+def _split_triangles(loop: list[int], split: np.ndarray) -> list[list[int]] | None:
+    """The triangles of :func:`_triangulate`'s programme: ``split[i, j]`` (k, k) the corner
+    that chord ``(i, j)`` of ``loop`` is split at (-1: none); None when the whole polygon has
+    no split (it is not simple)."""
+    if split[0, len(loop) - 1] < 0:
         return None
-    tris, stack = [], [(0, k - 1)]
+    tris, stack = [], [(0, len(loop) - 1)]
     while stack:
         i, j = stack.pop()
         if j - i < 2:
