@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..arrays import round_significant, run_owners
+from ..arrays import round_significant, run_owners, run_starts
 from ..errors import ParameterError
 from .patch import RULED_KINDS, patch_ids, patch_kinds
 from .pattern import Annotations, CreasePattern, edge_dihedrals, face_arrays
@@ -971,16 +971,12 @@ def _move_quality(
     of them turns over in the flat layout or one of their sides changes length, flat to
     folded, by more than ``SIM_MAX_STRETCH`` of its flat length or ``shift`` (n,) at its first
     corner (see :func:`_triangle_quality`; ``shift`` None: length changes are not looked at)."""
-    p2, p3 = v2[k], v3[k]
-    if moved is not None:
-        at = (k == moved[0])[:, :, None]
-        p2, p3 = np.where(at, moved[1], p2), np.where(at, moved[2], p3)
-    if shift is None:
-        return float(_triangle_quality(p2, p3, math.inf).min())
-    return float(_triangle_quality(p2, p3, SIM_MAX_STRETCH, shift[k[:, 0]]).min())
+    return _move_qualities([(k, moved)], v2, v3, shift)[0]
 
 
-def _move_qualities(moves: list, v2: np.ndarray, v3: np.ndarray, shift: np.ndarray) -> list:
+def _move_qualities(
+    moves: list, v2: np.ndarray, v3: np.ndarray, shift: np.ndarray | None
+) -> list[float]:
     """:func:`_move_quality` of many moves at once: ``moves`` a list of (triangles (j, 3),
     moved); their triangles in one call of :func:`_triangle_quality` (each triangle's
     quality is computed alone, so the numbers are those of one call per move)."""
@@ -988,15 +984,17 @@ def _move_qualities(moves: list, v2: np.ndarray, v3: np.ndarray, shift: np.ndarr
         return []
     k = np.concatenate([m[0] for m in moves])
     p2, p3 = v2[k], v3[k]
-    count = np.array([len(m[0]) for m in moves])
-    start = np.concatenate([[0], np.cumsum(count)[:-1]])
-    for (tris, moved), lo, m in zip(moves, start.tolist(), count.tolist(), strict=True):
+    start = run_starts([len(m[0]) for m in moves])
+    for (tris, moved), lo, hi in zip(moves, start[:-1].tolist(), start[1:].tolist(), strict=True):
         if moved is not None:
             at = (tris == moved[0])[:, :, None]
-            p2[lo : lo + m] = np.where(at, moved[1], p2[lo : lo + m])
-            p3[lo : lo + m] = np.where(at, moved[2], p3[lo : lo + m])
-    quality = _triangle_quality(p2, p3, SIM_MAX_STRETCH, shift[k[:, 0]])
-    return np.minimum.reduceat(quality, start).tolist()
+            p2[lo:hi] = np.where(at, moved[1], p2[lo:hi])
+            p3[lo:hi] = np.where(at, moved[2], p3[lo:hi])
+    if shift is None:
+        quality = _triangle_quality(p2, p3, math.inf)
+    else:
+        quality = _triangle_quality(p2, p3, SIM_MAX_STRETCH, shift[k[:, 0]])
+    return np.minimum.reduceat(quality, start[:-1]).tolist()
 
 
 def simulator_pattern(
