@@ -599,7 +599,9 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
     best_g = gmin[ar, order[:, 0]]
     need = ~at_target
     fallbacks = settings.FALLBACKS
-    found = np.full(B, "", dtype=object)  # the step that made each problem feasible
+    # the fallback that made each problem feasible ("": its best start, or phase 1 from it);
+    # each step below runs only on problems not feasible yet, so none is overwritten
+    found = np.full(B, "", dtype=object)
 
     def keep_best(idx: np.ndarray, y: np.ndarray, step: str) -> None:
         """Take the phase-1 points ``y`` of problems ``idx`` (repeats allowed) that beat
@@ -608,8 +610,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         for k in np.argsort(g_y):  # ascending: the best point per problem wins
             if g_y[k] > best_g[idx[k]]:
                 best[idx[k]], best_g[idx[k]] = y[k], g_y[k]
-        made = idx[(g_y > 0) & (found[idx] == "")]
-        found[made] = step
+        found[idx[g_y > 0]] = step
 
     # phase 1 from the PARALLEL_STARTS best starts first, then from the others
     for lo, hi in ((0, PARALLEL_STARTS), (PARALLEL_STARTS, n_s)):
@@ -624,7 +625,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         todo_b, todo_j = np.concatenate(todo_b), np.concatenate(todo_j)
         if len(todo_b) == 0:
             continue
-        step = "starts" if lo else "ipm"
+        step = "starts" if lo else ""
         keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter), step)
     # a quick solve gives up early: once more from the best point (fresh multipliers)
     again = np.nonzero(need & (best_g <= 0) & ~thorough)[0]
@@ -657,7 +658,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         if at_target[b]:
             result.append(ApexSolution(True, T[b].copy(), [], True, "target"))
         elif feasible[b]:
-            x, how = X[b], "ipm" if found[b] in ("", "ipm") else f"{found[b]}+ipm"
+            x, how = X[b], f"{found[b]}+ipm" if found[b] else "ipm"
             if not converged[b] and not kkt_point(p, T[b], x):
                 # rare: finish with SLSQP from the feasible point
                 x_s = project_slsqp(p, T[b], x)
