@@ -38,7 +38,9 @@ _KEY_SCALE = 1e6
 _GRID_TOL = 1e-6
 #: ``ftol`` and ``xtol`` of the least-squares fold of the Resch pattern.
 _FIT_TOL = 1e-8
-#: The projection onto the edge lengths stops once every length is this close ...
+#: The projection onto the edge lengths stops once every length is this close, or once within
+#: ``_LENGTH_TOL`` a step no longer halves the largest miss (round-off: about 1.4e-15 on
+#: ``resch:4x4``, where 23 more dense steps gained nothing) ...
 _LENGTH_DONE = 1e-15
 #: ... and fails when one is further than this after its rounds.
 _LENGTH_TOL = 1e-12
@@ -556,10 +558,13 @@ def _resch_folded(m: int, n: int, fold: float):
 
 def _project_lengths(x: np.ndarray, edges: np.ndarray, length: np.ndarray) -> np.ndarray:
     """Gauss-Newton with minimal-norm steps onto ``|p_a - p_b| = L`` for every edge."""
+    miss = np.inf
     for _ in range(30):
         r, jac = _edge_residual(x, edges, length)
-        if np.abs(r).max() < _LENGTH_DONE:
+        worst = np.abs(r).max()
+        if worst < _LENGTH_DONE or (worst < _LENGTH_TOL and worst > 0.5 * miss):
             break
+        miss = worst
         step, *_ = np.linalg.lstsq(jac.toarray(), r, rcond=None)
         x = x - step
     r, _ = _edge_residual(x, edges, length)
