@@ -18,7 +18,7 @@ from filletfold.export.outputs import edge_mismatch
 from filletfold.mesh import EXAMPLES, example_names, load_mesh
 from filletfold.rounding.edges import clamp_radii, round_edges
 from filletfold.rounding.material_loss import solve_material_loss
-from filletfold.surface.pattern import CreasePattern
+from filletfold.surface.pattern import CreasePattern, face_arrays
 from filletfold.vertex.solve import apex_problems
 
 ALL = example_names()
@@ -102,6 +102,24 @@ def patch_faces(pattern, kind):
     return [i for i, p in enumerate(pattern.face_patch) if p.kind == kind]
 
 
+def _face_table(p):
+    """Every pattern face's corners as flat arrays: ``flat`` (the corners' vertices, face after
+    face), ``start`` (offsets), ``face_of`` and ``nxt`` (per corner: its face, the next
+    corner's position in ``flat``), and per face its patch ``kind`` and ``index``."""
+    flat, start = face_arrays(p.faces)
+    size = np.diff(start)
+    face_of = np.repeat(np.arange(len(size)), size)
+    nxt = np.arange(len(flat)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    kind = np.array([s[0] for s in p.face_patch], dtype=object)
+    index = np.array([int(s[1]) for s in p.face_patch], dtype=np.int64)
+    return flat, start, face_of, nxt, kind, index
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=1)[:, None]
+
+
 def check_contraction_everywhere(d):
     example_design = d
     """No 3D chord is longer than its flat counterpart."""
@@ -110,57 +128,56 @@ def check_contraction_everywhere(d):
 
 
 def check_ruling_lengths_are_isometric(d):
-    example_design = d
-    d = example_design
     p, m = d.pattern, d.mesh
-    e2 = lambda a, b: np.linalg.norm(p.vertices_2d[a] - p.vertices_2d[b])  # noqa: E731
-    e3 = lambda a, b: np.linalg.norm(p.vertices_3d[a] - p.vertices_3d[b])  # noqa: E731
-    apex = {tuple(np.round(d.vertices.apex[u], 12)) for u in range(m.n_vertices)}
-    checked = 0
-    for i, face in enumerate(p.faces):
-        kind, idx = p.face_patch[i]
-        pairs = list(zip(face, np.roll(face, -1), strict=True))
-        if kind == "face":  # flat piece: every edge and diagonal
-            pairs = [(a, b) for a in face for b in face if a < b]
-        elif kind == "cone":  # rulings from the apex
-            pairs = [
-                (a, b)
-                for a, b in pairs
-                if tuple(np.round(p.vertices_3d[a], 12)) in apex
-                or tuple(np.round(p.vertices_3d[b], 12)) in apex
-            ]
-        else:  # cylinder rulings run along the mesh edge
-            a0, b0 = m.edges[int(idx)]
-            t = m.vertices[b0] - m.vertices[a0]
-            t /= np.linalg.norm(t)
-            pairs = [
-                (a, b)
-                for a, b in pairs
-                if abs(abs((p.vertices_3d[b] - p.vertices_3d[a]) @ t) - e3(a, b)) < 1e-12
-            ]
-        for a, b in pairs:
-            assert abs(e2(a, b) - e3(a, b)) < 1e-11 * m.mean_edge_length
-            checked += 1
-    assert checked > len(p.faces)
+    flat, start, face_of, nxt, kind, index = _face_table(p)
+    size = np.diff(start)
+    v3 = p.vertices_3d
+    a, b = flat, flat[nxt]  # the sides of every face
+    side_kind = kind[face_of]
+    pairs = []
+    for n in np.unique(size[kind == "face"]).tolist():  # flat piece: every side and diagonal
+        faces = np.flatnonzero((kind == "face") & (size == n))
+        corners = flat[start[faces][:, None] + np.arange(n)]
+        ii, jj = np.triu_indices(n, 1)
+        pairs.append(np.column_stack([corners[:, ii].ravel(), corners[:, jj].ravel()]))
+    # cones: the rulings from the apex
+    apex = {tuple(r) for r in np.round(d.vertices.apex, 12).tolist()}
+    on_apex = np.array([tuple(r) in apex for r in np.round(v3, 12).tolist()], dtype=bool)
+    cone = (side_kind == "cone") & (on_apex[a] | on_apex[b])
+    pairs.append(np.column_stack([a[cone], b[cone]]))
+    # cylinders: the rulings run along the mesh edge
+    other = (side_kind != "face") & (side_kind != "cone")
+    e = index[face_of[other]]
+    t = _unit(m.vertices[m.edges[e, 1]] - m.vertices[m.edges[e, 0]])
+    d3 = v3[b[other]] - v3[a[other]]
+    along = np.abs(np.abs(np.einsum("ij,ij->i", d3, t)) - np.linalg.norm(d3, axis=1)) < 1e-12
+    pairs.append(np.column_stack([a[other][along], b[other][along]]))
+    pairs = np.concatenate(pairs)
+    pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+    e2 = np.linalg.norm(p.vertices_2d[pairs[:, 0]] - p.vertices_2d[pairs[:, 1]], axis=1)
+    e3 = np.linalg.norm(v3[pairs[:, 0]] - v3[pairs[:, 1]], axis=1)
+    assert np.abs(e2 - e3).max(initial=0.0) < 1e-11 * m.mean_edge_length
+    assert len(pairs) > len(p.faces)
 
 
 def check_pieces_lie_on_their_planes_and_cylinders(d):
-    example_design = d
-    d = example_design
     p, m, rd = d.pattern, d.mesh, d.rounding
-    for i, face in enumerate(p.faces):
-        kind, idx = p.face_patch[i]
-        pts = p.vertices_3d[face]
-        if kind == "face":
-            f = int(idx)
-            assert np.abs((pts - m.vertices[m.faces[f][0]]) @ m.face_normal[f]).max() < 1e-10
-        elif kind == "cylinder":
-            e = int(idx)
-            t = m.vertices[m.edges[e, 1]] - m.vertices[m.edges[e, 0]]
-            t /= np.linalg.norm(t)
-            q = pts - rd.axis_point[e]
-            dist = np.linalg.norm(q - np.outer(q @ t, t), axis=1)
-            assert_allclose(dist, rd.radius[e], atol=1e-10)
+    flat, _, face_of, _, kind, index = _face_table(p)
+    pts, corner_kind, idx = p.vertices_3d[flat], kind[face_of], index[face_of]
+    on_face = corner_kind == "face"
+    if on_face.any():
+        f = idx[on_face]
+        mesh_flat, mesh_start = face_arrays(m.faces)
+        first = m.vertices[mesh_flat[mesh_start[f]]]
+        off = np.einsum("ij,ij->i", pts[on_face] - first, m.face_normal[f])
+        assert np.abs(off).max() < 1e-10
+    on_cylinder = corner_kind == "cylinder"
+    if on_cylinder.any():
+        e = idx[on_cylinder]
+        t = _unit(m.vertices[m.edges[e, 1]] - m.vertices[m.edges[e, 0]])
+        q = pts[on_cylinder] - rd.axis_point[e]
+        dist = np.linalg.norm(q - np.einsum("ij,ij->i", q, t)[:, None] * t, axis=1)
+        assert_allclose(dist, rd.radius[e], atol=1e-10)
 
 
 def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
@@ -210,25 +227,23 @@ def check_creases_are_mountains_at_back_apices_valleys_at_front(d):
 
 
 def check_no_overlap_in_the_pattern(d):
-    example_design = d
-    p = example_design.pattern
-    polys = [shapely.Polygon(p.vertices_2d[f]) for f in p.faces]
-    assert all(q.is_valid and q.area > 0 for q in polys)
-    total = sum(q.area for q in polys)
+    p = d.pattern
+    flat, _, face_of, _, _, _ = _face_table(p)
+    polys = shapely.polygons(shapely.linearrings(p.vertices_2d[flat], indices=face_of))
+    assert shapely.is_valid(polys).all() and (shapely.area(polys) > 0).all()
+    total = shapely.area(polys).sum()
     assert shapely.union_all(polys).area == pytest.approx(total, rel=1e-9)
 
 
 def check_faces_counter_clockwise_in_2d_and_front_facing_in_3d(d):
-    example_design = d
-    d = example_design
     p, m = d.pattern, d.mesh
-    normals = p.face_normal_3d()
-    for i, face in enumerate(p.faces):
-        q = p.vertices_2d[face]
-        assert np.sum(q[:, 0] * np.roll(q[:, 1], -1) - np.roll(q[:, 0], -1) * q[:, 1]) > 0
-        kind, idx = p.face_patch[i]
-        if kind == "face":
-            assert normals[i] @ m.face_normal[int(idx)] > 1 - 1e-9
+    flat, start, _, nxt, kind, index = _face_table(p)
+    q, qn = p.vertices_2d[flat], p.vertices_2d[flat[nxt]]
+    twice_area = np.add.reduceat(q[:, 0] * qn[:, 1] - qn[:, 0] * q[:, 1], start[:-1])
+    assert (twice_area > 0).all()
+    face = np.flatnonzero(kind == "face")
+    facing = np.einsum("ij,ij->i", p.face_normal_3d()[face], m.face_normal[index[face]])
+    assert (facing > 1 - 1e-9).all()
 
 
 def check_crease_loop_closes_around_every_cone(d):

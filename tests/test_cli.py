@@ -271,7 +271,8 @@ def test_a_log_gets_a_line_per_stage(tmp_path):
     import sys
 
     def run(*extra):
-        cmd = [sys.executable, "-m", "filletfold", "round", "blob", "-o", str(tmp_path / "b")]
+        out = str(tmp_path / "ico")
+        cmd = [sys.executable, "-m", "filletfold", "round", "icosahedron", "-o", out]
         done = subprocess.run([*cmd, *extra], capture_output=True, text=True, check=True)
         return [line for line in done.stderr.splitlines() if line.startswith("filletfold: ")]
 

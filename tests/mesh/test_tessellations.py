@@ -27,12 +27,23 @@ SPECS = [
     "resch:2x3,fold=0.7",
     "resch:4x4,fold=0.6",
 ]
+#: Folding ``resch:4x4`` takes about 5 s of least squares: its cases run in the slow tier.
+SLOW_SPECS = {"resch:4x4,fold=0.6"}
+CASES = [pytest.param(s, marks=pytest.mark.slow) if s in SLOW_SPECS else s for s in SPECS]
 DOMES = ["conical-dome", "conical-dome:12x5,opening=80,height=0.6", "conical-dome:5x3"]
+
+
+class _Loaded(dict):
+    """Each spec's ``(example_mesh(spec), load_mesh(spec))``, made when first asked for."""
+
+    def __missing__(self, spec):
+        self[spec] = (example_mesh(spec), load_mesh(spec))
+        return self[spec]
 
 
 @pytest.fixture(scope="module")
 def loaded():
-    return {spec: (example_mesh(spec), load_mesh(spec)) for spec in SPECS + DOMES}
+    return _Loaded()
 
 
 def interior_dihedral_deg(mesh: PolyMesh) -> np.ndarray:
@@ -76,7 +87,7 @@ def test_registry_lists_base_names_with_documented_parameters():
 
 
 # ---------------------------------------------------------------------- developable sheets
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", CASES)
 def test_tessellation_loads_unchanged(spec, loaded):
     (v, faces), (mesh, log) = loaded[spec]
     assert mesh.n_faces == len(faces) and mesh.n_vertices == len(v)
@@ -88,7 +99,7 @@ def test_tessellation_loads_unchanged(spec, loaded):
     assert mesh.face_area.min() > 0.05
 
 
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", CASES)
 def test_tessellation_is_developable_planar_and_folded(spec, loaded):
     mesh, _ = loaded[spec][1]
     inner = ~mesh.is_boundary_vertex
@@ -98,13 +109,13 @@ def test_tessellation_is_developable_planar_and_folded(spec, loaded):
     assert interior_dihedral_deg(mesh).min() > 2.0
 
 
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", CASES)
 def test_tessellation_does_not_intersect_itself(spec, loaded):
     mesh, _ = loaded[spec][1]
     assert crossing_pairs(mesh) == 0
 
 
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", CASES)
 def test_front_faces_up(spec, loaded):
     mesh, _ = loaded[spec][1]
     assert (mesh.face_area[:, None] * mesh.face_normal).sum(axis=0)[2] > 0
