@@ -15,7 +15,7 @@ once with each known fallback toggled (``-lp``: the default ones less ``lp``; ``
 plus ``starts``, in its place in the order), and prints one row per run: the cones
 (vertices with status ``ok``), the vertices rescued by smaller radii, those left sharp and
 infeasible, the apex problems solved
-(``solve_apex_batch``'s problems) and the phase-1 problems (the interior-point feasibility
+(``fitting.apex_work``: the design counts them) and the phase-1 problems (the feasibility
 runs, every start counted), the apex stage's seconds, the certificate, and with the default
 fallbacks the cones each one found (``fitting.cones_by_fallback``). Then a summary per
 fallback over all meshes: the cones it found (as a default one), and what it pays for: the
@@ -46,7 +46,6 @@ from real_meshes import corpus_files  # noqa: E402
 import filletfold  # noqa: E402
 import filletfold.vertex.batch as batch  # noqa: E402
 import filletfold.vertex.settings as settings  # noqa: E402
-import filletfold.vertex.solve as solve  # noqa: E402
 
 DEFAULT = tuple(settings.FALLBACKS)
 KNOWN = tuple(settings.KNOWN_FALLBACKS)
@@ -74,33 +73,22 @@ def default_cases(max_faces: int, match: list[str]) -> list[Path]:
 
 
 def run(path: Path, fallbacks: tuple) -> dict:
-    """One default design of ``path`` with only ``fallbacks`` on: counts and seconds."""
-    seen = collections.Counter()
-    solve_batch, phase1 = solve.solve_apex_batch, batch._phase1
-
-    def counting_solve(problems, *args, **kwargs):
-        seen["problems"] += len(problems)
-        return solve_batch(problems, *args, **kwargs)
-
-    def counting_phase1(rows, y0, *args, **kwargs):
-        seen["phase1"] += len(y0)
-        return phase1(rows, y0, *args, **kwargs)
-
+    """One default design of ``path`` with only ``fallbacks`` on: counts and seconds (the
+    solver's work as the design counts it, ``fitting.apex_work``)."""
     settings.FALLBACKS = fallbacks
-    solve.solve_apex_batch, batch._phase1 = counting_solve, counting_phase1
     try:
         design = filletfold.round_mesh(str(path))
     finally:
         settings.FALLBACKS = DEFAULT
-        solve.solve_apex_batch, batch._phase1 = solve_batch, phase1
+    work = design.fitting["apex_work"]
     counts = design.status_counts()
     return {
         "cones": counts["ok"],
         "rescued": len(design.fitting["rescued"]),
         "sharp": counts["sharp"],
         "infeasible": counts["infeasible"],
-        "problems": seen["problems"],
-        "phase1": seen["phase1"],
+        "problems": work["problems"],
+        "phase1": work["phase1_runs"],
         "apices_s": design.timings.get("apices", float("nan")),
         "valid": bool(design.certificate is not None and design.certificate.ok),
         "by_fallback": dict(design.fitting.get("cones_by_fallback", {})),

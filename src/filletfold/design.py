@@ -87,7 +87,9 @@ class Design:
         no radius rescued whose edges were left sharp instead (sharp vertices);
         ``cones_by_lp`` and ``cones_by_fallback`` (dict fallback -> int), the cones whose
         feasible point a fallback of the apex solver found
-        (:data:`~filletfold.vertex.settings.FALLBACKS`).
+        (:data:`~filletfold.vertex.settings.FALLBACKS`); ``apex_work`` (dict: ``problems``,
+        ``phase1_runs``, ``programmes``), what the apex solver did in this design, in counts
+        (:class:`~filletfold.vertex.batch.ApexWork`).
     """
 
     mesh: PolyMesh
@@ -260,7 +262,7 @@ def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, t
         fabrication=laid.fabrication,
         stages=stages,
         repairs=list(job.clean_log.repairs),
-        fitting=_fitting(rounding, edges.requested, edges.fitted, sol.rescue, sol.res),
+        fitting=_fitting(rounding, edges.requested, edges.fitted, sol.rescue, sol.res, sol.work),
     )
 
 
@@ -283,11 +285,12 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
     return mesh, rounding, res, moved
 
 
-def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res) -> dict:
+def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res, work) -> dict:
     """What :attr:`Design.fitting` holds: the radii asked for, the edges reduced to fit their
     limits, the edges left sharp, the vertices rescued (:mod:`filletfold.vertex.rescue`), the
-    cones whose apex needed the solver's linear programmes, and those each fallback of the
-    solver found (:func:`~filletfold.vertex.solve.cones_by_fallback`)."""
+    cones whose apex needed the solver's linear programmes, those each fallback of the
+    solver found (:func:`~filletfold.vertex.solve.cones_by_fallback`), and the solver's work
+    (:class:`~filletfold.vertex.batch.ApexWork`)."""
     bent = rounding.half_angle > 0  # rounded or left sharp (not boundary, not flat)
     asked = np.where(bent, requested, 0.0)
     sharp = rounding.sharp if rounding.sharp is not None else np.zeros(len(bent), dtype=bool)
@@ -303,4 +306,5 @@ def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res) -> 
         "sharpened": sorted(rescue.sharpened),
         "cones_by_lp": by_fallback.get("lp", 0),
         "cones_by_fallback": by_fallback,
+        "apex_work": work.as_dict(),
     }

@@ -430,7 +430,7 @@ class ApexStage:
         def solve(vertices, progress=None):
             return solve_apices(
                 state.frames, state.depths, res, state.centres, progress, vertices=vertices,
-                size=state.size, thorough=True, lp=lp, cuts=state.cuts,
+                size=state.size, thorough=True, lp=lp, cuts=state.cuts, work=state.work,
             )  # fmt: skip
 
         try:
@@ -509,6 +509,7 @@ class ApexStage:
             cuts=state.cuts,
             needs=self.needs,
             ring_closed=[f.ring.closed for f in state.frames],
+            work=state.work,
         )
 
 

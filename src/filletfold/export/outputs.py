@@ -226,6 +226,7 @@ def _fitting_report(design) -> dict:
         "sharpened": sharpened,
         "cones_by_lp": int(fit.get("cones_by_lp", 0)),
         "cones_by_fallback": {k: int(v) for k, v in fit.get("cones_by_fallback", {}).items()},
+        "apex_work": {k: int(v) for k, v in fit.get("apex_work", {}).items()},
     }
 
 

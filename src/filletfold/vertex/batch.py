@@ -28,8 +28,10 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import threading
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -464,6 +466,46 @@ def phase1_lp(rows: RowBlock, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return y, t
 
 
+@dataclass
+class ApexWork:
+    """What the apex solver did for one design, in counts (seconds depend on the machine,
+    these do not): a solve that grows one of them shows in a test before anyone times it.
+
+    Passed to :func:`solve_apex_batch` (and through
+    :func:`~filletfold.vertex.solve.solve_apices`), which add to it; safe to share between
+    threads. The design reports it as ``fitting.apex_work``.
+
+    Attributes
+    ----------
+    problems : int
+        Apex problems solved: one per vertex and attempt (a vertex solved again after a
+        change of radii counts again).
+    phase1 : int
+        Interior-point feasibility (phase-1) runs, every start and fallback counted.
+    programmes : int
+        Block linear programmes run (:func:`phase1_lp`, one per chunk that needed them).
+    """
+
+    problems: int = 0
+    phase1: int = 0
+    programmes: int = 0
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False, compare=False)
+
+    def add(self, problems: int = 0, phase1: int = 0, programmes: int = 0) -> None:
+        with self._lock:
+            self.problems += int(problems)
+            self.phase1 += int(phase1)
+            self.programmes += int(programmes)
+
+    def as_dict(self) -> dict:
+        """``{"problems": .., "phase1_runs": .., "programmes": ..}`` (the report's keys)."""
+        return {
+            "problems": self.problems,
+            "phase1_runs": self.phase1,
+            "programmes": self.programmes,
+        }
+
+
 def solve_apex_batch(
     problems: Sequence[ApexConstraints],
     targets: Sequence[np.ndarray],
@@ -472,6 +514,7 @@ def solve_apex_batch(
     thorough=True,
     lp: bool = True,
     max_iter: int = 80,
+    work: ApexWork | None = None,
 ) -> list[ApexSolution]:
     """Project every target onto its problem's feasible set, all problems at once.
 
@@ -507,6 +550,8 @@ def solve_apex_batch(
         rescue follows.
     max_iter : int
         Interior-point iterations per phase.
+    work : ApexWork, optional
+        Adds the problems, phase-1 runs and linear programmes solved here.
 
     Returns
     -------
@@ -515,6 +560,8 @@ def solve_apex_batch(
         and ``failing`` then names the violated constraints at the best point found.
     """
     out: list[ApexSolution | None] = [None] * len(problems)
+    work = ApexWork() if work is None else work
+    work.add(problems=len(problems))
     thorough = np.broadcast_to(np.asarray(thorough, dtype=bool), (len(problems),))
     sizes = np.array([len(p.lin_b) + len(p.quad_s) for p in problems])
     for n in (3, 5):
@@ -535,6 +582,7 @@ def solve_apex_batch(
                 n,
                 max_iter,
                 lp,
+                work,
             )
             for i, s in zip(chunk, sols, strict=True):
                 out[i] = s
@@ -573,7 +621,15 @@ def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSo
     return solve_apex_batch([cons], [target], [list(starts) if starts is not None else []])[0]
 
 
-def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> list[ApexSolution]:
+def _solve_chunk(
+    problems, targets, starts, thorough, n, max_iter, lp=True, work: ApexWork | None = None
+) -> list[ApexSolution]:
+    work = ApexWork() if work is None else work
+
+    def phase1(idx: np.ndarray, y0: np.ndarray, iters: int, **kwargs) -> np.ndarray:
+        work.add(phase1=len(idx))
+        return _phase1(rows.take(idx), y0, idx, iters, **kwargs)
+
     B = len(problems)
     T = np.stack(targets)
     rows = pack_problems(problems, T, n)
@@ -626,14 +682,15 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
         if len(todo_b) == 0:
             continue
         step = "starts" if lo else ""
-        keep_best(todo_b, _phase1(rows.take(todo_b), cand[todo_b, todo_j], todo_b, max_iter), step)
+        keep_best(todo_b, phase1(todo_b, cand[todo_b, todo_j], max_iter), step)
     # a quick solve gives up early: once more from the best point (fresh multipliers)
     again = np.nonzero(need & (best_g <= 0) & ~thorough)[0]
     if len(again) and "again" in fallbacks:
-        keep_best(again, _phase1(rows.take(again), best[again], again, max_iter), "again")
+        keep_best(again, phase1(again, best[again], max_iter), "again")
     # the interior-point phase 1 can stall short of a thin window: linear programmes next
     stalled = np.nonzero(need & (best_g <= 0) & thorough)[0]
     if len(stalled) and lp and "lp" in fallbacks:
+        work.add(programmes=1)
         y_lp, t_lp = phase1_lp(rows.take(stalled), best[stalled])
         up = t_lp > best_g[stalled]
         best[stalled[up]], best_g[stalled[up]] = y_lp[up], t_lp[up]
@@ -641,7 +698,7 @@ def _solve_chunk(problems, targets, starts, thorough, n, max_iter, lp=True) -> l
     # the give-up rule is only a hint here: the rest continue from their best point, longer
     rest = np.nonzero(need & (best_g <= 0) & thorough)[0]
     if len(rest) and "long" in fallbacks:
-        y_long = _phase1(rows.take(rest), best[rest], rest, 3 * max_iter, give_up=False)
+        y_long = phase1(rest, best[rest], 3 * max_iter, give_up=False)
         keep_best(rest, y_long, "long")
     feasible = need & (best_g > 0)
     solve = np.nonzero(feasible)[0]

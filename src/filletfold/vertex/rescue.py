@@ -140,6 +140,7 @@ def rescue_vertices(state: VertexState, *, apply: bool, vertices=None) -> Rescue
             thorough=max(tries[u] for u in bad) >= ROUNDS,  # the fallbacks at the last factor
             size=state.size,
             cuts=cuts,
+            work=state.work,
         )
         if apply:
             out.resolved.update(affected.tolist())
@@ -215,6 +216,7 @@ def _probe(state: VertexState, radius: np.ndarray, vertices, sharp: np.ndarray) 
             thorough=False,
             size=state.size,
             cuts=state.cuts,
+            work=state.work,
         )
         for u in todo:
             if trial.status[u] == "ok":

@@ -203,7 +203,7 @@ def sharpen_vertices(state: VertexState, kinds) -> Sharpening:
         if todo:
             solved = solve_apices(
                 {u: frames[u] for u in todo}, state.depths, res, centres, state.progress, todo,
-                size=state.size, cuts=state.cuts,
+                size=state.size, cuts=state.cuts, work=state.work,
             )  # fmt: skip
             apices.update(solved)
         out.resolved.update(int(u) for u in again)

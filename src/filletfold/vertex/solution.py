@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..rounding.edges import EdgeRounding
+from .batch import ApexWork
 from .rescue import Rescue
 from .solve import VertexResult
 
@@ -36,6 +37,9 @@ class VertexSolution:
     ring_closed : list of bool
         Whether each vertex's ring is closed (kept apart: the layout reads it after the frames
         may be released).
+    work : ApexWork
+        The apex solver's work in this design (vertices taken over from an earlier design
+        cost none).
     """
 
     rounding: EdgeRounding
@@ -49,3 +53,4 @@ class VertexSolution:
     cuts: dict
     needs: dict
     ring_closed: list
+    work: ApexWork = field(default_factory=ApexWork)

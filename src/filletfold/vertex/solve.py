@@ -23,7 +23,7 @@ from .apex import (
     build_constraints_many,
     validate_apices,
 )
-from .batch import solve_apex_batch
+from .batch import ApexWork, solve_apex_batch
 from .frame import VertexFrame, closed_ring_sides, developed_apices, vertex_frames
 from .normal import is_developable, solid_angles_front, vertex_normals
 from .runs import run_means
@@ -576,6 +576,7 @@ def solve_apices(
     size: float | None = None,
     lp: bool = True,
     cuts: dict | None = None,
+    work: ApexWork | None = None,
 ) -> dict:
     """Developed and spatial apices of every cone vertex (sec. 2.4, 3.2), validated densely.
 
@@ -621,6 +622,9 @@ def solve_apices(
         starts with them (after a change of radii its dips are mostly where they were, and
         each would otherwise cost a solve again); every vertex settled here is set to those
         it ended with. The vertex rescue passes one dict from solve to solve.
+    work : ApexWork, optional
+        Adds the solver's work (problems, phase-1 runs, linear programmes); the design passes
+        one from solve to solve (``fitting.apex_work``).
 
     Returns
     -------
@@ -645,7 +649,7 @@ def solve_apices(
         slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
         # the slices are independent (each settles its own vertices): in threads
         for _ in thread_map(
-            lambda part: _solve_round(part, pending, res, out, centres, thorough, lp, cuts),
+            lambda part: _solve_round(part, pending, res, out, centres, thorough, lp, cuts, work),
             slices,
         ):
             if progress is not None:
@@ -693,6 +697,7 @@ def _solve_round(
     thorough: bool = True,
     lp: bool = True,
     cuts: dict | None = None,
+    work: ApexWork | None = None,
 ) -> None:
     """One attempt of the vertices ``order`` (in ``pending``): solve them at once, validate the
     solved ones at once, and settle every vertex that is done (ok, or out of attempts; its
@@ -706,6 +711,7 @@ def _solve_round(
         [pending[u].starts for u in order],
         thorough=[thorough and t[1] < 1.0 for t in tries],  # only thin attempts end a vertex
         lp=lp,
+        work=work,
     )
     # the dense validation of every solved vertex at once
     solved = [

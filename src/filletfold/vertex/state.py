@@ -18,6 +18,7 @@ import numpy as np
 
 from ..mesh.polymesh import PolyMesh
 from ..rounding.edges import EdgeRounding, round_edges, shrink_broken
+from .batch import ApexWork
 from .solve import VertexResult
 
 
@@ -57,6 +58,8 @@ class VertexState:
         The samples each vertex's solves added: a vertex solved again starts with its own.
     progress : callable or None
         ``progress(stage, done, total)``.
+    work : ApexWork
+        The apex solver's work over every solve of this state (counts).
     """
 
     mesh: PolyMesh
@@ -74,6 +77,7 @@ class VertexState:
     apices: dict = field(default_factory=dict)
     cuts: dict = field(default_factory=dict)
     progress: Any = None
+    work: ApexWork = field(default_factory=ApexWork)
 
     def sharp_frames(self) -> np.ndarray:
         """(n_vertices,) bool: the vertices whose frames are built sharp."""
