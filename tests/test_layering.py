@@ -193,6 +193,7 @@ MANY_PARAMETERS = {
     "export/cutfiles.py:cut_files": "public: the cut files' options",
     "export/outputs.py:export_design": "public: Design.export's options",
     "vertex/solve.py:solve_apices": "public: the apex solver's entry point",
+    "vertex/solve.py:_solve_round": "one round of solve_apices, with its arguments and work",
     "vertex/batch.py:interior_point_numpy": "public: the solver, twin of the kernel's",
     "vertex/batch_kernel.py:interior_point_numba": "public: the kernel, twin of numpy's",
     "vertex/batch_kernel.py:_status": "numba: arrays one by one",

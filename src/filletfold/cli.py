@@ -6,7 +6,7 @@ Commands
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--from REPORT] [--radius R] [--depth D] [--samples N]``
 ``[--arc-step DEG]``
-``[--chord-tol TOL] [--coplanar-tol DEG]``
+``[--chord-tol TOL] [--coplanar-tol DEG] [--faces N]``
 ``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME] [--nest NESTER]``
 ``[--view V]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
@@ -197,6 +197,7 @@ ROUND_PARAMETERS = {
     "scale": "scale",
     "no_tabs": "tabs",
     "nest": "nest",
+    "faces": "faces",
 }
 
 
@@ -361,6 +362,17 @@ def round_cmd(
             "--coplanar-tol", help="Merge neighbouring faces within this angle (degrees)."
         ),
     ] = tol.coplanar_deg,
+    faces: Annotated[
+        int | None,
+        typer.Option(
+            "--faces",
+            min=4,
+            help="Coarsen the mesh to about this many triangles before rounding (quadric "
+            "decimation; the summary and report.json give how far the surface moved). A scan "
+            "of 100,000 triangles otherwise gives tens of thousands of pieces.",
+            show_default=False,
+        ),
+    ] = None,
     dry_run: Annotated[
         bool, typer.Option("--dry-run", help="Solve and print the summary, write nothing.")
     ] = False,

@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import callers_progress, named_stages
 from .errors import stage as _stage
+from .mesh.coarsen import Coarsening
 from .mesh.polymesh import PolyMesh
 from .parameters import Parameters
 from .pipeline import (
@@ -76,6 +77,9 @@ class Design:
         Intermediate results a later ``round_mesh(..., reuse=design)`` takes over.
     repairs : list of Repair
         The repairs made to the input mesh (:mod:`filletfold.mesh.repair`).
+    coarsening : Coarsening or None
+        With ``faces``: the triangles and vertices before and after the mesh was coarsened
+        (:func:`~filletfold.mesh.coarsen.coarsen_mesh`), and how far its surface moved.
     fitting : dict
         ``radius_requested`` (n_edges,) float, the radii asked for (0 at boundary and flat
         edges); ``fitted_radius`` (n_edges,) float, the radii after fitting to the limits and
@@ -108,6 +112,7 @@ class Design:
     repairs: list = field(default_factory=list)
     fitting: dict = field(default_factory=dict)
     certificate: object = None
+    coarsening: Coarsening | None = None
 
     @property
     def vertex_status(self) -> list:
@@ -262,6 +267,7 @@ def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, t
         fabrication=laid.fabrication,
         stages=stages,
         repairs=list(job.clean_log.repairs),
+        coarsening=job.coarsening,
         fitting=_fitting(rounding, edges.requested, edges.fitted, sol.rescue, sol.res, sol.work),
     )
 

@@ -50,6 +50,7 @@ _JSON_TYPES = {
     "scale": ("number", "null"),
     "tabs": ("bool",),
     "nest": ("string",),
+    "faces": ("integer", "null"),
 }
 
 
@@ -139,6 +140,11 @@ class Parameters:
         ``"sparrow"`` (the irregular nester of the ``nest`` extra, ``"sparrow:S"`` for S seconds
         per packing run; needs ``sheet``) or ``"auto"`` (sparrow when installed and ``sheet`` is
         given, else the shelves). See :mod:`filletfold.layout.nest`.
+    faces : int or None
+        Coarsen the mesh to about this many triangles before it is rounded (quadric
+        decimation, :func:`~filletfold.mesh.coarsen.coarsen_mesh`): a scan of 100,000
+        triangles otherwise gives tens of thousands of pieces. The design reports how far the
+        surface moved (``coarsening``). None: the mesh as it is.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -159,6 +165,7 @@ class Parameters:
     scale: float | None = None
     tabs: bool = True
     nest: str = "shelf"
+    faces: int | None = None
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:

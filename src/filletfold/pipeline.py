@@ -38,6 +38,7 @@ from .errors import FilletfoldError, InternalError, SolverError, is_callers, one
 from .errors import stage as _stage
 from .layout.arrange import arrange
 from .mesh import load_mesh
+from .mesh.coarsen import Coarsening, coarsen_mesh
 from .mesh.polymesh import PolyMesh, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth
 from .rounding.conical import conical_material_loss, is_conical
@@ -123,6 +124,8 @@ class Job:
         The chord tolerance, absolute.
     progress : callable
         ``progress(stage, done, total)``.
+    coarsening : Coarsening or None
+        What coarsening the mesh did (``params.faces``), else None.
     """
 
     params: Parameters
@@ -140,6 +143,7 @@ class Job:
     min_chord: float
     chord: float
     progress: Any
+    coarsening: Coarsening | None = None
 
 
 @dataclass
@@ -245,13 +249,19 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
     """Stage 1: the mesh read and cleaned (:func:`~filletfold.mesh.load_mesh`), or taken over
     from ``earlier`` when it is the same :class:`PolyMesh` cleaned the same way; moved about
     its centre when it lies far from the origin (:func:`far_offset`)."""
-    input_key = _input_key(mesh, params.coplanar_deg, params.strict)
+    input_key = _input_key(mesh, params.coplanar_deg, params.strict, params.faces)
     cleaned = None if earlier is None else earlier.cleaned
     if input_key is not None and cleaned is not None and cleaned[0] == input_key:
-        _, pm, clean_log, shift = cleaned  # the same input, cleaned the same way: take it over
+        _, pm, clean_log, shift, coarsening = cleaned  # the same input, cleaned the same way
     else:
         _stage("reading the mesh")
         pm, clean_log = load_mesh(mesh, coplanar_deg=params.coplanar_deg, strict=params.strict)
+        coarsening = None
+        if params.faces is not None:  # decimated, then cleaned as any input (repairs kept)
+            _stage("coarsening the mesh")
+            v, t, coarsening = coarsen_mesh(pm, params.faces)
+            pm, log = load_mesh((v, t), coplanar_deg=params.coplanar_deg, strict=params.strict)
+            clean_log.repairs.extend(log.repairs)
         shift = far_offset(pm.vertices)
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)
@@ -263,6 +273,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         clean_log=clean_log,
         shift=shift,
         input_key=input_key,
+        coarsening=coarsening,
         key=_stage_key(pm, *(getattr(params, name) for name in STAGE_KEY)),
         depths=resolve_depth(params.depth, pm.mean_edge_length, pm.n_vertices),
         kinds=params.sharp_kinds(),
@@ -561,7 +572,7 @@ def stages_of(job: Job, edges: Edges, sol: VertexSolution, mods: Modules) -> Sta
         modules=mods.modules,
         cleaned=None
         if job.input_key is None
-        else (job.input_key, job.mesh, job.clean_log, job.shift),
+        else (job.input_key, job.mesh, job.clean_log, job.shift, job.coarsening),
         cuts=sol.cuts,
     )
 
@@ -623,12 +634,13 @@ def _build_modules(pm: PolyMesh, solved: list, centres, points, progress) -> lis
         raise  # every module built alone: the failure was in the batch (re-raise it)
 
 
-def _input_key(mesh, coplanar_deg, strict) -> tuple | None:
-    """Hashable identity of a :func:`round_mesh` input and the options its cleaning depends
-    on, for a :class:`PolyMesh` (its vertices and faces by their bytes); None otherwise."""
+def _input_key(mesh, coplanar_deg, strict, faces=None) -> tuple | None:
+    """Hashable identity of a :func:`round_mesh` input and the options its cleaning (and
+    coarsening) depends on, for a :class:`PolyMesh` (its vertices and faces by their bytes);
+    None otherwise."""
     if not isinstance(mesh, PolyMesh):
         return None
-    return (*_mesh_key(mesh), repr(coplanar_deg), strict)
+    return (*_mesh_key(mesh), repr(coplanar_deg), strict, repr(faces))
 
 
 def _stage_key(pm: PolyMesh, *params) -> tuple:

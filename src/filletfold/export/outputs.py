@@ -101,6 +101,7 @@ def report_records(design) -> dict:
             "max_relative_edge_mismatch": float(relative.max(initial=0.0)),
         },
         "repairs": [r.as_dict() for r in design.repairs],
+        "coarsening": design.coarsening.as_dict() if design.coarsening is not None else None,
         "certificate": design.certificate.as_dict() if design.certificate is not None else None,
         "fitting": _fitting_report(design),
         "layout": {"kind": design.layout, "note": design.layout_note or None},
@@ -358,6 +359,12 @@ def relative_mismatch(pattern) -> np.ndarray:
     return _mismatches(pattern)[1]
 
 
+#: A design of more pieces gets a line in the summary suggesting ``--faces``.
+MANY_PIECES = 1000
+#: The triangle count that line suggests.
+COARSE_FACES = 2000
+
+
 def design_summary(design, max_listed: int = 8) -> str:
     """A few lines for the terminal (at most ``max_listed`` vertices that are not ok)."""
     mesh = design.mesh
@@ -377,6 +384,8 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"vertices: {shown}",
     ]
     lines[1:1] = _repair_lines(design, max_listed)
+    if design.coarsening is not None:
+        lines.insert(1, design.coarsening.summary())
     lines[-1:-1] = _fitting_lines(design)
     if design.material_loss is not None:
         ml = design.material_loss
@@ -396,6 +405,12 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"max edge mismatch {mismatch.max(initial=0.0):.2e} "
         f"(relative {relative.max(initial=0.0):.2e})"
     )
+    if design.coarsening is None and pat.n_pieces > MANY_PIECES:
+        lines.append(
+            f"  {pat.n_pieces} pieces are more than a person cuts: --faces N coarsens the mesh "
+            f"first (quadric decimation; --faces {COARSE_FACES} gives some "
+            f"{COARSE_FACES // 2} vertices)"
+        )
     if design.layout_note:
         lines.append(f"  no single sheet: {design.layout_note}")
     fab = design.fabrication
