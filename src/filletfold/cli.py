@@ -6,7 +6,7 @@ Commands
     List the built-in meshes.
 ``filletfold round MESH [-o OUT] [--from REPORT] [--radius R] [--depth D] [--samples N]``
 ``[--arc-step DEG]``
-``[--chord-tol TOL] [--coplanar-tol DEG] [--faces N]``
+``[--chord-tol TOL] [--coplanar-tol DEG] [--faces N | --edge-length L]``
 ``[--format LIST] [--units U] [--scale S] [--sheet PAGE] [--preset NAME] [--nest NESTER]``
 ``[--view V]``
     Round a mesh (file or built-in name) and write ``design.fold``, ``report.json``,
@@ -198,6 +198,7 @@ ROUND_PARAMETERS = {
     "no_tabs": "tabs",
     "nest": "nest",
     "faces": "faces",
+    "edge_length": "edge_length",
 }
 
 
@@ -370,6 +371,15 @@ def round_cmd(
             help="Coarsen the mesh to about this many triangles before rounding (quadric "
             "decimation; the summary and report.json give how far the surface moved). A scan "
             "of 100,000 triangles otherwise gives tens of thousands of pieces.",
+            show_default=False,
+        ),
+    ] = None,
+    edge_length: Annotated[
+        str | None,
+        typer.Option(
+            "--edge-length",
+            help="Coarsen instead to triangles of about this side: a length, or N% of the "
+            "mean edge length (300% for edges three times as long); not with --faces.",
             show_default=False,
         ),
     ] = None,

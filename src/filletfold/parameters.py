@@ -51,6 +51,7 @@ _JSON_TYPES = {
     "tabs": ("bool",),
     "nest": ("string",),
     "faces": ("integer", "null"),
+    "edge_length": ("number", "string", "null"),
 }
 
 
@@ -145,6 +146,10 @@ class Parameters:
         decimation, :func:`~filletfold.mesh.coarsen.coarsen_mesh`): a scan of 100,000
         triangles otherwise gives tens of thousands of pieces. The design reports how far the
         surface moved (``coarsening``). None: the mesh as it is.
+    edge_length : float, str or None
+        Coarsen instead to the count of equilateral triangles of this side (a length, or
+        ``"300%"`` of the mean edge length) that cover the mesh's area
+        (:func:`~filletfold.mesh.coarsen.coarse_target`); not with ``faces``.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -166,6 +171,7 @@ class Parameters:
     tabs: bool = True
     nest: str = "shelf"
     faces: int | None = None
+    edge_length: object = None
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:

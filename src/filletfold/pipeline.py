@@ -38,7 +38,7 @@ from .errors import FilletfoldError, InternalError, SolverError, is_callers, one
 from .errors import stage as _stage
 from .layout.arrange import arrange
 from .mesh import load_mesh
-from .mesh.coarsen import Coarsening, coarsen_mesh
+from .mesh.coarsen import Coarsening, coarse_target, coarsen_mesh
 from .mesh.polymesh import PolyMesh, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth
 from .rounding.conical import conical_material_loss, is_conical
@@ -249,17 +249,18 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
     """Stage 1: the mesh read and cleaned (:func:`~filletfold.mesh.load_mesh`), or taken over
     from ``earlier`` when it is the same :class:`PolyMesh` cleaned the same way; moved about
     its centre when it lies far from the origin (:func:`far_offset`)."""
-    input_key = _input_key(mesh, params.coplanar_deg, params.strict, params.faces)
+    coarse = (params.faces, params.edge_length)
+    input_key = _input_key(mesh, params.coplanar_deg, params.strict, coarse)
     cleaned = None if earlier is None else earlier.cleaned
     if input_key is not None and cleaned is not None and cleaned[0] == input_key:
         _, pm, clean_log, shift, coarsening = cleaned  # the same input, cleaned the same way
     else:
         _stage("reading the mesh")
         pm, clean_log = load_mesh(mesh, coplanar_deg=params.coplanar_deg, strict=params.strict)
-        coarsening = None
-        if params.faces is not None:  # decimated, then cleaned as any input (repairs kept)
+        coarsening, target = None, coarse_target(pm, params.faces, params.edge_length)
+        if target is not None:  # decimated, then cleaned as any input (repairs kept)
             _stage("coarsening the mesh")
-            v, t, coarsening = coarsen_mesh(pm, params.faces)
+            v, t, coarsening = coarsen_mesh(pm, target)
             pm, log = load_mesh((v, t), coplanar_deg=params.coplanar_deg, strict=params.strict)
             clean_log.repairs.extend(log.repairs)
         shift = far_offset(pm.vertices)

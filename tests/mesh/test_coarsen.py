@@ -135,3 +135,21 @@ def test_the_summary_suggests_faces_for_a_design_of_many_pieces(monkeypatch):
     coarse = filletfold.round_mesh("blob", faces=200)
     assert coarse.coarsening is not None and "--faces N" not in coarse.summary()
     assert coarse.summary().splitlines()[1].startswith("coarsened: 320 -> ")
+
+
+def test_edge_length_sets_the_triangle_count_from_the_area():
+    from filletfold.mesh.coarsen import coarse_target
+
+    mesh, _ = load_mesh("blob")
+    assert coarse_target(mesh) is None and coarse_target(mesh, faces=50) == 50
+    length = 2 * mesh.mean_edge_length
+    want = round(float(mesh.face_area.sum()) / (np.sqrt(3) / 4 * length**2))
+    assert coarse_target(mesh, edge_length="200%") == coarse_target(mesh, edge_length=length)
+    assert coarse_target(mesh, edge_length=length) == want
+    assert coarse_target(mesh, edge_length=1e6) == 4  # at least a tetrahedron's
+    with pytest.raises(ParameterError, match="not both"):
+        coarse_target(mesh, faces=50, edge_length=length)
+    with pytest.raises(ParameterError, match="edge length"):
+        coarse_target(mesh, edge_length="-3%")
+    design = filletfold.round_mesh("blob", edge_length="200%")
+    assert design.coarsening.faces_after <= want

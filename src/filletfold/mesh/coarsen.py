@@ -13,6 +13,7 @@ again.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,7 +21,13 @@ import numpy as np
 from ..errors import ParameterError
 from .polymesh import PolyMesh, mesh_size
 
-__all__ = ["Coarsening", "coarsen_mesh", "surface_distance", "triangles_of"]
+__all__ = [
+    "Coarsening",
+    "coarse_target",
+    "coarsen_mesh",
+    "surface_distance",
+    "triangles_of",
+]
 
 #: Fewest triangles :func:`coarsen_mesh` takes as a target (a tetrahedron).
 MIN_FACES = 4
@@ -70,6 +77,29 @@ class Coarsening:
             f"{self.vertices_before:,} -> {self.vertices_after:,} vertices; the surface moved "
             f"by at most {self.distance:.4g} ({rel:.2g} % of the size) at the vertices"
         )
+
+
+def coarse_target(mesh: PolyMesh, faces=None, edge_length=None) -> int | None:
+    """The triangle count :func:`coarsen_mesh` aims for: ``faces``, or the count of
+    equilateral triangles of side ``edge_length`` (a length, or ``"300%"`` of the mean edge
+    length) that cover the mesh's area; None when neither is given.
+
+    Raises
+    ------
+    ParameterError
+        Both given, or a length that is not a positive length.
+    """
+    if faces is not None and edge_length is not None:
+        raise ParameterError(
+            "give faces (--faces) or edge_length (--edge-length), not both", name="edge_length"
+        )
+    if edge_length is None:
+        return faces
+    from ..parameters import parse_length
+
+    length = float(parse_length(edge_length, mesh.mean_edge_length, "edge length"))
+    area = float(np.sum(mesh.face_area))
+    return max(MIN_FACES, round(area / (math.sqrt(3.0) / 4.0 * length**2)))
 
 
 def triangles_of(mesh: PolyMesh) -> np.ndarray:
