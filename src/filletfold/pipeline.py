@@ -28,7 +28,7 @@ from __future__ import annotations
 import contextlib
 import copy
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -262,7 +262,8 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
             _stage("coarsening the mesh")
             v, t, coarsening = coarsen_mesh(pm, target)
             pm, log = load_mesh((v, t), coplanar_deg=params.coplanar_deg, strict=params.strict)
-            clean_log.repairs.extend(log.repairs)
+            for r in log.repairs:  # named by the coarsened mesh's elements
+                clean_log.repairs.append(replace(r, where=f"{r.where} of the coarsened mesh"))
         shift = far_offset(pm.vertices)
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)

@@ -117,6 +117,7 @@ def test_round_with_faces_designs_the_coarse_mesh_and_reports_it(tmp_path):
     assert 0 < c["relative_hausdorff"] < 0.1
     assert report["parameters"]["faces"] == 120
     assert report["certificate"]["ok"]
+    assert not any("coarsened" in r["where"] for r in report["repairs"])  # a clean result
     design = filletfold.round_mesh("blob")
     assert design.coarsening is None  # not coarsened by default
 
