@@ -52,8 +52,9 @@ def test_arc_step_sets_the_points_per_arc(tmp_path):
     """--arc-step is recorded in the report; a finer step (or 0) gives more pattern faces."""
     faces = {}
     for step in ("0", "1.5", "6"):
-        out = tmp_path / f"blob-{step}"
-        args = ["round", "blob", "--arc-step", step, "--chord-tol", "0", "--format", "fold,json"]
+        out = tmp_path / f"sphere-{step}"
+        args = ["round", "geodesic-sphere", "--arc-step", step, "--chord-tol", "0"]
+        args += ["--format", "fold,json"]
         args += ["-o", str(out)]
         assert main(args) == 0
         report = json.loads((out / "report.json").read_text())

@@ -82,7 +82,13 @@ def test_every_example_gives_the_modules_of_the_oracle(name):
     compare(d, d.stages.samples)
 
 
-@pytest.mark.parametrize(("samples", "arc_step"), [(24, 1.5), (24, 0.0), (3, 1.5), (3, 0.0)])
+#: The default sampling runs in the fast tier, the others (7 s) in the slow one.
+SAMPLINGS = [(24, 1.5)] + [
+    pytest.param(*c, marks=pytest.mark.slow) for c in [(24, 0.0), (3, 1.5), (3, 0.0)]
+]
+
+
+@pytest.mark.parametrize(("samples", "arc_step"), SAMPLINGS)
 def test_geodesic_sphere_and_random_convex(samples, arc_step):
     designs = [
         design_of("geodesic-sphere:level=2", samples=samples, arc_step=arc_step, sharp="none")

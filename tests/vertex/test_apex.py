@@ -204,7 +204,11 @@ def test_solved_apices_match_reference(name, with_centres):
                  want[::-1])  # fmt: skip
 
 
-def test_perturbed_apices_match_reference():
+@pytest.mark.parametrize(
+    "n_samples",
+    [9, pytest.param(65, marks=pytest.mark.slow)],  # 65: 3 s of reference checks
+)
+def test_perturbed_apices_match_reference(n_samples):
     """Apices that fail every kind of condition; the failing lists, in order, and margins."""
     seen = set()
     for name in EXAMPLES:
@@ -212,16 +216,15 @@ def test_perturbed_apices_match_reference():
         for seed, how in enumerate(["jitter", "far", "mirror", "deep"]):
             Vp, vp = _perturbed(frames, V, v, sigma, how, seed)
             for c in (None, centres):
-                for n_samples in (65, 9):
-                    got = validate_apices(frames, Vp, vp, sigma, n_samples, centres=c)
-                    want = [
-                        _reference_validate(f, Vp[j], vp[j], sigma[j], n_samples, centres=c)
-                        for j, f in enumerate(frames)
-                    ]
-                    _assert_same(got, want)
-                    for w in want:
-                        seen.update(k for k, text in KINDS.items() for f in w.failing
-                                    if f.startswith(text))  # fmt: skip
+                got = validate_apices(frames, Vp, vp, sigma, n_samples, centres=c)
+                want = [
+                    _reference_validate(f, Vp[j], vp[j], sigma[j], n_samples, centres=c)
+                    for j, f in enumerate(frames)
+                ]
+                _assert_same(got, want)
+                for w in want:
+                    seen.update(k for k, text in KINDS.items() for f in w.failing
+                                if f.startswith(text))  # fmt: skip
     assert seen == set(KINDS) - {"chord"}  # the chord plane is only sampled in the solve
 
 
