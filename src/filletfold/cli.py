@@ -46,7 +46,7 @@ from .defaults import (
     DEFAULT_SAMPLES,
     DEFAULT_SHARP,
 )
-from .errors import FilletfoldError, InternalError, one_line, watching_stages
+from .errors import FilletfoldError, InternalError, ParameterError, one_line, watching_stages
 from .memory import limit_arenas
 from .tolerances import tol
 
@@ -199,6 +199,7 @@ ROUND_PARAMETERS = {
     "nest": "nest",
     "faces": "faces",
     "edge_length": "edge_length",
+    "size": "size",
 }
 
 
@@ -217,6 +218,10 @@ def _round_parameters(ctx: typer.Context, from_report: Path | None):
         if source_of is not None and source_of.name == "COMMANDLINE":
             value = ctx.params[option]
             given[name] = not value if option == "no_tabs" else value
+    if "scale" in given and "size" in given:
+        raise ParameterError("give --size or --scale, not both", name="size")
+    if "scale" in given:  # a scale given now replaces a size the report had
+        given["size"] = None
     return base.replace(**given), source
 
 
@@ -392,6 +397,16 @@ def round_cmd(
     formats: FormatOption = None,
     units: UnitsOption = "",
     scale: ScaleOption = None,
+    size: Annotated[
+        str | None,
+        typer.Option(
+            "--size",
+            help="The object's size: its mesh's largest side becomes this long (300mm, 30cm, "
+            "12in; a bare number is mm). Sets --units (the size's unit unless given) and "
+            "--scale for the cut files and sheets; not with --scale.",
+            show_default=False,
+        ),
+    ] = None,
     sheet: SheetOption = None,
     preset: PresetOption = None,
     view: ViewOption = None,
@@ -487,8 +502,8 @@ def round_cmd(
             design,
             target,
             formats=chosen,
-            units=params.units,
-            scale=params.scale,
+            units=design.params.units,  # with --size, those the mesh's extent gave
+            scale=design.params.scale,
             page=params.sheet or "A4",
             preset=preset,
             view=view,

@@ -52,6 +52,7 @@ _JSON_TYPES = {
     "nest": ("string",),
     "faces": ("integer", "null"),
     "edge_length": ("number", "string", "null"),
+    "size": ("number", "string", "null"),
 }
 
 
@@ -150,6 +151,12 @@ class Parameters:
         Coarsen instead to the count of equilateral triangles of this side (a length, or
         ``"300%"`` of the mean edge length) that cover the mesh's area
         (:func:`~filletfold.mesh.coarsen.coarse_target`); not with ``faces``.
+    size : str, float or None
+        The physical size of the object: its mesh's largest bounding-box side becomes this
+        length (``"300mm"``, ``"30cm"``, ``"12in"``; a bare number is mm,
+        :func:`~filletfold.units.parse_size`). The design then has ``units`` (the size's unit
+        unless given) and ``scale`` derived from it (:func:`sized`): the cut files and sheets
+        are at that size.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -172,6 +179,7 @@ class Parameters:
     nest: str = "shelf"
     faces: int | None = None
     edge_length: object = None
+    size: object = None
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:
@@ -286,6 +294,10 @@ class Parameters:
                 f"coplanar tolerance must be in [0, 90) degrees, got {self.coplanar_deg!r}",
                 name="coplanar_deg",
             )
+        if self.size is not None:
+            from .units import parse_size
+
+            parse_size(self.size)
         if self.sheet is not None:  # a bad sheet, before the solve
             sheet_in_pattern_units(self.sheet, self.sheet_units, self.sheet_scale)
         resolve_chord_tol(self.chord_tol, 1.0)
@@ -513,3 +525,24 @@ def resolve_depth(depth, reference: float, n: int):
         return out
     d = parse_length(depth, reference, "depth", count=n)
     return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
+
+
+def sized(params: Parameters, extent: float) -> Parameters:
+    """``params`` with ``units`` and ``scale`` derived from ``size`` for a mesh whose largest
+    bounding-box side is ``extent`` (unchanged without ``size``): the units are ``units``, or
+    the size's own unit; the scale makes ``extent`` pattern units ``size`` long.
+
+    Raises
+    ------
+    ParameterError
+        For a bad size, or a mesh of no extent.
+    """
+    from .units import MM_PER_UNIT, parse_size
+
+    if params.size is None:
+        return params
+    mm, unit = parse_size(params.size)
+    if not extent > 0:
+        raise ParameterError("size needs a mesh of some extent", name="size")
+    units = params.units or unit
+    return params.replace(units=units, scale=mm / MM_PER_UNIT[units] / extent)

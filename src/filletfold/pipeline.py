@@ -40,7 +40,7 @@ from .layout.arrange import arrange
 from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_mesh
 from .mesh.polymesh import PolyMesh, mesh_size
-from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth
+from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth, sized
 from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
@@ -268,6 +268,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)
     size, strict = mesh_size(pm), params.strict
+    params = sized(params, float(np.ptp(pm.vertices, axis=0).max(initial=0.0)))
     return Job(
         params=params,
         mesh=pm,

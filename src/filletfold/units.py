@@ -22,6 +22,7 @@ __all__ = [
     "MM_PER_UNIT",
     "SHEET_SIZES_MM",
     "check_units",
+    "parse_size",
     "sheet_size_mm",
 ]
 
@@ -40,6 +41,7 @@ MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "pt": 25.4 / 72.0
 CUT_FILE_UNITS = ("mm", "cm", "m", "in")
 
 _NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
+_SIZE = re.compile(rf"\s*{_NUMBER}\s*(mm|cm|m|in)?\s*")
 _CUSTOM = re.compile(rf"\s*{_NUMBER}\s*[xX×]\s*{_NUMBER}\s*(?:mm)?\s*")
 
 
@@ -110,3 +112,26 @@ def check_units(units: str, choices: Iterable[str] = CUT_FILE_UNITS, *, unitless
         return units
     listed = ", ".join(choices) + (" or '' (unitless)" if unitless else "")
     raise ParameterError(f"units must be one of {listed}, got {units!r}", name="units")
+
+
+def parse_size(size) -> tuple[float, str]:
+    """A physical length such as ``"300mm"``, ``"30 cm"``, ``"0.3m"`` or ``"12in"`` (a bare
+    number is millimetres): its value in millimetres and the unit it was written in.
+
+    Raises
+    ------
+    ParameterError
+        Not a positive number with one of the units of :data:`CUT_FILE_UNITS`.
+    """
+    if isinstance(size, bool) or not isinstance(size, str | int | float):
+        raise ParameterError(f"size must be a length such as '300mm', got {size!r}", name="size")
+    m = _SIZE.fullmatch(str(size))
+    value = float(m.group(1)) if m else float("nan")
+    if not (m and math.isfinite(value) and value > 0):
+        raise ParameterError(
+            f"size must be a positive length with a unit of {', '.join(CUT_FILE_UNITS)} "
+            f"(e.g. '300mm'), got {size!r}",
+            name="size",
+        )
+    unit = m.group(2) or "mm"
+    return value * MM_PER_UNIT[unit], unit

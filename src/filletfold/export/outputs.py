@@ -12,6 +12,7 @@ from ..errors import named_stages
 from ..layout.tabs import assembly_text
 from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
+from ..surface.pattern import face_arrays
 from ..tolerances import tol
 from . import report_json, write_outputs
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
@@ -365,6 +366,26 @@ MANY_PIECES = 1000
 COARSE_FACES = 2000
 
 
+def _size_line(design) -> str:
+    """The summary's line for ``size``: the scale it gave and the smallest piece at it (the
+    longer side of its bounding box in the pattern)."""
+    p, pat = design.params, design.pattern
+    flat, start = face_arrays(pat.faces)
+    piece = np.repeat(np.asarray(pat.face_piece), np.diff(start))
+    xy = pat.vertices_2d[flat]
+    n = int(pat.n_pieces)
+    lo = np.full((n, 2), np.inf)
+    hi = np.full((n, 2), -np.inf)
+    np.minimum.at(lo, piece, xy)
+    np.maximum.at(hi, piece, xy)
+    across = (hi - lo).max(axis=1)
+    smallest = float(across[np.isfinite(across)].min(initial=np.inf)) * float(p.scale)
+    return (
+        f"size: {p.size} (the mesh's largest side): 1 unit = {float(p.scale):.4g} {p.units}; "
+        f"the smallest piece spans {smallest:.3g} {p.units}"
+    )
+
+
 def design_summary(design, max_listed: int = 8) -> str:
     """A few lines for the terminal (at most ``max_listed`` vertices that are not ok)."""
     mesh = design.mesh
@@ -405,6 +426,8 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"max edge mismatch {mismatch.max(initial=0.0):.2e} "
         f"(relative {relative.max(initial=0.0):.2e})"
     )
+    if design.params.size is not None:
+        lines.append(_size_line(design))
     if design.coarsening is None and pat.n_pieces > MANY_PIECES:
         lines.append(
             f"  {pat.n_pieces} pieces are more than a person cuts: --faces N coarsens the mesh "

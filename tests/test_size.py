@@ -1,0 +1,72 @@
+"""``--size``: the object's physical size sets the drawing units and scale."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import filletfold
+from filletfold.cli import main
+from filletfold.errors import ParameterError
+from filletfold.parameters import Parameters, sized
+from filletfold.units import parse_size
+
+
+@pytest.mark.parametrize(
+    ("text", "mm", "unit"),
+    [
+        ("300mm", 300.0, "mm"),
+        ("30 cm", 300.0, "cm"),
+        ("0.3m", 300.0, "m"),
+        ("12in", 304.8, "in"),
+        ("250", 250.0, "mm"),
+        (120, 120.0, "mm"),
+    ],
+)
+def test_a_size_is_a_length_with_a_unit(text, mm, unit):
+    assert parse_size(text) == (pytest.approx(mm), unit)
+
+
+@pytest.mark.parametrize("text", ["3ft", "-1mm", "0", "0mm", "", "mm", True, None, "1e400mm"])
+def test_a_bad_size_is_refused_naming_it(text):
+    with pytest.raises(ParameterError, match="size"):
+        parse_size(text)
+
+
+def test_sized_derives_units_and_scale_from_the_extent():
+    assert sized(Parameters(), 2.0) == Parameters()  # no size: unchanged
+    p = sized(Parameters(size="300mm"), 2.0)
+    assert (p.units, p.scale) == ("mm", pytest.approx(150.0))
+    p = sized(Parameters(size="300mm", units="cm"), 2.0)
+    assert (p.units, p.scale) == ("cm", pytest.approx(15.0))
+    p = sized(Parameters(size="12in"), 3.0)
+    assert (p.units, p.scale) == ("in", pytest.approx(4.0))
+
+
+def test_a_sized_design_has_the_size_and_says_so():
+    design = filletfold.round_mesh("icosahedron", size="30cm")
+    extent = float(np.ptp(design.mesh.vertices, axis=0).max())
+    assert design.params.units == "cm"
+    assert design.params.scale * extent == pytest.approx(30.0)
+    line = next(x for x in design.summary().splitlines() if x.startswith("size: 30cm"))
+    assert "1 unit = 18.54 cm" in line and "the smallest piece spans" in line
+
+
+def test_round_with_size_writes_the_cut_files_at_that_size(tmp_path):
+    out = tmp_path / "ico"
+    args = ["round", "icosahedron", "--size", "300mm", "-q", "-f", "svg,json", "-o", str(out)]
+    assert main(args) == 0
+    report = json.loads((out / "report.json").read_text())
+    p = report["parameters"]
+    assert (p["size"], p["units"]) == ("300mm", "mm")
+    assert p["scale"] == pytest.approx(300.0 / ((1 + 5**0.5) / 2), rel=1e-12)  # extent phi
+    svg = (out / "pattern.svg").read_text()
+    assert 'mm" height="' in svg  # a drawing in millimetres
+
+
+def test_size_and_scale_together_are_refused_in_one_line(capsys):
+    assert main(["round", "cube", "--size", "300mm", "--scale", "2", "--dry-run"]) != 0
+    err = capsys.readouterr().err
+    assert "--size or --scale" in err and "Traceback" not in err
