@@ -417,6 +417,15 @@ def test_server_answers_and_stops():
         app.request_load("bad.obj", b"v 1 2\nf 1 2 3\n")
         assert _wait_for(lambda: "error" in app.status)
         assert "bad.obj: line 1" in app.status and app.session.design is design
+
+        # coarsening in the worker: the status says what it did
+        app.request_load("blob")
+        assert _wait_for(lambda: app.status.startswith("**blob**"))
+        app.request_coarsen(120)
+        assert _wait_for(lambda: "coarsened: 320 -> " in app.status)
+        assert app.session.mesh.n_faces <= 120
+        app.request_coarsen(None)
+        assert _wait_for(lambda: "coarsened" not in app.status and "blob**" in app.status)
     finally:
         app.stop()
     with pytest.raises(OSError):
@@ -554,3 +563,34 @@ def test_the_download_keeps_every_parameter_of_the_shown_design():
     assert json.loads(files["report.json"])["fabrication"]["tabs"] > 0
     fold = json.loads(files["design.fold"])
     assert len(fold["vertices_coords"]) >= len(shown.pattern.vertices_2d)
+
+
+def test_coarsen_designs_the_loaded_mesh_with_fewer_triangles_and_back():
+    s = AppSession()
+    s.load("geodesic-sphere:level=3")  # 642 vertices, 1280 triangles
+    loaded = s.mesh
+    s.set_vertex_depth(5, "40%")
+    design = s.coarsen(200)
+    assert s.loaded is loaded and s.mesh is not loaded
+    assert s.coarsening.faces_before == 1280 and s.coarsening.faces_after <= 200
+    assert design.mesh.n_vertices == s.coarsening.vertices_after < 642
+    assert s.vertex_depth == {}  # the vertices are new
+    again = s.coarsen(100)  # from the loaded mesh, not from the coarse one
+    assert s.coarsening.faces_before == 1280 and again.mesh.n_faces <= 100
+    back = s.coarsen(None)
+    assert s.mesh is loaded and s.coarsening is None and back.mesh.n_vertices == 642
+    s.recompute()  # a slider change after a coarsening designs the coarse mesh
+    s.coarsen(150)
+    n = s.mesh.n_vertices
+    s.set_params(radius="5%")
+    assert s.recompute().mesh.n_vertices == n
+
+
+def test_coarsen_errors_keep_the_design():
+    s = AppSession()
+    with pytest.raises(MeshReadError, match="no mesh"):
+        s.coarsen(100)
+    design = s.load("cube")
+    with pytest.raises(ParameterError, match="faces"):
+        s.coarsen(2)
+    assert s.design is design and s.coarsening is None

@@ -14,6 +14,7 @@ computes, the panel shows the stage and a progress bar.
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import logging
 import threading
@@ -135,9 +136,17 @@ class AppServer:
         """Ask the worker to load an example or an uploaded file (replacing any load not yet
         started)."""
         with self._wake:
-            self._upload = (source, content)
+            self._upload = functools.partial(self.session.load, source, content)
             self._wake.notify_all()
         self._set_status(f"loading {source}…")
+
+    def request_coarsen(self, faces: int | None) -> None:
+        """Ask the worker to design the loaded mesh coarsened to about ``faces`` triangles
+        (None: as loaded), replacing any load not yet started."""
+        with self._wake:
+            self._upload = functools.partial(self.session.coarsen, faces)
+            self._wake.notify_all()
+        self._set_status(f"coarsening to {faces} triangles…" if faces else "the loaded mesh again…")
 
     def wait_drawn(self, design_id: int, timeout: float = 30.0) -> bool:
         """Wait until the scene shows design ``design_id`` or a newer one.
@@ -179,7 +188,7 @@ class AppServer:
             try:
                 if upload is not None:
                     self._phase = "load"
-                    self.session.load(upload[0], upload[1], progress=self._report_progress)
+                    upload(progress=self._report_progress)  # a load, or a coarsening
                     self._after_load()
                 if dirty:
                     self._phase = "recompute"
@@ -248,6 +257,8 @@ class AppServer:
             self._upload_button = gui.add_upload_button(
                 "Upload mesh (OBJ/OFF/PLY/STL, ≤ 50 MB)", icon=None
             )
+            self._faces = gui.add_number("Coarsen to triangles (0: as loaded)", 0, min=0, step=100)
+            self._coarsen_button = gui.add_button("Coarsen")
         with gui.add_folder("Parameters"):
             self._radius = gui.add_slider("Radius (% edge)", 1.0, 50.0, 0.5, DEFAULT_RADIUS_PERCENT)
             self._depth = gui.add_slider("Depth (% edge)", 1.0, 150.0, 1.0, DEFAULT_DEPTH_PERCENT)
@@ -275,6 +286,11 @@ class AppServer:
         def _(event) -> None:
             f = event.target.value
             self.request_load(f.name, f.content)
+
+        @self._coarsen_button.on_click
+        def _(_event) -> None:
+            faces = int(self._faces.value)
+            self.request_coarsen(faces if faces > 0 else None)
 
         for handle in (
             self._radius,
@@ -462,9 +478,11 @@ class AppServer:
             shown = (
                 f", pattern drawn at {arrays.pattern_scale:.0%}" if arrays.pattern_scale < 1 else ""
             )
+            coarse = self.session.coarsening
             self._set_status(
                 f"**{design.source}**: {len(design.mesh.vertices)} vertices ({counts}), "
                 f"{len(design.pattern.faces)} pattern faces{shown}  \n{params_text(design.params)}"
+                + (f"  \n{coarse.summary()}" if coarse is not None else "")
             )
             n = len(design.mesh.vertices)
             self._vertex.max = max(n - 1, 0)

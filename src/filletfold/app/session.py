@@ -29,6 +29,7 @@ from ..export.outputs import mesh_fold_keys, summary_records
 from ..export.report import report_json
 from ..layout.tabs import assembly_text
 from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
+from ..mesh.coarsen import Coarsening, coarsen_mesh
 from ..mesh.polymesh import PolyMesh
 from ..parameters import Parameters
 
@@ -151,6 +152,10 @@ class AppSession:
         The newest design computed.
     design_id : int
         Request id of ``design`` (0 before the first).
+    loaded : PolyMesh or None
+        The mesh as loaded: :meth:`coarsen` always starts from it.
+    coarsening : Coarsening or None
+        What :meth:`coarsen` did to ``loaded`` to give ``mesh`` (None: ``mesh`` is ``loaded``).
     """
 
     def __init__(
@@ -163,6 +168,8 @@ class AppSession:
         material_loss: bool = False,
     ):
         self.mesh: PolyMesh | None = None
+        self.loaded: PolyMesh | None = None
+        self.coarsening: Coarsening | None = None
         self.name = ""
         self.params = Parameters(
             radius=radius,
@@ -283,6 +290,37 @@ class AppSession:
                 )
             mesh, _ = load_mesh(str(source) if isinstance(source, str) else path)
             name = str(source) if not path.exists() else path.name
+        return self._design_mesh(mesh, name, progress, loaded=mesh, coarsening=None)
+
+    def coarsen(self, faces: int | None, *, progress=None) -> Design:
+        """Design the loaded mesh coarsened to about ``faces`` triangles (quadric decimation,
+        :func:`~filletfold.mesh.coarsen.coarsen_mesh`), or the loaded mesh itself with
+        ``None``; the per-vertex depths are cleared (the vertices are new). On any error the
+        current design stays.
+
+        Returns
+        -------
+        Design
+            The new current design; :attr:`coarsening` says what the coarsening did.
+
+        Raises
+        ------
+        FilletfoldError
+            No mesh loaded, a bad count, or the design fails.
+        """
+        with self._lock:
+            loaded, name = self.loaded, self.name
+        if loaded is None:
+            raise MeshReadError("no mesh loaded")
+        if faces is None:
+            return self._design_mesh(loaded, name, progress, loaded=loaded, coarsening=None)
+        v, t, info = coarsen_mesh(loaded, faces)
+        mesh, _ = load_mesh((v, t))
+        return self._design_mesh(mesh, name, progress, loaded=loaded, coarsening=info)
+
+    def _design_mesh(self, mesh, name, progress, *, loaded, coarsening) -> Design:
+        """Make ``mesh`` current with its design (the per-vertex depths cleared), unless a
+        newer request's design is taken first; remember what it was loaded and coarsened as."""
         with self._lock:
             saved = self.vertex_depth
             self.vertex_depth = {}
@@ -294,6 +332,7 @@ class AppSession:
         with self._lock:
             if self.commit(request, design):
                 self.vertex_depth = {}
+                self.loaded, self.coarsening = loaded, coarsening
         return self.design
 
     def set_params(self, **kw) -> None:
