@@ -70,3 +70,32 @@ def test_size_and_scale_together_are_refused_in_one_line(capsys):
     assert main(["round", "cube", "--size", "300mm", "--scale", "2", "--dry-run"]) != 0
     err = capsys.readouterr().err
     assert "--size or --scale" in err and "Traceback" not in err
+
+
+def test_pieces_under_the_minimum_are_reported_and_warned_of():
+    from filletfold.export.outputs import MIN_PIECE_MM, piece_sizes_mm, piece_spans
+
+    plain = filletfold.round_mesh("icosahedron")
+    assert piece_sizes_mm(plain) is None  # no units: no physical size
+    assert not any("warning: " in x and " mm" in x for x in plain.summary().splitlines())
+    big = filletfold.round_mesh("icosahedron", units="cm", scale=10.0)
+    spans = piece_spans(big.pattern)
+    assert len(spans) == big.pattern.n_pieces and np.all(spans > 0)
+    sizes = piece_sizes_mm(big)
+    assert sizes["smallest_piece_mm"] == pytest.approx(spans.min() * 100.0)
+    assert sizes["pieces_under_min"] == 0 and sizes["min_piece_mm"] == MIN_PIECE_MM
+    tiny = filletfold.round_mesh("icosahedron", size="4mm")  # pieces of about 2.5 mm
+    sizes = piece_sizes_mm(tiny)
+    assert sizes["pieces_under_min"] == tiny.pattern.n_pieces == 12
+    assert sizes["smallest_piece_mm"] < MIN_PIECE_MM
+    assert "warning: 12 of 12 pieces span less than 3 mm" in tiny.summary()
+
+
+def test_the_report_gives_the_smallest_piece_at_the_drawing_size(tmp_path):
+    out = tmp_path / "cube"
+    assert main(["round", "cube", "--units", "mm", "--scale", "30", "-q", "-o", str(out)]) == 0
+    fab = json.loads((out / "report.json").read_text())["fabrication"]
+    assert fab["pieces_under_min"] == 0 and fab["smallest_piece_mm"] > 3.0
+    out = tmp_path / "plain"
+    assert main(["round", "cube", "-q", "-o", str(out)]) == 0
+    assert "smallest_piece_mm" not in json.loads((out / "report.json").read_text())["fabrication"]

@@ -14,6 +14,7 @@ from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
 from ..surface.pattern import face_arrays
 from ..tolerances import tol
+from ..units import MM_PER_UNIT
 from . import report_json, write_outputs
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .report import Records
@@ -311,12 +312,15 @@ def _vertex_records(res) -> Records:
 
 
 def _fabrication_report(design) -> dict:
-    """Pieces, glue tabs, and (with sheets) pieces per sheet and material use. The seams (one
-    record per cut border) are not repeated here: ``assembly.txt`` lists them."""
+    """Pieces, glue tabs, (with sheets) pieces per sheet and material use, and (with drawing
+    units) the smallest piece's span and the pieces under the minimum
+    (:func:`piece_sizes_mm`). The seams (one record per cut border) are not repeated here:
+    ``assembly.txt`` lists them."""
     out = {"pieces": int(design.pattern.n_pieces)}
     for k, v in design.fabrication.items():
         if k != "seams":
             out[k] = v if isinstance(v, list | dict) else int(v)
+    out.update(piece_sizes_mm(design) or {})
     return out
 
 
@@ -360,30 +364,65 @@ def relative_mismatch(pattern) -> np.ndarray:
     return _mismatches(pattern)[1]
 
 
+#: Pieces that span less than this on the sheet (mm) are too small to cut and fold: the
+#: summary warns (issue 29's default minimum).
+MIN_PIECE_MM = 3.0
 #: A design of more pieces gets a line in the summary suggesting ``--faces``.
 MANY_PIECES = 1000
 #: The triangle count that line suggests.
 COARSE_FACES = 2000
 
 
-def _size_line(design) -> str:
-    """The summary's line for ``size``: the scale it gave and the smallest piece at it (the
-    longer side of its bounding box in the pattern)."""
-    p, pat = design.params, design.pattern
-    flat, start = face_arrays(pat.faces)
-    piece = np.repeat(np.asarray(pat.face_piece), np.diff(start))
-    xy = pat.vertices_2d[flat]
-    n = int(pat.n_pieces)
-    lo = np.full((n, 2), np.inf)
-    hi = np.full((n, 2), -np.inf)
+def piece_spans(pattern) -> np.ndarray:
+    """(n_pieces,) the longer side of each piece's bounding box in the pattern (pattern
+    units; NaN for a piece without faces)."""
+    flat, start = face_arrays(pattern.faces)
+    piece = np.repeat(np.asarray(pattern.face_piece, dtype=np.int64), np.diff(start))
+    xy = pattern.vertices_2d[flat]
+    n = int(pattern.n_pieces)
+    lo, hi = np.full((n, 2), np.inf), np.full((n, 2), -np.inf)
     np.minimum.at(lo, piece, xy)
     np.maximum.at(hi, piece, xy)
-    across = (hi - lo).max(axis=1)
-    smallest = float(across[np.isfinite(across)].min(initial=np.inf)) * float(p.scale)
-    return (
-        f"size: {p.size} (the mesh's largest side): 1 unit = {float(p.scale):.4g} {p.units}; "
-        f"the smallest piece spans {smallest:.3g} {p.units}"
-    )
+    span = (hi - lo).max(axis=1)
+    return np.where(np.isfinite(span), span, np.nan)
+
+
+def piece_sizes_mm(design) -> dict | None:
+    """With drawing ``units`` (given, or from ``size``): the smallest piece's span and the
+    pieces that span less than :data:`MIN_PIECE_MM`, in millimetres on the sheet (the
+    report's ``fabrication.smallest_piece_mm`` and ``pieces_under_min``); None without units."""
+    p = design.params
+    if not p.units:
+        return None
+    mm = piece_spans(design.pattern) * p.sheet_scale * MM_PER_UNIT[p.units]
+    mm = mm[np.isfinite(mm)]
+    return {
+        "smallest_piece_mm": float(mm.min(initial=np.inf)) if len(mm) else None,
+        "pieces_under_min": int(np.count_nonzero(mm < MIN_PIECE_MM)),
+        "min_piece_mm": MIN_PIECE_MM,
+    }
+
+
+def _size_lines(design) -> list[str]:
+    """The summary's lines for the physical size: with ``size``, the scale it gave and the
+    smallest piece at it; with any units, a warning for pieces under :data:`MIN_PIECE_MM`."""
+    p, sizes = design.params, piece_sizes_mm(design)
+    if sizes is None:
+        return []
+    lines = []
+    smallest = sizes["smallest_piece_mm"]
+    if p.size is not None:
+        lines.append(
+            f"size: {p.size} (the mesh's largest side): 1 unit = {float(p.scale):.4g} {p.units}; "
+            f"the smallest piece spans {smallest:.3g} mm"
+        )
+    if sizes["pieces_under_min"]:
+        lines.append(
+            f"  warning: {sizes['pieces_under_min']} of {design.pattern.n_pieces} pieces span "
+            f"less than {MIN_PIECE_MM:g} mm (the smallest {smallest:.3g} mm), too small to cut "
+            "and fold: a larger --size, or fewer faces (--faces N)"
+        )
+    return lines
 
 
 def design_summary(design, max_listed: int = 8) -> str:
@@ -426,8 +465,7 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"max edge mismatch {mismatch.max(initial=0.0):.2e} "
         f"(relative {relative.max(initial=0.0):.2e})"
     )
-    if design.params.size is not None:
-        lines.append(_size_line(design))
+    lines += _size_lines(design)
     if design.coarsening is None and pat.n_pieces > MANY_PIECES:
         lines.append(
             f"  {pat.n_pieces} pieces are more than a person cuts: --faces N coarsens the mesh "
