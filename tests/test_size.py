@@ -99,3 +99,17 @@ def test_the_report_gives_the_smallest_piece_at_the_drawing_size(tmp_path):
     out = tmp_path / "plain"
     assert main(["round", "cube", "-q", "-o", str(out)]) == 0
     assert "smallest_piece_mm" not in json.loads((out / "report.json").read_text())["fabrication"]
+
+
+def test_labels_too_low_to_read_are_warned_of():
+    from filletfold.export.outputs import MIN_LABEL_MM, piece_sizes_mm
+
+    small = filletfold.round_mesh("icosahedron", size="40mm")
+    label = piece_sizes_mm(small)["smallest_label_mm"]
+    assert 0 < label < MIN_LABEL_MM
+    assert f"warning: labels {label:.3g} mm high" in small.summary()
+    large = filletfold.round_mesh("icosahedron", size="300mm")
+    assert piece_sizes_mm(large)["smallest_label_mm"] == pytest.approx(label * 300 / 40)
+    assert "warning: labels" not in large.summary()
+    bare = filletfold.round_mesh("icosahedron", size="40mm", tabs=False)  # part numbers only
+    assert piece_sizes_mm(bare)["smallest_label_mm"] is None or "warning: labels" in bare.summary()

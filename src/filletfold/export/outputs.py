@@ -12,7 +12,7 @@ from ..errors import named_stages
 from ..layout.tabs import assembly_text
 from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
-from ..surface.pattern import face_arrays
+from ..surface.pattern import LabelRows, face_arrays
 from ..tolerances import tol
 from ..units import MM_PER_UNIT
 from . import report_json, write_outputs
@@ -367,6 +367,8 @@ def relative_mismatch(pattern) -> np.ndarray:
 #: Pieces that span less than this on the sheet (mm) are too small to cut and fold: the
 #: summary warns (issue 29's default minimum).
 MIN_PIECE_MM = 3.0
+#: Labels lower than this on the sheet (mm) are hard to read: the summary warns.
+MIN_LABEL_MM = 2.0
 #: A design of more pieces gets a line in the summary suggesting ``--faces``.
 MANY_PIECES = 1000
 #: The triangle count that line suggests.
@@ -389,17 +391,23 @@ def piece_spans(pattern) -> np.ndarray:
 
 def piece_sizes_mm(design) -> dict | None:
     """With drawing ``units`` (given, or from ``size``): the smallest piece's span and the
-    pieces that span less than :data:`MIN_PIECE_MM`, in millimetres on the sheet (the
-    report's ``fabrication.smallest_piece_mm`` and ``pieces_under_min``); None without units."""
+    pieces that span less than :data:`MIN_PIECE_MM`, and the lowest label, in millimetres on
+    the sheet (the report's ``fabrication.smallest_piece_mm``, ``pieces_under_min``,
+    ``smallest_label_mm``); None without units."""
     p = design.params
     if not p.units:
         return None
-    mm = piece_spans(design.pattern) * p.sheet_scale * MM_PER_UNIT[p.units]
+    mm_per = p.sheet_scale * MM_PER_UNIT[p.units]
+    mm = piece_spans(design.pattern) * mm_per
     mm = mm[np.isfinite(mm)]
+    labels = design.pattern.annotations.labels
+    heights = np.abs(np.asarray(LabelRows.of(labels).height if len(labels) else [], dtype=float))
+    heights = heights[np.isfinite(heights) & (heights > 0)] * mm_per
     return {
         "smallest_piece_mm": float(mm.min(initial=np.inf)) if len(mm) else None,
         "pieces_under_min": int(np.count_nonzero(mm < MIN_PIECE_MM)),
         "min_piece_mm": MIN_PIECE_MM,
+        "smallest_label_mm": float(heights.min()) if len(heights) else None,
     }
 
 
@@ -415,6 +423,12 @@ def _size_lines(design) -> list[str]:
         lines.append(
             f"size: {p.size} (the mesh's largest side): 1 unit = {float(p.scale):.4g} {p.units}; "
             f"the smallest piece spans {smallest:.3g} mm"
+        )
+    label = sizes["smallest_label_mm"]
+    if label is not None and label < MIN_LABEL_MM:
+        lines.append(
+            f"  warning: labels {label:.3g} mm high, under {MIN_LABEL_MM:g} mm: hard to read "
+            "(a larger --size)"
         )
     if sizes["pieces_under_min"]:
         lines.append(
