@@ -113,3 +113,18 @@ def test_labels_too_low_to_read_are_warned_of():
     assert "warning: labels" not in large.summary()
     bare = filletfold.round_mesh("icosahedron", size="40mm", tabs=False)  # part numbers only
     assert piece_sizes_mm(bare)["smallest_label_mm"] is None or "warning: labels" in bare.summary()
+
+
+def test_a_nearly_flat_mesh_is_warned_of_and_nets_join_it():
+    from filletfold.export.outputs import FLAT_RATIO, thickness_ratio
+
+    square = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    assert thickness_ratio(square) == 0.0
+    assert thickness_ratio(np.vstack([square, [[0.5, 0.5, 0.01]]])) == pytest.approx(0.01)
+    flat = filletfold.round_mesh("miura:4x4,fold=0.05")
+    assert thickness_ratio(flat.mesh.vertices) < FLAT_RATIO
+    assert "warning: the mesh is nearly flat" in flat.summary()
+    joined = filletfold.round_mesh("miura:4x4,fold=0.05", layout="net")
+    assert joined.pattern.n_pieces < flat.pattern.n_pieces
+    assert "nearly flat" not in joined.summary()
+    assert "nearly flat" not in filletfold.round_mesh("miura").summary()  # folded: 16 %

@@ -367,6 +367,9 @@ def relative_mismatch(pattern) -> np.ndarray:
 #: Pieces that span less than this on the sheet (mm) are too small to cut and fold: the
 #: summary warns (issue 29's default minimum).
 MIN_PIECE_MM = 3.0
+#: A mesh thinner than this share of its length is nearly flat: the summary warns that its
+#: modules could be far fewer pieces.
+FLAT_RATIO = 0.02
 #: Labels lower than this on the sheet (mm) are hard to read: the summary warns.
 MIN_LABEL_MM = 2.0
 #: A design of more pieces gets a line in the summary suggesting ``--faces``.
@@ -439,6 +442,16 @@ def _size_lines(design) -> list[str]:
     return lines
 
 
+def thickness_ratio(points: np.ndarray) -> float:
+    """The extent of ``points`` (k, 3) along their least principal axis over the extent along
+    the largest (0: flat, 1: as thick as long)."""
+    p = np.asarray(points, dtype=np.float64)
+    p = p - p.mean(axis=0)
+    _, _, axes = np.linalg.svd(p, full_matrices=False)
+    extent = np.ptp(p @ axes.T, axis=0)
+    return float(extent[-1] / extent[0]) if len(extent) == 3 and extent[0] > 0 else 0.0
+
+
 def design_summary(design, max_listed: int = 8) -> str:
     """A few lines for the terminal (at most ``max_listed`` vertices that are not ok)."""
     mesh = design.mesh
@@ -480,6 +493,12 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"(relative {relative.max(initial=0.0):.2e})"
     )
     lines += _size_lines(design)
+    thin = thickness_ratio(mesh.vertices)
+    if thin < FLAT_RATIO and pat.n_pieces > 1 and design.layout == "modules":
+        lines.append(
+            f"  warning: the mesh is nearly flat (its thickness is {100 * thin:.2g} % of its "
+            f"length): its {pat.n_pieces} pieces could be far fewer (--layout net joins them)"
+        )
     if design.coarsening is None and pat.n_pieces > MANY_PIECES:
         lines.append(
             f"  {pat.n_pieces} pieces are more than a person cuts: --faces N coarsens the mesh "
