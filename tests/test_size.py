@@ -128,3 +128,38 @@ def test_a_nearly_flat_mesh_is_warned_of_and_nets_join_it():
     assert joined.pattern.n_pieces < flat.pattern.n_pieces
     assert "nearly flat" not in joined.summary()
     assert "nearly flat" not in filletfold.round_mesh("miura").summary()  # folded: 16 %
+
+
+def test_cut_and_fold_lengths_and_areas():
+    from filletfold.export.outputs import cut_and_fold
+
+    bare = filletfold.round_mesh("cube", tabs=False)
+    p = bare.pattern
+    work = cut_and_fold(p)
+    length = np.linalg.norm(p.vertices_2d[p.edges[:, 0]] - p.vertices_2d[p.edges[:, 1]], axis=1)
+    assert work["cut_length"] == pytest.approx(length[p.edge_assignment == "B"].sum())
+    assert work["fold_length"] == pytest.approx(
+        length[np.isin(p.edge_assignment, ["M", "V"])].sum()
+    )
+    # the pattern is the folded form's development: the same area in 3D, up to what the chords
+    # across bent facets lose (a facet's diagonals are shorter folded than flat)
+    area3 = sum(
+        0.5
+        * np.linalg.norm(
+            sum(
+                np.cross(p.vertices_3d[f[k]], p.vertices_3d[f[(k + 1) % len(f)]])
+                for k in range(len(f))
+            )
+        )
+        for f in p.faces
+    )
+    assert work["piece_area"] == pytest.approx(area3, rel=1e-3)
+    assert "sheet_area" not in work
+    tabbed = cut_and_fold(filletfold.round_mesh("cube").pattern)
+    assert tabbed["cut_length"] > work["cut_length"] and tabbed["fold_length"] == pytest.approx(
+        work["fold_length"]
+    )
+    sheets = filletfold.round_mesh("cube", sheet="A4", units="mm", scale=30.0)
+    n = len(sheets.pattern.annotations.sheets)
+    assert cut_and_fold(sheets.pattern)["sheet_area"] == pytest.approx(n * 210 * 297 / 30**2)
+    assert "to make: " in sheets.summary() and " m² of sheets" in sheets.summary()

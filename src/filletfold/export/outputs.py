@@ -320,7 +320,48 @@ def _fabrication_report(design) -> dict:
     for k, v in design.fabrication.items():
         if k != "seams":
             out[k] = v if isinstance(v, list | dict) else int(v)
+    out.update(cut_and_fold(design.pattern))
     out.update(piece_sizes_mm(design) or {})
+    return out
+
+
+def cut_and_fold(pattern) -> dict:
+    """What a cutter and a folder do, in pattern units: ``cut_length`` (the pieces' borders,
+    less the tabs' hinges, plus the tabs' outlines less their hinges), ``fold_length`` (the
+    mountain and valley creases, the tabs' hinges not counted), ``piece_area`` (the pieces'
+    area in 2D: the folded form's, as the pattern is its development, up to what the chords
+    across bent facets lose: 8e-5 on the cube) and, with sheets, ``sheet_area`` (the
+    material the sheets take)."""
+    from .paths import point_rows
+
+    e = pattern.edges
+    length = np.linalg.norm(pattern.vertices_2d[e[:, 0]] - pattern.vertices_2d[e[:, 1]], axis=1)
+    cut = float(length[pattern.edge_assignment == "B"].sum())
+    fold = float(length[np.isin(pattern.edge_assignment, ["M", "V"])].sum())
+    ann = pattern.annotations
+    if len(ann.tabs):
+        pts, sizes = point_rows(ann.tabs)
+        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        nxt = np.arange(len(pts)) + 1
+        nxt[starts + sizes - 1] = starts  # each outline closed
+        cut += float(np.linalg.norm(pts[nxt] - pts, axis=1).sum())
+        hinge_pts, _ = point_rows(ann.tab_hinges)
+        hinge = hinge_pts.reshape(-1, 2, 2)
+        cut -= 2.0 * float(np.linalg.norm(hinge[:, 1] - hinge[:, 0], axis=1).sum())
+    flat, start = face_arrays(pattern.faces)
+    p = pattern.vertices_2d[flat]
+    nxt = np.arange(len(flat)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    twice = p[:, 0] * p[nxt, 1] - p[nxt, 0] * p[:, 1]
+    out = {
+        "cut_length": cut,
+        "fold_length": fold,
+        "piece_area": float(0.5 * twice.sum()),
+    }
+    sheets = np.asarray(ann.sheets, dtype=float).reshape(-1, 4)
+    if len(sheets):
+        w, h = sheets[:, 2] - sheets[:, 0], sheets[:, 3] - sheets[:, 1]
+        out["sheet_area"] = float((w * h).sum())
     return out
 
 
@@ -422,6 +463,16 @@ def _size_lines(design) -> list[str]:
         return []
     lines = []
     smallest = sizes["smallest_piece_mm"]
+    mm = p.sheet_scale * MM_PER_UNIT[p.units]
+    work = cut_and_fold(design.pattern)
+    line = (
+        f"to make: {work['cut_length'] * mm / 1000:.4g} m of cuts, "
+        f"{work['fold_length'] * mm / 1000:.4g} m of folds, "
+        f"{work['piece_area'] * mm * mm / 1e6:.4g} m² of pieces"
+    )
+    if "sheet_area" in work:
+        line += f" on {work['sheet_area'] * mm * mm / 1e6:.4g} m² of sheets"
+    lines.append(line)
     if p.size is not None:
         lines.append(
             f"size: {p.size} (the mesh's largest side): 1 unit = {float(p.scale):.4g} {p.units}; "
