@@ -101,18 +101,26 @@ def test_the_report_gives_the_smallest_piece_at_the_drawing_size(tmp_path):
     assert "smallest_piece_mm" not in json.loads((out / "report.json").read_text())["fabrication"]
 
 
-def test_labels_too_low_to_read_are_warned_of():
+def test_tabs_and_labels_have_a_physical_height_and_low_ones_are_warned_of():
     from filletfold.export.outputs import MIN_LABEL_MM, piece_sizes_mm
+    from filletfold.layout.arrange import TAB_MM
 
-    small = filletfold.round_mesh("icosahedron", size="40mm")
+    # with units, full tabs are TAB_MM on the sheet and labels 0.45 of them, at any size
+    for size in ("40mm", "300mm"):
+        design = filletfold.round_mesh("icosahedron", size=size)
+        # (label heights are written to 3 digits in pattern units)
+        assert piece_sizes_mm(design)["smallest_label_mm"] == pytest.approx(0.45 * TAB_MM, rel=5e-3)
+        assert "warning: labels" not in design.summary()
+    # a drawing too small for them: tabs at most half an edge, and the labels warned of
+    small = filletfold.round_mesh("icosahedron", size="4mm")
     label = piece_sizes_mm(small)["smallest_label_mm"]
-    assert 0 < label < MIN_LABEL_MM
+    edge_mm = small.mesh.mean_edge_length * small.params.scale
+    assert label == pytest.approx(0.45 * 0.5 * edge_mm, rel=5e-3) and label < MIN_LABEL_MM
     assert f"warning: labels {label:.3g} mm high" in small.summary()
-    large = filletfold.round_mesh("icosahedron", size="300mm")
-    assert piece_sizes_mm(large)["smallest_label_mm"] == pytest.approx(label * 300 / 40)
-    assert "warning: labels" not in large.summary()
-    bare = filletfold.round_mesh("icosahedron", size="40mm", tabs=False)  # part numbers only
-    assert piece_sizes_mm(bare)["smallest_label_mm"] is None or "warning: labels" in bare.summary()
+    # without units, as before: a share of the mean edge length
+    plain = filletfold.round_mesh("icosahedron")
+    heights = np.asarray(plain.pattern.annotations.labels.height)
+    assert heights.min() == pytest.approx(0.45 * 0.04 * plain.mesh.mean_edge_length, rel=5e-3)
 
 
 def test_a_nearly_flat_mesh_is_warned_of_and_nets_join_it():

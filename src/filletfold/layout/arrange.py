@@ -23,8 +23,25 @@ from .sheet import glue_pieces
 from .shelf import shelf_offsets
 from .tabs import add_tabs_and_labels
 
-#: Height of a glue tab, as a share of the mean edge length.
+#: Height of a glue tab, as a share of the mean edge length, in a drawing without units.
 TAB_HEIGHT = 0.04
+#: Height of a glue tab on the sheet (mm) when the drawing has units (``units``, or ``size``):
+#: the paper-craft flap; labels are 0.45 of it, 2.25 mm.
+TAB_MM = 5.0
+#: ... but at most this share of the mean edge length (a tiny drawing keeps tabs its edges
+#: can carry, and the summary warns of its labels).
+TAB_MAX = 0.5
+
+
+def tab_height(params, ref: float) -> float:
+    """The glue tabs' full height in pattern units: :data:`TAB_MM` on the sheet when the
+    drawing has units (at most :data:`TAB_MAX` of the mean edge length ``ref``), else
+    :data:`TAB_HEIGHT` of ``ref``."""
+    if not params.units:
+        return TAB_HEIGHT * ref
+    from ..units import MM_PER_UNIT
+
+    return min(TAB_MM / (MM_PER_UNIT[params.units] * params.sheet_scale), TAB_MAX * ref)
 
 
 def arrange(
@@ -105,7 +122,7 @@ def arrange(
             pieces, layout_used = [glued], "sheet"
         elif layout == "sheet":
             raise SolverError(f"the modules do not form one sheet: {layout_note}")
-    tab_h = TAB_HEIGHT * ref if tabs else 0.0
+    tab_h = tab_height(params, ref) if tabs else 0.0
     gap = 0.1 * ref + 2.5 * tab_h
     sheet_box = room = None
     if sheet is not None:
