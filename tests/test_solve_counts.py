@@ -62,7 +62,15 @@ def _counted(monkeypatch, path: Path):
     return design, design.fitting["apex_work"]
 
 
-@pytest.mark.parametrize("name", sorted(MEASURED))
+#: The fast tier bounds the fox's counts (a scan with infeasible cones, rescued and sharp
+#: vertices); the bunny's (4 s more) are bounded in the slow tier.
+CASES = [
+    pytest.param(name, marks=pytest.mark.slow) if name.startswith("meshio-bun") else name
+    for name in sorted(MEASURED)
+]
+
+
+@pytest.mark.parametrize("name", CASES)
 def test_apex_work_does_not_grow(monkeypatch, name):
     design, work = _counted(monkeypatch, CORPUS / name)
     problems, programmes, phase1 = MEASURED[name]
