@@ -154,3 +154,15 @@ def test_edge_length_sets_the_triangle_count_from_the_area():
         coarse_target(mesh, edge_length="-3%")
     design = filletfold.round_mesh("blob", edge_length="200%")
     assert design.coarsening.faces_after <= want
+
+
+def test_a_concave_polygon_is_triangulated_inside_itself():
+    """A merged coplanar region may be concave: a fan from this L's first corner would cover
+    4 instead of 3 (a triangle outside it), and the decimation would start from that."""
+    from filletfold.mesh.polymesh import PolyMesh
+
+    v = np.array([[2, 0, 0], [2, 1, 0], [1, 1, 0], [1, 2, 0], [0, 2, 0], [0, 0, 0]], float)
+    mesh = PolyMesh(v, [np.arange(6)])
+    p = v[triangles_of(mesh)]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    assert len(p) == 4 and area.sum() == pytest.approx(3.0) and np.all(area > 0)

@@ -103,14 +103,18 @@ def coarse_target(mesh: PolyMesh, faces=None, edge_length=None) -> int | None:
 
 
 def triangles_of(mesh: PolyMesh) -> np.ndarray:
-    """(t, 3) int: every face of ``mesh`` fanned into triangles from its first corner (the
-    cleaned mesh's polygons are planar and simple; a fan is exact for the convex ones, and
-    the quadric decimation only needs the planes and the connectivity)."""
+    """(t, 3) int: every face of ``mesh`` as triangles: triangles as they are, larger polygons
+    (a merged coplanar region may be concave) by
+    :func:`~filletfold.mesh.repair.triangulate_polygon_3d`, which stays inside them."""
+    from .repair import triangulate_polygon_3d
+
     out = []
     for f in mesh.faces:
         f = np.asarray(f, dtype=np.int64)
-        k = len(f)
-        out.append(np.column_stack([np.full(k - 2, f[0]), f[1:-1], f[2:]]))
+        if len(f) == 3:
+            out.append(f[None])
+        else:
+            out.append(f[np.array(triangulate_polygon_3d(mesh.vertices[f]), dtype=np.int64)])
     if not out:
         return np.zeros((0, 3), dtype=np.int64)
     return np.concatenate(out)
