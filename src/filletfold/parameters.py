@@ -315,6 +315,14 @@ class Parameters:
         """Drawing units per pattern unit when fitting sheets (``scale``, or 1)."""
         return 1.0 if self.scale is None else float(self.scale)
 
+    @property
+    def mm_per_unit(self) -> float:
+        """Millimetres on the sheet per pattern unit (``scale`` in ``units``; a unitless
+        drawing is read in mm, as sheets are)."""
+        from .units import MM_PER_UNIT
+
+        return self.sheet_scale * MM_PER_UNIT[self.sheet_units]
+
     def sharp_kinds(self) -> frozenset:
         """The kinds of cone-less vertices kept sharp (``"auto"`` resolved)."""
         from .vertex.sharpen import parse_sharp

@@ -28,7 +28,7 @@ from __future__ import annotations
 import contextlib
 import copy
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -38,7 +38,7 @@ from .errors import FilletfoldError, InternalError, SolverError, is_callers, one
 from .errors import stage as _stage
 from .layout.arrange import arrange
 from .mesh import load_mesh
-from .mesh.coarsen import Coarsening, coarse_target, coarsen_mesh
+from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
 from .mesh.polymesh import PolyMesh, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth, sized
 from .rounding.conical import conical_material_loss, is_conical
@@ -125,7 +125,7 @@ class Job:
     progress : callable
         ``progress(stage, done, total)``.
     coarsening : Coarsening or None
-        What coarsening the mesh did (``params.faces``), else None.
+        What coarsening the mesh did (``params.faces`` or ``params.edge_length``), else None.
     """
 
     params: Parameters
@@ -260,10 +260,10 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         coarsening, target = None, coarse_target(pm, params.faces, params.edge_length)
         if target is not None:  # decimated, then cleaned as any input (repairs kept)
             _stage("coarsening the mesh")
-            v, t, coarsening = coarsen_mesh(pm, target)
-            pm, log = load_mesh((v, t), coplanar_deg=params.coplanar_deg, strict=params.strict)
-            for r in log.repairs:  # named by the coarsened mesh's elements
-                clean_log.repairs.append(replace(r, where=f"{r.where} of the coarsened mesh"))
+            pm, repairs, coarsening = coarsen_and_clean(
+                pm, target, coplanar_deg=params.coplanar_deg, strict=params.strict
+            )
+            clean_log.repairs.extend(repairs)
         shift = far_offset(pm.vertices)
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)
@@ -637,13 +637,13 @@ def _build_modules(pm: PolyMesh, solved: list, centres, points, progress) -> lis
         raise  # every module built alone: the failure was in the batch (re-raise it)
 
 
-def _input_key(mesh, coplanar_deg, strict, faces=None) -> tuple | None:
+def _input_key(mesh, coplanar_deg, strict, coarse=None) -> tuple | None:
     """Hashable identity of a :func:`round_mesh` input and the options its cleaning (and
     coarsening) depends on, for a :class:`PolyMesh` (its vertices and faces by their bytes);
     None otherwise."""
     if not isinstance(mesh, PolyMesh):
         return None
-    return (*_mesh_key(mesh), repr(coplanar_deg), strict, repr(faces))
+    return (*_mesh_key(mesh), repr(coplanar_deg), strict, repr(coarse))
 
 
 def _stage_key(pm: PolyMesh, *params) -> tuple:

@@ -29,7 +29,7 @@ from ..export.outputs import mesh_fold_keys, summary_records
 from ..export.report import report_json
 from ..layout.tabs import assembly_text
 from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
-from ..mesh.coarsen import Coarsening, coarsen_mesh
+from ..mesh.coarsen import Coarsening, coarsen_and_clean
 from ..mesh.polymesh import PolyMesh
 from ..parameters import Parameters
 
@@ -314,8 +314,7 @@ class AppSession:
             raise MeshReadError("no mesh loaded")
         if faces is None:
             return self._design_mesh(loaded, name, progress, loaded=loaded, coarsening=None)
-        v, t, info = coarsen_mesh(loaded, faces)
-        mesh, _ = load_mesh((v, t))
+        mesh, _, info = coarsen_and_clean(loaded, faces)
         return self._design_mesh(mesh, name, progress, loaded=loaded, coarsening=info)
 
     def _design_mesh(self, mesh, name, progress, *, loaded, coarsening) -> Design:

@@ -13,8 +13,8 @@ from ..layout.tabs import assembly_text
 from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
 from ..surface.pattern import LabelRows, face_arrays
+from ..surface.validate import face_signed_area_2d
 from ..tolerances import tol
-from ..units import MM_PER_UNIT
 from . import report_json, write_outputs
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .report import Records
@@ -348,15 +348,10 @@ def cut_and_fold(pattern) -> dict:
         hinge_pts, _ = point_rows(ann.tab_hinges)
         hinge = hinge_pts.reshape(-1, 2, 2)
         cut -= 2.0 * float(np.linalg.norm(hinge[:, 1] - hinge[:, 0], axis=1).sum())
-    flat, start = face_arrays(pattern.faces)
-    p = pattern.vertices_2d[flat]
-    nxt = np.arange(len(flat)) + 1
-    nxt[start[1:] - 1] = start[:-1]
-    twice = p[:, 0] * p[nxt, 1] - p[nxt, 0] * p[:, 1]
     out = {
         "cut_length": cut,
         "fold_length": fold,
-        "piece_area": float(0.5 * twice.sum()),
+        "piece_area": float(face_signed_area_2d(pattern.vertices_2d, pattern.faces).sum()),
     }
     sheets = np.asarray(ann.sheets, dtype=float).reshape(-1, 4)
     if len(sheets):
@@ -441,7 +436,7 @@ def piece_sizes_mm(design) -> dict | None:
     p = design.params
     if not p.units:
         return None
-    mm_per = p.sheet_scale * MM_PER_UNIT[p.units]
+    mm_per = p.mm_per_unit
     mm = piece_spans(design.pattern) * mm_per
     mm = mm[np.isfinite(mm)]
     labels = design.pattern.annotations.labels
@@ -463,7 +458,7 @@ def _size_lines(design) -> list[str]:
         return []
     lines = []
     smallest = sizes["smallest_piece_mm"]
-    mm = p.sheet_scale * MM_PER_UNIT[p.units]
+    mm = p.mm_per_unit
     work = cut_and_fold(design.pattern)
     line = (
         f"to make: {work['cut_length'] * mm / 1000:.4g} m of cuts, "

@@ -39,9 +39,7 @@ def tab_height(params, ref: float) -> float:
     :data:`TAB_HEIGHT` of ``ref``."""
     if not params.units:
         return TAB_HEIGHT * ref
-    from ..units import MM_PER_UNIT
-
-    return min(TAB_MM / (MM_PER_UNIT[params.units] * params.sheet_scale), TAB_MAX * ref)
+    return min(TAB_MM / params.mm_per_unit, TAB_MAX * ref)
 
 
 def arrange(

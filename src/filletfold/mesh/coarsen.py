@@ -24,6 +24,7 @@ from .polymesh import PolyMesh, mesh_size
 __all__ = [
     "Coarsening",
     "coarse_target",
+    "coarsen_and_clean",
     "coarsen_mesh",
     "surface_distance",
     "triangles_of",
@@ -176,6 +177,28 @@ def coarsen_mesh(mesh: PolyMesh, faces: int) -> tuple[np.ndarray, np.ndarray, Co
         size=float(mesh_size(mesh)),
     )
     return v_new, t_new, info
+
+
+def coarsen_and_clean(mesh: PolyMesh, faces: int, **clean) -> tuple[PolyMesh, list, Coarsening]:
+    """:func:`coarsen_mesh`, then the result cleaned as any input
+    (:func:`~filletfold.mesh.load_mesh` with ``clean``: ``coplanar_deg``, ``strict``), so that
+    coplanar triangles merge into polygons again.
+
+    Returns
+    -------
+    mesh : PolyMesh
+    repairs : list of Repair
+        The cleaning's repairs, each naming its element "... of the coarsened mesh".
+    coarsening : Coarsening
+    """
+    from dataclasses import replace
+
+    from . import load_mesh
+
+    v, t, info = coarsen_mesh(mesh, faces)
+    coarse, log = load_mesh((v, t), **clean)
+    repairs = [replace(r, where=f"{r.where} of the coarsened mesh") for r in log.repairs]
+    return coarse, repairs, info
 
 
 def surface_distance(points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray) -> float:

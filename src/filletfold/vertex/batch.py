@@ -622,17 +622,17 @@ def solve_apex(cons: ApexConstraints, target: np.ndarray, starts=None) -> ApexSo
 
 
 def _solve_chunk(
-    problems, targets, starts, thorough, n, max_iter, lp=True, work: ApexWork | None = None
+    problems, targets, starts, thorough, n, max_iter, lp, work: ApexWork
 ) -> list[ApexSolution]:
-    work = ApexWork() if work is None else work
-
-    def phase1(idx: np.ndarray, y0: np.ndarray, iters: int, **kwargs) -> np.ndarray:
-        work.add(phase1=len(idx))
-        return _phase1(rows.take(idx), y0, idx, iters, **kwargs)
-
     B = len(problems)
     T = np.stack(targets)
     rows = pack_problems(problems, T, n)
+
+    def phase1(idx: np.ndarray, y0: np.ndarray, iters: int, **kwargs) -> np.ndarray:
+        """:func:`_phase1` of problems ``idx`` from ``y0``, counted in ``work``."""
+        work.add(phase1=len(idx))
+        return _phase1(rows.take(idx), y0, idx, iters, **kwargs)
+
     L = np.array([p.scale for p in problems])
     at_target = rows.min_slack(np.zeros((B, n))) >= 0
     # candidate starts in y coordinates, the target (y = 0) first
