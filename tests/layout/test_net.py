@@ -56,3 +56,42 @@ def test_nets_hold_every_piece_once_and_overlap_nothing(name):
 def test_a_net_design_has_fewer_pieces_than_modules():
     d = filletfold.round_mesh("cube", tabs=False, layout="net")
     assert d.layout == "net" and d.pattern.n_pieces < d.mesh.n_vertices
+
+
+def _square(x0: float, y0: float):
+    import shapely
+
+    return shapely.box(x0, y0, x0 + 1, y0 + 1)
+
+
+def test_a_piece_touching_a_placed_one_at_two_points_of_the_surface_clashes():
+    from filletfold.layout.net import _Placed
+
+    placed = _Placed(cell=1.0)
+    corner = np.array([[1.0, 1.0]])
+    placed.add(_square(0, 0), (corner, np.array([[0.0, 0.0, 0.0]])), np.zeros((0, 2)))
+    same = (corner, np.array([[0.0, 0.0, 0.0]]))  # one point of the surface: glued there
+    other = (corner, np.array([[0.0, 0.0, 1.0]]))  # two points at one place: a pinch
+    assert not placed.clashes(_square(1, 1), same, 1e-9, 1e-9)
+    assert placed.clashes(_square(1, 1), other, 1e-9, 1e-9)
+    far = (np.array([[5.0, 5.0]]), np.array([[0.0, 0.0, 1.0]]))
+    assert not placed.clashes(_square(3, 3), far, 1e-9, 1e-9)
+    assert placed.clashes(_square(0.5, 0.5), far, 1e-9, 1e-9)  # overlaps a quarter
+
+
+def test_nets_of_a_real_mesh_are_few_and_touch_only_where_they_are_glued():
+    """The corpus sphere (162 vertices): nets joined smallest pair first make it one piece (6
+    when grown from one seed at a time); no two sides of the pattern meet, flat, unless they
+    share a point (a pinch would be two points of the surface at one place)."""
+    import shapely
+
+    from tests.test_corpus import CORPUS
+
+    d = filletfold.round_mesh(str(CORPUS / "geometry-central-sphere_small.ply"), layout="net")
+    assert d.certificate.ok
+    assert d.pattern.n_pieces <= 2
+    v2, edges = d.pattern.vertices_2d, d.pattern.edges
+    lines = shapely.linestrings(v2[edges])
+    a, b = shapely.STRtree(lines).query(lines, predicate="intersects")
+    apart = (edges[a][:, :, None] != edges[b][:, None, :]).all(axis=(1, 2))
+    assert not apart.any(), edges[a[apart]][:3]

@@ -20,6 +20,9 @@ from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from ..vertex.frame import apply, invert, vertex_frames
 from .net import build_nets, cut_edges_for_nets
 
+#: Meshes of at most this many vertices try four choices of cuts for their nets, larger ones one.
+SMALL = 60
+
 
 def sheet_in_pattern_units(sheet: str, units: str, scale: float) -> tuple[float, float]:
     """Sheet size in pattern units, when one pattern unit is drawn as ``scale`` ``units``.
@@ -68,8 +71,9 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
     sheet : (float, float), optional
         Every net must fit this (pattern units).
     tries : int, optional
-        How many cut choices to try (the default ring starts first); default 4, or 2 above
-        60 vertices.
+        How many cut choices to try (the default ring starts, the glue tree's cuts, then trees
+        rooted at far vertices; one: the glue tree's cuts); default 4, or 1 above
+        :data:`SMALL` vertices.
 
     Returns
     -------
@@ -77,10 +81,10 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
     """
     rounding, solved, centres = sol.rounding, sol.solved, sol.centres
     if tries is None:
-        tries = 4 if mesh.n_vertices <= 60 else 2
-    choices = [None]
-    cut = cut_edges_for_nets(mesh)
-    choices.append(cut)
+        tries = 4 if mesh.n_vertices <= SMALL else 1
+    # a larger mesh tries the glue tree's cuts alone: never more nets than the ring starts'
+    # on the corpus (cow: 334 against 355; spot 288 against 365; airplane 509 against 670)
+    choices = [None, cut_edges_for_nets(mesh)] if tries > 1 else [cut_edges_for_nets(mesh)]
     # further trees rooted at the vertices farthest from each other
     far = np.argsort(-np.linalg.norm(mesh.vertices - mesh.vertices.mean(axis=0), axis=1))
     for root in far[: max(0, tries - 2)]:
