@@ -136,12 +136,13 @@ class _Placed:
         hi = np.floor(np.asarray(box[2:]) / self.cell).astype(np.int64)
         return [(i, j) for i in range(lo[0], hi[0] + 1) for j in range(lo[1], hi[1] + 1)]
 
-    def clashes(self, shape, corners: tuple, overlap_tol: float, eps: float) -> bool:
+    def clashes(self, shape, corners: tuple, overlap_tol: float, eps: float, thin: float) -> bool:
         """Whether ``shape`` overlaps the placed outlines by more than ``overlap_tol`` of its
         area (summed over them: they overlap one another by no more than that), or its piece
         touches a placed piece at a point that is two points of the surface (a pinch: a cutter
         cuts it apart, Origami Simulator welds it). ``corners`` are the piece's border points,
-        placed, (k, 2) and (k, 3); points within ``eps`` are one."""
+        placed, (k, 2) and (k, 3); points within ``eps`` are one. Any overlap wider than
+        ``thin`` (twice its area over its perimeter, for each part of it) clashes too."""
         box = shapely.bounds(shape)
         near = sorted({k for c in self._cells(box) for k in self.grid.get(c, ())})
         near = [
@@ -154,7 +155,14 @@ class _Placed:
             return False
         shapes = np.array([self.shapes[k] for k in near])
         both = shapely.intersection(shapes, shape)
-        if float(shapely.area(both).sum()) > overlap_tol * shape.area:
+        area = shapely.area(both)
+        if float(area.sum()) > overlap_tol * shape.area:
+            return True
+        # a small overlap still clashes unless it is a sliver along a border that glues (two
+        # copies of it apart by round-off): a small face beside a large face piece overlapped
+        # is far less than the tolerance of the whole piece (pyvista airplane)
+        parts = shapely.get_parts(both[area > 0])
+        if len(parts) and (2 * shapely.area(parts) > thin * shapely.length(parts)).any():
             return True
         p2, p3 = corners
         for k in np.asarray(near)[shapely.dwithin(shapes, shape, eps)].tolist():
@@ -284,6 +292,11 @@ def build_nets(
     shapes = np.array([_outline(p) for p in pieces], dtype=object)  # placed: moved with nets
     spans = [np.ptp(a, axis=0).max() for a in arrays if len(a)]
     cell = float(np.median(spans)) if spans else 1.0
+    # a border glues where its two copies are congruent to round-off of the largest place a
+    # piece can be moved to: a border that is only nearly so (two sharp modules' developments
+    # apart by 3e-10 of the edge, compas mesh.obj) would move the points of one module and
+    # stretch its edges, folded against flat, past the certificate's contraction limit
+    exact = 64 * float(np.spacing(sum(spans)))
     n = len(pieces)
     net_of = np.arange(n)
     members = {k: [k] for k in range(n)}
@@ -315,13 +328,15 @@ def build_nets(
         src = _apply(place[b], arrays[b][[j for _, j in matches]])
         dst = _apply(place[a], arrays[a][[i for i, _ in matches]])
         m = rigid_fit(src, dst)
-        if np.abs(_apply(m, src) - dst).max() > eps * 1e3:
+        if np.abs(_apply(m, src) - dst).max() > exact:
             continue
         moving = members[nb]
         moved = _moved(shapes[moving], m)
         target = nets[na]
         if any(
-            target.clashes(s, (_apply(m, corners[k][0]), corners[k][1]), overlap_tol, 1e3 * eps)
+            target.clashes(
+                s, (_apply(m, corners[k][0]), corners[k][1]), overlap_tol, 1e3 * eps, 16 * exact
+            )
             for k, s in zip(moving, moved, strict=True)
         ):
             continue
@@ -337,7 +352,7 @@ def build_nets(
         members[na].extend(members.pop(nb))
         del nets[nb]
     groups = sorted((sorted(v) for v in members.values()), key=lambda v: (-len(v), v[0]))
-    out = [merge_pieces([pieces[i] for i in ids], list(place[ids]), eps) for ids in groups]
+    out = [merge_pieces([pieces[i] for i in ids], list(place[ids]), exact) for ids in groups]
     return out, groups
 
 
