@@ -326,8 +326,9 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
 
     A strip is left as it is where collapsing it would turn a face over, make it degenerate
     (flat or folded) or stretch a side beyond ``SIM_MAX_STRETCH`` or ``SIM_MAX_SHIFT`` when
-    folded, or leave a face that visits a point twice: such strips are found face by face and
-    the rest are collapsed again without them, until no face is broken.
+    folded, leave a face that visits a point twice, or move a side across (or onto) a side it
+    shares no point with: such strips are found face by face and the rest are collapsed again
+    without them, until no face is broken.
     """
     faces = _split_faces(pattern)
     edge_faces = pattern.faces_beside_edges()
@@ -359,10 +360,13 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
         pairs = [p for p, on in zip(proposals, active, strict=True) if on]
         rep = _components(n, np.concatenate([np.zeros((0, 2), dtype=np.int64), *pairs]))
         merged = _merged_faces(pattern, faces, rep, shift, verdicts)
-        if merged[-1] is None:
-            break
+        if merged[-1] is not None:
+            broken = np.unique(rep[merged[-1]])
+        else:  # the merged points' labels
+            broken = _crossed(merged[0], merged[2], np.bincount(rep, minlength=n) > 1)
+            if broken is None:
+                break
         # the strips that merged a point of a broken face go back
-        broken = np.unique(rep[merged[-1]])
         hit = np.array([np.isin(rep[p], broken).any() for p in proposals]) & active
         if not hit.any():  # cannot happen: a broken face has a merged point
             break
@@ -382,6 +386,29 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
         pattern.piece_vertex,
         annotations=pattern.annotations,
     )
+
+
+def _crossed(v2: np.ndarray, loops: list, moved: np.ndarray):
+    """The ends of the sides of ``loops`` (faces of merged points) at a ``moved`` point that
+    cross or touch, flat, a side they share no point with, and of the sides they meet (a
+    collapsed strip's crease cut across a thin notch of its piece: the slit between two
+    modules glued in a net); None when none do."""
+    import shapely
+
+    if not loops:
+        return None
+    sides = np.concatenate([np.c_[f, np.roll(f, -1)] for f in map(np.asarray, loops)])
+    sides = np.unique(np.sort(sides, axis=1), axis=0)
+    mine = np.nonzero(moved[sides].any(axis=1))[0]
+    if not len(mine):
+        return None
+    lines = shapely.linestrings(v2[sides])
+    a, b = shapely.STRtree(lines).query(lines[mine], predicate="intersects")
+    a = mine[a]
+    apart = _apart(sides[a], sides[b])
+    if not apart.any():
+        return None
+    return np.unique(sides[np.r_[a[apart], b[apart]]])
 
 
 def _merged_faces(
