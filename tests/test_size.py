@@ -84,7 +84,7 @@ def test_pieces_under_the_minimum_are_reported_and_warned_of():
     sizes = piece_sizes_mm(big)
     assert sizes["smallest_piece_mm"] == pytest.approx(spans.min() * 100.0)
     assert sizes["pieces_under_min"] == 0 and sizes["min_piece_mm"] == MIN_PIECE_MM
-    tiny = filletfold.round_mesh("icosahedron", size="4mm")  # pieces of about 2.5 mm
+    tiny = filletfold.round_mesh("icosahedron", size="4mm", layout="modules")  # ~2.5 mm each
     sizes = piece_sizes_mm(tiny)
     assert sizes["pieces_under_min"] == tiny.pattern.n_pieces == 12
     assert sizes["smallest_piece_mm"] < MIN_PIECE_MM
@@ -129,10 +129,10 @@ def test_a_nearly_flat_mesh_is_warned_of_and_nets_join_it():
     square = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
     assert thickness_ratio(square) == 0.0
     assert thickness_ratio(np.vstack([square, [[0.5, 0.5, 0.01]]])) == pytest.approx(0.01)
-    flat = filletfold.round_mesh("miura:4x4,fold=0.05")
+    flat = filletfold.round_mesh("miura:4x4,fold=0.05", layout="modules")
     assert thickness_ratio(flat.mesh.vertices) < FLAT_RATIO
     assert "warning: the mesh is nearly flat" in flat.summary()
-    joined = filletfold.round_mesh("miura:4x4,fold=0.05", layout="net")
+    joined = filletfold.round_mesh("miura:4x4,fold=0.05")  # nets, by default
     assert joined.pattern.n_pieces < flat.pattern.n_pieces
     assert "nearly flat" not in joined.summary()
     assert "nearly flat" not in filletfold.round_mesh("miura").summary()  # folded: 16 %

@@ -359,7 +359,7 @@ def round_cmd(
             "--layout",
             help="'modules' (one piece per vertex), 'net' (modules joined into few pieces), "
             "'sheet' (all glued into one uncut sheet; fails if they do not fit) or 'auto' (the "
-            "sheet with --material-loss when possible, nets with --sheet, else modules).",
+            "sheet with --material-loss when possible, else nets).",
         ),
     ] = "auto",
     coplanar_tol: Annotated[

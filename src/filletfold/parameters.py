@@ -105,8 +105,8 @@ class Parameters:
         ``"modules"``: one piece per vertex, side by side. ``"net"``: modules joined into as
         few non-overlapping pieces as found (each cone keeps its cut). ``"sheet"``: all
         modules glued into one uncut sheet (needs every vertex's development to close; raises
-        otherwise). ``"auto"``: the sheet when it can be made (with ``material_loss``), nets
-        when a ``sheet`` size is given, else modules.
+        otherwise). ``"auto"``: the sheet when it can be made (with ``material_loss``), else
+        nets.
     coplanar_deg : float
         Merge neighbouring faces whose normals differ by less than this (degrees).
     fit_vertices : bool or None

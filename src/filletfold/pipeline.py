@@ -592,7 +592,7 @@ def layout_stage(
     lowers the peak memory of a large design by about a third."""
     p, pm = job.params, job.mesh
     pieces = [piece for module in mods.modules for piece in module]
-    if release and not (p.layout == "net" or (p.layout == "auto" and p.sheet is not None)):
+    if release and p.layout not in ("net", "auto"):
         # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
         sol.frames = sol.classified = sol.solved = mods.modules = None
     _stage("layout")

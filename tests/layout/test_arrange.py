@@ -19,7 +19,7 @@ from filletfold.units import sheet_size_mm
 #: (mesh, keyword arguments of round_mesh, the layout used)
 CASES = {
     "cube-modules": ("cube", {"layout": "modules"}, "modules"),
-    "cube-auto": ("cube", {"layout": "auto"}, "modules"),
+    "cube-auto": ("cube", {"layout": "auto"}, "net"),
     "cube-auto-A4": ("cube", {"layout": "auto", "sheet": "A4", "scale": 60}, "net"),
     "cube-net-A4-sheets": ("cube", {"layout": "net", "sheet": "A4", "scale": 100}, "net"),
     "cube-modules-A4": ("cube", {"layout": "modules", "sheet": "A4", "scale": 100}, "modules"),
@@ -146,6 +146,6 @@ def test_a_sheet_too_small_for_a_module(layout):
 def test_the_sheet_layout_needs_developments_that_close():
     with pytest.raises(SolverError, match="one sheet"):
         filletfold.round_mesh("cube", layout="sheet")
-    # with `auto` the same input keeps its modules, and says why
+    # with `auto` the same input is laid out in nets, and says why it is not one sheet
     d = filletfold.round_mesh("cube", layout="auto", material_loss=True)
-    assert d.layout == "modules" and "not developable" in d.layout_note
+    assert d.layout == "net" and "not developable" in d.layout_note

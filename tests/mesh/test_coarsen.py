@@ -132,7 +132,9 @@ def test_the_summary_suggests_faces_for_a_design_of_many_pieces(monkeypatch):
     import filletfold.export.outputs as outputs
 
     monkeypatch.setattr(outputs, "MANY_PIECES", 10)  # blob's modules are 162 pieces
-    assert "--faces N coarsens the mesh" in filletfold.round_mesh("blob").summary()
+    assert (
+        "--faces N coarsens the mesh" in filletfold.round_mesh("blob", layout="modules").summary()
+    )
     coarse = filletfold.round_mesh("blob", faces=200)
     assert coarse.coarsening is not None and "--faces N" not in coarse.summary()
     assert coarse.summary().splitlines()[1].startswith("coarsened: 320 -> ")

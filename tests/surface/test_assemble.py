@@ -60,9 +60,9 @@ def test_assembled_cone_rulings_are_isometric_to_round_off(name, tmp_path):
             source.write_bytes(case.file[1])
         else:
             source = (np.array(case.vertices, dtype=float), [f.copy() for f in case.faces])
-        pat = filletfold.round_mesh(source, sharp="none").pattern  # its cones, as found
+        pat = filletfold.round_mesh(source, sharp="none", layout="modules").pattern
     else:
-        pat = design_of(name).pattern
+        pat = design_of(name, layout="modules").pattern  # a piece per module: one apex each
     flat, start = pat.faces.flat, pat.faces.start
     size = np.diff(start)
     face = np.repeat(np.arange(len(size)), size)

@@ -121,7 +121,7 @@ def _signed_area(q) -> float:
 def test_modules_split_exactly_where_the_union_says(name):
     """Every module piece is free of overlap by the union test; every vertex whose module was
     split overlaps as one piece by the union test too."""
-    d = design_of(name)
+    d = design_of(name, layout="modules")
     for piece in d.pieces:
         p2, _ = piece.arrays()
         assert not reference_overlap(p2, piece.faces)

@@ -191,7 +191,7 @@ def test_developable_vertex_is_detected_and_reported():
     m = load_mesh((v, f))[0]
     u = int(np.argmin(np.linalg.norm(m.vertices, axis=1)))
     assert abs(m.vertex_angle_sum[u] - 2 * np.pi) < 1e-12
-    d = filletfold.round_mesh(m, radius="2%")
+    d = filletfold.round_mesh(m, radius="2%", layout="modules")
     assert d.vertices.status[u] == "developable"
     assert "material loss" in d.vertices.reason[u]
     assert np.all(np.isnan(d.vertices.apex[u]))

@@ -132,7 +132,7 @@ def arrange(
                 f"the sheet {sheet} at scale {scale:g} {units} per unit is too small for any piece",
                 name="sheet",
             )
-    if layout == "net" or (layout == "auto" and layout_used == "modules" and sheet is not None):
+    if layout == "net" or (layout == "auto" and layout_used == "modules"):
         pieces = net_pieces(pm, sol, pieces, mods.points, eps, sheet=room)
         layout_used = "net"
     if sheet is not None:
