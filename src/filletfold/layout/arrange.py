@@ -133,7 +133,7 @@ def arrange(
                 name="sheet",
             )
     if layout == "net" or (layout == "auto" and layout_used == "modules"):
-        pieces = net_pieces(pm, sol, pieces, mods.points, eps, sheet=room)
+        pieces = net_pieces(pm, sol, mods.modules, mods.points, eps, sheet=room)
         layout_used = "net"
     if sheet is not None:
         pieces = [orient(piece) for piece in pieces]

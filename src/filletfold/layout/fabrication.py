@@ -63,8 +63,9 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
     sol : VertexSolution
         Its rounding, face piece centres and ``solved``: the frames the apices were solved
         in, and the apices (:class:`~filletfold.vertex.solution.VertexSolution`).
-    modules : list of Piece
-        The modules as built from ``solved`` (used for the first choice of cuts).
+    modules : list of list of Piece
+        Each vertex's module (its pieces) as built from ``solved``: the first choice of cuts,
+        and the module of every vertex that a later choice cuts where it was cut.
     samples : int or (n_edges,) int
         Points per arc (see :func:`~filletfold.surface.module.build_modules`).
     eps : float
@@ -84,35 +85,38 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
         tries = 4 if mesh.n_vertices <= SMALL else 1
     # a larger mesh tries the glue tree's cuts alone: never more nets than the ring starts'
     # on the corpus (cow: 334 against 355; spot 288 against 365; airplane 509 against 670)
-    choices = [None, cut_edges_for_nets(mesh)] if tries > 1 else [cut_edges_for_nets(mesh)]
+    # a vertex the tree cuts where its module is cut keeps its module
+    start = np.array([f.ring.edges[0] if f.ring.closed else -1 for f, _, _ in solved])
+    choices = [None, cut_edges_for_nets(mesh)]
+    if tries == 1:
+        choices = choices[1:]
     # further trees rooted at the vertices farthest from each other
     far = np.argsort(-np.linalg.norm(mesh.vertices - mesh.vertices.mean(axis=0), axis=1))
     for root in far[: max(0, tries - 2)]:
         choices.append(cut_edges_for_nets(mesh, root=int(root)))
     best = None
     for cut in choices[:tries]:
-        pieces = [] if cut is not None else modules
-        recut = {}  # the frames cut along the tree's edges, built at once
+        cut_at = []  # the vertices cut elsewhere than their module is
         if cut is not None:
             cut_at = [u for u, (f, _, _) in enumerate(solved) if f.ring.closed and cut[u] >= 0]
-            sharp = np.array([f.sharp for f, _, _ in solved], dtype=bool)
-            new_frames = vertex_frames(
-                mesh, rounding, cut_at, [int(cut[u]) for u in cut_at], sharp=sharp
-            )
-            recut = dict(zip(cut_at, new_frames, strict=True))
-        batch = []  # (frame, apex, developed apex) of every vertex, its ring re-cut
-        for u, (frame, apex, v) in enumerate(solved if cut is not None else []):
-            if u in recut:
-                k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
-                new = recut[u]
-                if v is not None and k:
-                    v = apply(invert(frame.face_map[k - 1]), v)[0]
-                frame = new
-            batch.append((frame, apex, v))
+            cut_at = [u for u in cut_at if cut[u] != start[u]]
+        sharp = np.array([f.sharp for f, _, _ in solved], dtype=bool)
+        new_frames = vertex_frames(
+            mesh, rounding, cut_at, [int(cut[u]) for u in cut_at], sharp=sharp
+        )
+        batch = []  # (frame, apex, developed apex) of each vertex re-cut
+        for u, new in zip(cut_at, new_frames, strict=True):
+            frame, apex, v = solved[u]
+            k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
+            if v is not None and k:
+                v = apply(invert(frame.face_map[k - 1]), v)[0]
+            batch.append((new, apex, v))
+        rebuilt = {}
         if batch:
             frames, apices, developed = (list(c) for c in zip(*batch, strict=True))
-            for module in build_modules(mesh, frames, centres, samples, apices, developed):
-                pieces.extend(module)
+            built = build_modules(mesh, frames, centres, samples, apices, developed)
+            rebuilt = dict(zip(cut_at, built, strict=True))
+        pieces = [piece for u, module in enumerate(modules) for piece in rebuilt.get(u, module)]
         nets, _ = build_nets(pieces, eps, sheet)
         if best is None or len(nets) < len(best):
             best = nets
