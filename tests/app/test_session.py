@@ -567,20 +567,20 @@ def test_the_download_keeps_every_parameter_of_the_shown_design():
 
 def test_coarsen_designs_the_loaded_mesh_with_fewer_triangles_and_back():
     s = AppSession()
-    s.load("geodesic-sphere:level=3")  # 642 vertices, 1280 triangles
+    s.load("geodesic-sphere:level=2")  # 162 vertices, 320 triangles
     loaded = s.mesh
     s.set_vertex_depth(5, "40%")
-    design = s.coarsen(200)
+    design = s.coarsen(120)
     assert s.loaded is loaded and s.mesh is not loaded
-    assert s.coarsening.faces_before == 1280 and s.coarsening.faces_after <= 200
-    assert design.mesh.n_vertices == s.coarsening.vertices_after < 642
+    assert s.coarsening.faces_before == 320 and s.coarsening.faces_after <= 120
+    assert design.mesh.n_vertices == s.coarsening.vertices_after < 162
     assert s.vertex_depth == {}  # the vertices are new
-    again = s.coarsen(100)  # from the loaded mesh, not from the coarse one
-    assert s.coarsening.faces_before == 1280 and again.mesh.n_faces <= 100
+    again = s.coarsen(60)  # from the loaded mesh, not from the coarse one
+    assert s.coarsening.faces_before == 320 and again.mesh.n_faces <= 60
     back = s.coarsen(None)
-    assert s.mesh is loaded and s.coarsening is None and back.mesh.n_vertices == 642
+    assert s.mesh is loaded and s.coarsening is None and back.mesh.n_vertices == 162
     s.recompute()  # a slider change after a coarsening designs the coarse mesh
-    s.coarsen(150)
+    s.coarsen(80)
     n = s.mesh.n_vertices
     s.set_params(radius="5%")
     assert s.recompute().mesh.n_vertices == n

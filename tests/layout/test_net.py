@@ -58,6 +58,11 @@ def test_a_net_design_has_fewer_pieces_than_modules():
     assert d.layout == "net" and d.pattern.n_pieces < d.mesh.n_vertices
 
 
+def _clash(placed, shape, corners, *tolerances) -> bool:
+    """Whether one piece (its outline and border points) clashes with a net's placed pieces."""
+    return placed.clashes(np.array([shape], dtype=object), [corners], *tolerances)
+
+
 def _square(x0: float, y0: float):
     import shapely
 
@@ -72,11 +77,11 @@ def test_a_piece_touching_a_placed_one_at_two_points_of_the_surface_clashes():
     placed.add(_square(0, 0), (corner, np.array([[0.0, 0.0, 0.0]])), np.zeros((0, 2)))
     same = (corner, np.array([[0.0, 0.0, 0.0]]))  # one point of the surface: glued there
     other = (corner, np.array([[0.0, 0.0, 1.0]]))  # two points at one place: a pinch
-    assert not placed.clashes(_square(1, 1), same, 1e-9, 1e-9, 1e-12)
-    assert placed.clashes(_square(1, 1), other, 1e-9, 1e-9, 1e-12)
+    assert not _clash(placed, _square(1, 1), same, 1e-9, 1e-9, 1e-12)
+    assert _clash(placed, _square(1, 1), other, 1e-9, 1e-9, 1e-12)
     far = (np.array([[5.0, 5.0]]), np.array([[0.0, 0.0, 1.0]]))
-    assert not placed.clashes(_square(3, 3), far, 1e-9, 1e-9, 1e-12)
-    assert placed.clashes(_square(0.5, 0.5), far, 1e-9, 1e-9, 1e-12)  # overlaps a quarter
+    assert not _clash(placed, _square(3, 3), far, 1e-9, 1e-9, 1e-12)
+    assert _clash(placed, _square(0.5, 0.5), far, 1e-9, 1e-9, 1e-12)  # overlaps a quarter
 
 
 def test_nets_of_a_real_mesh_are_few_and_touch_only_where_they_are_glued():
@@ -109,6 +114,6 @@ def test_a_small_overlap_clashes_unless_it_is_a_sliver_along_a_glued_border():
     nowhere = (np.zeros((0, 2)), np.zeros((0, 3)))
     placed.add(shapely.box(0, 0, 100, 100), nowhere, np.zeros((0, 2)))
     corner = shapely.box(99.999, 99.999, 200, 200)  # 1e-6 of the area overlapped, 1e-3 wide
-    assert placed.clashes(corner, nowhere, 1e-9 * 1e5, 1e-9, 1e-12)
+    assert _clash(placed, corner, nowhere, 1e-9 * 1e5, 1e-9, 1e-12)
     beside = shapely.box(100 - 1e-13, 0, 200, 100)  # round-off of the shared border
-    assert not placed.clashes(beside, nowhere, 1e-9, 1e-9, 1e-12)
+    assert not _clash(placed, beside, nowhere, 1e-9, 1e-9, 1e-12)

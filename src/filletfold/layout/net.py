@@ -23,17 +23,17 @@ from ..tolerances import tol
 
 
 def rigid_fit(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
-    """3x3 homogeneous rotation + translation taking points ``src`` (k, 2) onto ``dst``."""
+    """3x3 homogeneous rotation + translation taking points ``src`` (k, 2) onto ``dst`` (least
+    squares; never a reflection, which cannot glue orientation-preserving pieces). In the
+    plane the best rotation has the angle of the summed cross and dot products of the centred
+    point pairs (the 2D Kabsch solution in closed form)."""
     cs, cd = src.mean(axis=0), dst.mean(axis=0)
-    h = (src - cs).T @ (dst - cd)
-    u, _, vt = np.linalg.svd(h)
-    r = (u @ vt).T
-    if np.linalg.det(r) < 0:  # a reflection cannot glue orientation-preserving pieces
-        vt[-1] *= -1
-        r = (u @ vt).T
+    a, b = src - cs, dst - cd
+    angle = np.arctan2(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]), np.sum(a * b))
+    c, s = np.cos(angle), np.sin(angle)
     m = np.eye(3)
-    m[:2, :2] = r
-    m[:2, 2] = cd - r @ cs
+    m[:2, :2] = [[c, -s], [s, c]]
+    m[:2, 2] = cd - m[:2, :2] @ cs
     return m
 
 
@@ -136,27 +136,37 @@ class _Placed:
         hi = np.floor(np.asarray(box[2:]) / self.cell).astype(np.int64)
         return [(i, j) for i in range(lo[0], hi[0] + 1) for j in range(lo[1], hi[1] + 1)]
 
-    def clashes(self, shape, corners: tuple, overlap_tol: float, eps: float, thin: float) -> bool:
-        """Whether ``shape`` overlaps the placed outlines by more than ``overlap_tol`` of its
-        area (summed over them: they overlap one another by no more than that), or its piece
-        touches a placed piece at a point that is two points of the surface (a pinch: a cutter
-        cuts it apart, Origami Simulator welds it). ``corners`` are the piece's border points,
+    def clashes(self, shapes, corners: list, overlap_tol: float, eps: float, thin: float) -> bool:
+        """Whether any of ``shapes`` (the outlines of the pieces of a net that would join,
+        placed) overlaps the placed outlines by more than ``overlap_tol`` of its area (summed
+        over them: they overlap one another by no more than that), or its piece touches a
+        placed piece at a point that is two points of the surface (a pinch: a cutter cuts it
+        apart, Origami Simulator welds it). ``corners`` are each piece's border points,
         placed, (k, 2) and (k, 3); points within ``eps`` are one. Any overlap wider than
-        ``thin`` (twice its area over its perimeter, for each part of it) clashes too."""
-        box = shapely.bounds(shape)
-        near = sorted({k for c in self._cells(box) for k in self.grid.get(c, ())})
-        near = [
-            k
-            for k in near
-            if self.boxes[k][0] <= box[2] + eps and box[0] <= self.boxes[k][2] + eps
-            and self.boxes[k][1] <= box[3] + eps and box[1] <= self.boxes[k][3] + eps
-        ]  # fmt: skip
-        if not near:
+        ``thin`` (twice its area over its perimeter, for each part of it) clashes too. The
+        pairs of a new and a placed outline whose boxes meet are tested all at once."""
+        boxes = shapely.bounds(shapes)
+        placed = np.asarray(self.boxes)
+        new, old = [], []
+        for i, box in enumerate(boxes):
+            near = np.fromiter(
+                {k for c in self._cells(box) for k in self.grid.get(c, ())}, dtype=np.int64
+            )
+            b = placed[near]
+            near = near[
+                (b[:, 0] <= box[2] + eps) & (box[0] <= b[:, 2] + eps)
+                & (b[:, 1] <= box[3] + eps) & (box[1] <= b[:, 3] + eps)
+            ]  # fmt: skip
+            new.append(np.full(len(near), i))
+            old.append(near)
+        new, old = np.concatenate(new), np.concatenate(old)
+        if not len(new):
             return False
-        shapes = np.array([self.shapes[k] for k in near])
-        both = shapely.intersection(shapes, shape)
+        mine, theirs = shapes[new], np.asarray(self.shapes, dtype=object)[old]
+        both = shapely.intersection(theirs, mine)
         area = shapely.area(both)
-        if float(area.sum()) > overlap_tol * shape.area:
+        overlap = np.bincount(new, weights=area, minlength=len(shapes))
+        if (overlap > overlap_tol * shapely.area(shapes)).any():
             return True
         # a small overlap still clashes unless it is a sliver along a border that glues (two
         # copies of it apart by round-off): a small face beside a large face piece overlapped
@@ -164,9 +174,9 @@ class _Placed:
         parts = shapely.get_parts(both[area > 0])
         if len(parts) and (2 * shapely.area(parts) > thin * shapely.length(parts)).any():
             return True
-        p2, p3 = corners
-        for k in np.asarray(near)[shapely.dwithin(shapes, shape, eps)].tolist():
-            q2, q3 = self.corners[k]
+        close = shapely.dwithin(theirs, mine, eps)
+        for i, k in zip(new[close].tolist(), old[close].tolist(), strict=True):
+            (p2, p3), (q2, q3) = corners[i], self.corners[k]
             flat = np.linalg.norm(p2[:, None] - q2[None], axis=-1) <= eps
             if (np.linalg.norm(p3[:, None] - q3[None], axis=-1)[flat] > eps).any():
                 return True
@@ -292,11 +302,6 @@ def build_nets(
     shapes = np.array([_outline(p) for p in pieces], dtype=object)  # placed: moved with nets
     spans = [np.ptp(a, axis=0).max() for a in arrays if len(a)]
     cell = float(np.median(spans)) if spans else 1.0
-    # a border glues where its two copies are congruent to round-off of the largest place a
-    # piece can be moved to: a border that is only nearly so (two sharp modules' developments
-    # apart by 3e-10 of the edge, compas mesh.obj) would move the points of one module and
-    # stretch its edges, folded against flat, past the certificate's contraction limit
-    exact = 64 * float(np.spacing(sum(spans)))
     n = len(pieces)
     net_of = np.arange(n)
     members = {k: [k] for k in range(n)}
@@ -328,32 +333,43 @@ def build_nets(
         src = _apply(place[b], arrays[b][[j for _, j in matches]])
         dst = _apply(place[a], arrays[a][[i for i, _ in matches]])
         m = rigid_fit(src, dst)
+        # a border glues where its two copies are congruent to round-off of where they lie: a
+        # border that is only nearly so (two sharp modules' developments apart by 3e-10 of
+        # the edge, compas mesh.obj) would move the points of one module and stretch its
+        # edges, folded against flat, past the certificate's contraction limit
+        exact = _round_off(dst)
         if np.abs(_apply(m, src) - dst).max() > exact:
             continue
         moving = members[nb]
         moved = _moved(shapes[moving], m)
         target = nets[na]
-        if any(
-            target.clashes(
-                s, (_apply(m, corners[k][0]), corners[k][1]), overlap_tol, 1e3 * eps, 16 * exact
-            )
-            for k, s in zip(moving, moved, strict=True)
-        ):
+        placed = [(_apply(m, corners[k][0]), corners[k][1]) for k in moving]
+        if target.clashes(moved, placed, overlap_tol, 1e3 * eps, 16 * exact):
             continue
         hull = _hull(np.vstack([target.hull, _apply(m, nets[nb].hull)]))
         if sheet is not None and not _fits(hull, sheet):
             continue
         place[moving] = m @ place[moving]
         shapes[moving] = moved
-        for k, s in zip(moving, moved, strict=True):
-            corners[k] = (_apply(m, corners[k][0]), corners[k][1])
-            target.add(s, corners[k], hull)
+        for k, s, c in zip(moving, moved, placed, strict=True):
+            corners[k] = c
+            target.add(s, c, hull)
         net_of[moving] = na
         members[na].extend(members.pop(nb))
         del nets[nb]
     groups = sorted((sorted(v) for v in members.values()), key=lambda v: (-len(v), v[0]))
-    out = [merge_pieces([pieces[i] for i in ids], list(place[ids]), exact) for ids in groups]
+    out = []
+    for ids in groups:  # the glued points, merged at the round-off of where they lie
+        reach = max((np.abs(corners[i][0]).max() for i in ids if len(corners[i][0])), default=0)
+        exact = _round_off(np.array([reach]))
+        out.append(merge_pieces([pieces[i] for i in ids], list(place[ids]), exact))
     return out, groups
+
+
+def _round_off(points: np.ndarray) -> float:
+    """64 units in the last place of the largest coordinate of ``points``: how far apart two
+    computations of one point may lie there."""
+    return 64 * float(np.spacing(np.abs(points).max())) if points.size else 0.0
 
 
 def _apply(m: np.ndarray, points: np.ndarray) -> np.ndarray:
