@@ -269,14 +269,15 @@ def build_nets(
 
     Every piece starts as a net of its own. Two nets are joined across a border their pieces
     share by the rigid motion that matches the smaller net's copy of the border points to the
-    larger's, if the smaller net, moved so, overlaps nothing of the larger, no piece of it
-    comes within ``eps`` of a piece of the larger that is not beside it on the surface (a
-    point of the pattern that would be two of the surface), and the two still fit the sheet.
-    The joins are tried smallest pair first (the sum of the two nets' pieces, then the longer
-    border): nets grow side by side instead of one net winding around the object and leaving
-    its gaps to single pieces (on a 2,904-vertex scan: 355 nets, 13 of one piece, instead of
-    565, 260 of one piece, grown from one seed at a time). Each border is tried once; a join
-    that fails is not tried again.
+    larger's, if the two copies are congruent to round-off, the smaller net, moved so,
+    overlaps nothing of the larger (see :meth:`_Placed.clashes`: a sliver along the glued
+    border aside), no two of their pieces meet at a place that is two points of the surface,
+    and the two still fit the sheet. The joins are tried smallest pair first (the sum of the
+    two nets' pieces, then the longer border): nets grow side by side instead of one net
+    winding around the object and leaving its gaps to single pieces (a 2,904-vertex scan's
+    modules, cut at their ring starts: 355 nets, 13 of one piece, instead of 565, 260 of one
+    piece, grown from one seed at a time). Each border is tried once; a join that fails is
+    not tried again. The glued points of a net are merged.
 
     Parameters
     ----------
