@@ -146,13 +146,12 @@ class _Placed:
         ``thin`` (twice its area over its perimeter, for each part of it) clashes too. The
         pairs of a new and a placed outline whose boxes meet are tested all at once."""
         boxes = shapely.bounds(shapes)
-        placed = np.asarray(self.boxes)
         new, old = [], []
         for i, box in enumerate(boxes):
             near = np.fromiter(
                 {k for c in self._cells(box) for k in self.grid.get(c, ())}, dtype=np.int64
             )
-            b = placed[near]
+            b = np.array([self.boxes[k] for k in near.tolist()]).reshape(-1, 4)
             near = near[
                 (b[:, 0] <= box[2] + eps) & (box[0] <= b[:, 2] + eps)
                 & (b[:, 1] <= box[3] + eps) & (box[1] <= b[:, 3] + eps)
@@ -162,7 +161,9 @@ class _Placed:
         new, old = np.concatenate(new), np.concatenate(old)
         if not len(new):
             return False
-        mine, theirs = shapes[new], np.asarray(self.shapes, dtype=object)[old]
+        mine = shapes[new]
+        theirs = np.empty(len(old), dtype=object)
+        theirs[:] = [self.shapes[k] for k in old.tolist()]
         both = shapely.intersection(theirs, mine)
         area = shapely.area(both)
         overlap = np.bincount(new, weights=area, minlength=len(shapes))
