@@ -192,13 +192,16 @@ def test_export_zip_holds_the_files_and_they_parse(cube_session, tmp_path):
 
 
 def test_shown_design_has_no_tabs_but_the_download_does(cube_session):
-    """Glue tabs are off in the live view (speed) and added for the download (reuse)."""
+    """Glue tabs are off in the live view (speed) and added for the download (reuse); the view
+    shows the modules, the download is laid out in nets, as the command line's default."""
     assert cube_session.design.fabrication["tabs"] == 0
+    assert cube_session.design.layout == "modules"
     files = cube_session.export_files()
     report = json.loads(files["report.json"])
     assert report["fabrication"]["tabs"] > 0
     assert "assembly.txt" in files
     assert report["source"] == "cube"
+    assert report["layout"]["kind"] == "net" and report["pattern"]["pieces"] < 8
 
 
 def test_nearest_vertex_to_ray():

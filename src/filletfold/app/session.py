@@ -179,6 +179,9 @@ class AppSession:
             material_loss=material_loss,
             clamp=True,
             tabs=False,  # the download always has them (see export_files)
+            # a slider change redraws the modules (torus: 66 ms; joined into nets on every
+            # change, 820 ms); the download is laid out in nets, as the command line does
+            layout="modules",
         )
         self.vertex_depth: dict = {}
         self.design: Design | None = None
@@ -431,11 +434,14 @@ class AppSession:
             design = self.design
         if design is None:
             raise ParameterError("no design computed yet", name="design")
-        if design.fabrication.get("tabs", 0) == 0 and design.stages is not None:
-            # the shown design was computed without glue tabs: add them (layout stage only)
+        if design.stages is not None and (
+            design.fabrication.get("tabs", 0) == 0 or design.params.layout == "modules"
+        ):
+            # the shown design was computed as modules without glue tabs: lay it out in nets
+            # with tabs, as the command line does (the layout stage only)
             p = design.params
             source = design.source
-            design = round_mesh(design.mesh, p, tabs=True, reuse=design)
+            design = round_mesh(design.mesh, p, tabs=True, layout="auto", reuse=design)
             design.source = source
         files = dict(
             cut_files(
