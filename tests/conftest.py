@@ -34,10 +34,12 @@ def design_of(
     arc_step: float = 1.5,
     sharp: str = "auto",
     chord_tol=0,
-    layout: str = "auto",
+    layout: str = "modules",
 ) -> filletfold.Design:
     """Round a built-in example (cached: designs are read-only in the tests); sampled by the
-    arc step alone unless a chord tolerance is given."""
+    arc step alone unless a chord tolerance is given. Laid out as modules (the tests of a
+    stage look at its modules) unless a layout is given: :func:`example_design` gives the
+    default layout, nets, whose invariants every example is checked for."""
     return filletfold.round_mesh(
         name,
         radius=radius,
@@ -52,7 +54,7 @@ def design_of(
 
 @pytest.fixture(params=ALL)
 def example_design(request) -> filletfold.Design:
-    return design_of(request.param)
+    return design_of(request.param, layout="auto")
 
 
 def random_convex(seed: int):

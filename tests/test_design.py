@@ -97,7 +97,7 @@ def test_mismatch_converges_under_refinement(name):
     assert 7.6 < ab[0] / ab[1] < 8.4 and 7.6 < ab[1] / ab[2] < 8.4
 
 
-@pytest.mark.parametrize("name", ["blob", "geodesic-sphere"])
+@pytest.mark.parametrize("name", [pytest.param("blob", marks=pytest.mark.slow), "geodesic-sphere"])
 def test_mismatch_converges_as_the_arc_step_shrinks(name):
     """Halving the arc step (arcs under (samples - 1) steps) divides the relative chord
     mismatch by about 4: the adaptive sampling refines like the uniform one."""

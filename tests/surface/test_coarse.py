@@ -61,7 +61,7 @@ DESIGNS = ["cube", "icosahedron net", "miura material-loss", "compas-boxes"]
 #: the simulator copy checked every merge, bunny-lowres stopped with "fillet 251 of the
 #: pattern has no outline" and pyvista-nut with "pattern face 624 is clockwise".
 CORPUS_DESIGNS = [
-    "blob default",
+    pytest.param("blob default", marks=pytest.mark.slow),
     pytest.param("bunny-lowres", marks=pytest.mark.slow),
     pytest.param("pyvista-nut", marks=pytest.mark.slow),
 ]
