@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from filletfold.arrays import run_owners, run_starts, split_runs
+from filletfold.arrays import run_next, run_owners, run_starts, split_runs
 
 
 @settings(max_examples=200, deadline=None)
@@ -39,3 +39,14 @@ def test_run_starts_and_owners_describe_the_runs(sizes):
         assert (owners[a:b] == k).all()
     runs = split_runs(np.arange(starts[-1]), starts[1:-1])
     assert [len(r) for r in runs] == (list(sizes) if sizes else [0])
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.integers(1, 6), max_size=8))
+def test_run_next_closes_every_run_into_a_loop(sizes):
+    start = run_starts(sizes)
+    nxt = run_next(start)
+    expected = [
+        a + (i + 1) % (b - a) for a, b in itertools.pairwise(start.tolist()) for i in range(b - a)
+    ]
+    assert nxt.tolist() == expected

@@ -3,7 +3,8 @@
 A *ragged array* holds ``n`` runs of different lengths (the corners of polygons, the sides of
 vertices, the samples of arcs) one run after another in one flat array. Its ``sizes`` (n,)
 give each run's length; :func:`run_starts` where each run starts (and the end),
-:func:`run_owners` which run each flat entry belongs to, :func:`split_runs` the runs as views.
+:func:`run_owners` which run each flat entry belongs to, :func:`run_next` each entry's next in
+its run read as a closed loop (a polygon's next corner), :func:`split_runs` the runs as views.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import itertools
 
 import numpy as np
 
-__all__ = ["round_significant", "run_owners", "run_starts", "split_runs"]
+__all__ = ["round_significant", "run_next", "run_owners", "run_starts", "split_runs"]
 
 
 def run_starts(sizes) -> np.ndarray:
@@ -23,6 +24,16 @@ def run_starts(sizes) -> np.ndarray:
     out = np.zeros(len(sizes) + 1, dtype=np.int64)
     np.cumsum(sizes, out=out[1:])
     return out
+
+
+def run_next(start) -> np.ndarray:
+    """(start[-1],) int64: the index of each entry's next entry in its run, the last entry of
+    a run pointing back to the run's first: every run read as a closed loop (the next corner
+    of each polygon). ``start`` is :func:`run_starts` of the (nonzero) sizes."""
+    start = np.asarray(start, dtype=np.int64).reshape(-1)
+    nxt = np.arange(1, int(start[-1]) + 1, dtype=np.int64)
+    nxt[start[1:] - 1] = start[:-1]
+    return nxt
 
 
 def run_owners(sizes) -> np.ndarray:

@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 import shapely
 
-from .arrays import run_owners
+from .arrays import run_next, run_owners
 from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
@@ -307,8 +307,7 @@ class _Data:
         if self.size_of.min() < 3 or self.flat.min() < 0 or self.flat.max() >= n:
             raise ParameterError("pattern faces must list at least 3 vertex indices in range")
         self.face_of = run_owners(self.size_of)
-        self.nxt = np.arange(1, len(self.flat) + 1)
-        self.nxt[self.start[1:] - 1] = self.start[:-1]
+        self.nxt = run_next(self.start)
         self.prv = np.empty_like(self.nxt)
         self.prv[self.nxt] = np.arange(len(self.nxt))
         q = float(coord_quantum)
@@ -341,8 +340,7 @@ class _Data:
         p = self.mv[mflat]
         centre = np.add.reduceat(p, mstart[:-1], axis=0) / msize[:, None]
         qc = p - np.repeat(centre, msize, axis=0)
-        mnxt = np.arange(1, len(mflat) + 1)
-        mnxt[mstart[1:] - 1] = mstart[:-1]
+        mnxt = run_next(mstart)
         normal = np.add.reduceat(np.cross(qc, qc[mnxt]), mstart[:-1], axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):
             normal /= np.linalg.norm(normal, axis=1)[:, None]

@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 
-from ..arrays import run_starts
+from ..arrays import run_next, run_starts
 from ..surface.pattern import CreasePattern, FaceRows
 from ..surface.validate import validated_faces
 from ..tolerances import tol
@@ -104,8 +104,7 @@ def vertex_normal_3d(vertices_3d: np.ndarray, faces: list) -> np.ndarray:
         size = np.diff(start)
         p = vertices_3d[flat]
         p = p - np.repeat(np.add.reduceat(p, start[:-1], axis=0) / size[:, None], size, axis=0)
-        nxt = np.arange(1, len(flat) + 1)
-        nxt[start[1:] - 1] = start[:-1]
+        nxt = run_next(start)
         area_normal = 0.5 * np.add.reduceat(np.cross(p, p[nxt]), start[:-1], axis=0)
         np.add.at(acc, flat, np.repeat(area_normal, size, axis=0))
     norm = np.linalg.norm(acc, axis=1)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..arrays import run_next, run_starts
 from ..errors import named_stages
 from ..layout.tabs import assembly_text
 from ..memory import release_memory
@@ -341,9 +342,7 @@ def cut_and_fold(pattern) -> dict:
     ann = pattern.annotations
     if len(ann.tabs):
         pts, sizes = point_rows(ann.tabs)
-        starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-        nxt = np.arange(len(pts)) + 1
-        nxt[starts + sizes - 1] = starts  # each outline closed
+        nxt = run_next(run_starts(sizes))  # each outline closed
         cut += float(np.linalg.norm(pts[nxt] - pts, axis=1).sum())
         hinge_pts, _ = point_rows(ann.tab_hinges)
         hinge = hinge_pts.reshape(-1, 2, 2)

@@ -17,6 +17,7 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 
+from ..arrays import run_next, run_starts
 from ..surface.faces import FaceLists, face_polygons, flat_faces
 from ..surface.piece import Piece
 from ..tolerances import tol
@@ -199,10 +200,7 @@ def _border_points(piece: Piece) -> np.ndarray:
     flat, size = flat_faces(piece.faces)
     if not len(flat):
         return np.zeros(0, dtype=np.int64)
-    start = np.r_[0, np.cumsum(size)[:-1]]
-    nxt = np.arange(len(flat)) + 1
-    nxt[np.cumsum(size) - 1] = start  # each face's last corner goes back to its first
-    sides = np.sort(np.c_[flat, flat[nxt]], axis=1)
+    sides = np.sort(np.c_[flat, flat[run_next(run_starts(size))]], axis=1)
     key = sides[:, 0] * (int(flat.max()) + 1) + sides[:, 1]
     _, inverse, count = np.unique(key, return_inverse=True, return_counts=True)
     return np.unique(sides[count[inverse] == 1])

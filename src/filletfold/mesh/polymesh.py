@@ -18,7 +18,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..arrays import run_owners, run_starts
+from ..arrays import run_next, run_owners, run_starts
 from ..errors import MeshError
 from .measures import newell_vectors
 
@@ -81,8 +81,7 @@ class PolyMesh:
         if len(he_from) and (he_from.min() < 0 or he_from.max() >= n):
             raise MeshError("a face refers to a vertex index outside the vertex list")
         self.face_start = run_starts(face_size)
-        nxt = np.arange(1, len(he_from) + 1)  # the next corner of each face, cyclically
-        nxt[self.face_start[1:] - 1] = self.face_start[:-1]
+        nxt = run_next(self.face_start)  # the next corner of each face, cyclically
         he_to = he_from[nxt]
         he_face = run_owners(face_size)
         self.halfedge_from = he_from
@@ -160,8 +159,7 @@ class PolyMesh:
         axes were not orthogonal to the cylinders' tangent lines by as much, and the
         development's gluing maps shrank lengths by ``1e-11``).
         """
-        nxt = np.arange(len(self.halfedge_from)) + 1
-        nxt[self.face_start[1:] - 1] = self.face_start[:-1]
+        nxt = run_next(self.face_start)
         return newell_vectors(self.vertices[self.halfedge_from], self.face_start, nxt)
 
     @cached_property

@@ -38,7 +38,7 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ..arrays import run_owners, run_starts, split_runs
+from ..arrays import run_next, run_owners, run_starts, split_runs
 from ..errors import MeshError
 
 #: Added to the diagonal of planarize's normal equations (``A A^T``), which are singular when
@@ -325,8 +325,7 @@ def _degenerate(faces, v, rel_height: float) -> np.ndarray:
     start = run_starts(size)
     idx = np.concatenate(faces)
     face = run_owners(size)
-    nxt = np.arange(len(idx)) + 1
-    nxt[start[1:] - 1] = start[:-1]
+    nxt = run_next(start)
     p = v[idx]
     centroid = np.add.reduceat(p, start[:-1], axis=0) / size[:, None]
     q = p - centroid[face]
@@ -497,8 +496,7 @@ def _edge_counts(faces, n: int) -> tuple[np.ndarray, np.ndarray]:
     frm = np.concatenate(faces).astype(np.int64)
     size = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
     start = run_starts(size)
-    nxt = np.arange(len(frm)) + 1
-    nxt[start[1:] - 1] = start[:-1]
+    nxt = run_next(start)
     to = frm[nxt]
     return np.unique(np.minimum(frm, to) * n + np.maximum(frm, to), return_counts=True)
 
@@ -534,8 +532,7 @@ def split_non_manifold(faces, origin, v, vorig, log: RepairLog, unpaired=(), why
     start = run_starts(size)
     frm = np.concatenate(faces).astype(np.int64)
     face = run_owners(size)
-    nxt = np.arange(len(frm)) + 1
-    nxt[start[1:] - 1] = start[:-1]
+    nxt = run_next(start)
     to = frm[nxt]
     n = len(v)
     lo, hi = np.minimum(frm, to), np.maximum(frm, to)
@@ -900,8 +897,7 @@ def planarize(faces, v, log: RepairLog, *, rounds: int = 8, rel: float = 1e-15):
     start = run_starts(size)
     idx = np.concatenate([faces[i] for i in poly.tolist()])
     face = run_owners(size)
-    nxt = np.arange(len(idx)) + 1
-    nxt[start[1:] - 1] = start[:-1]
+    nxt = run_next(start)
     x = v.copy()
     diam = np.maximum.reduceat(np.linalg.norm(x[idx] - x[idx[nxt]], axis=1), start[:-1])
 
