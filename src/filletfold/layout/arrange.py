@@ -79,7 +79,9 @@ def arrange(
         seconds the placement on sheets took (with a sheet).
     release_pieces : bool
         Empty ``pieces`` (the caller's list) once the pattern is assembled, so that the glue
-        tabs run without them in memory (the pattern holds their points again).
+        tabs run without them in memory (the pattern holds their points again); with nets,
+        as soon as the nets are made, with ``sol``'s frames, classification and solutions
+        and ``mods``'s modules (the nets are copies).
 
     Returns
     -------
@@ -135,6 +137,9 @@ def arrange(
     if layout == "net" or (layout == "auto" and layout_used == "modules"):
         pieces = net_pieces(pm, sol, mods.modules, mods.points, eps, sheet=room)
         layout_used = "net"
+        if release_pieces:  # the nets hold copies: the modules, and what built them, can go
+            given.clear()
+            sol.frames = sol.classified = sol.solved = mods.modules = None
     if sheet is not None:
         pieces = [orient(piece) for piece in pieces]
         t = time.perf_counter()
