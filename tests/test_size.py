@@ -36,7 +36,13 @@ def test_a_bad_size_is_refused_naming_it(text):
 
 
 def test_sized_derives_units_and_scale_from_the_extent():
-    assert sized(Parameters(), 2.0) == Parameters()  # no size: unchanged
+    assert sized(Parameters(size=None), 2.0) == Parameters(size=None)  # no size: unchanged
+    assert sized(Parameters(), 2.0, 0.1) == Parameters()  # the default: the layout settles it
+    # the default with units or a scale given is no size (the mesh is in those units), and
+    # so it is for a mesh of no extent
+    assert sized(Parameters(units="mm"), 2.0, 0.1) == Parameters(units="mm", size=None)
+    assert sized(Parameters(scale=3.0), 2.0, 0.1) == Parameters(scale=3.0, size=None)
+    assert sized(Parameters(), 0.0, 0.0) == Parameters(size=None)
     p = sized(Parameters(size="300mm"), 2.0)
     assert (p.units, p.scale) == ("mm", pytest.approx(150.0))
     p = sized(Parameters(size="300mm", units="cm"), 2.0)
@@ -75,7 +81,7 @@ def test_size_and_scale_together_are_refused_in_one_line(capsys):
 def test_pieces_under_the_minimum_are_reported_and_warned_of():
     from filletfold.export.outputs import MIN_PIECE_MM, piece_sizes_mm, piece_spans
 
-    plain = filletfold.round_mesh("icosahedron")
+    plain = filletfold.round_mesh("icosahedron", size=None)
     assert piece_sizes_mm(plain) is None  # no units: no physical size
     assert not any("warning: " in x and " mm" in x for x in plain.summary().splitlines())
     big = filletfold.round_mesh("icosahedron", units="cm", scale=10.0)
@@ -97,7 +103,7 @@ def test_the_report_gives_the_smallest_piece_at_the_drawing_size(tmp_path):
     fab = json.loads((out / "report.json").read_text())["fabrication"]
     assert fab["pieces_under_min"] == 0 and fab["smallest_piece_mm"] > 3.0
     out = tmp_path / "plain"
-    assert main(["round", "cube", "-q", "-o", str(out)]) == 0
+    assert main(["round", "cube", "-q", "-o", str(out), "--size", "none"]) == 0
     assert "smallest_piece_mm" not in json.loads((out / "report.json").read_text())["fabrication"]
 
 
@@ -117,8 +123,8 @@ def test_tabs_and_labels_have_a_physical_height_and_low_ones_are_warned_of():
     edge_mm = small.mesh.mean_edge_length * small.params.scale
     assert label == pytest.approx(0.45 * 0.5 * edge_mm, rel=5e-3) and label < MIN_LABEL_MM
     assert f"warning: labels {label:.3g} mm high" in small.summary()
-    # without units, as before: a share of the mean edge length
-    plain = filletfold.round_mesh("icosahedron")
+    # without units: a share of the mean edge length
+    plain = filletfold.round_mesh("icosahedron", size=None)
     heights = np.asarray(plain.pattern.annotations.labels.height)
     assert heights.min() == pytest.approx(0.45 * 0.04 * plain.mesh.mean_edge_length, rel=5e-3)
 
@@ -171,3 +177,100 @@ def test_cut_and_fold_lengths_and_areas():
     n = len(sheets.pattern.annotations.sheets)
     assert cut_and_fold(sheets.pattern)["sheet_area"] == pytest.approx(n * 210 * 297 / 30**2)
     assert "to make: " in sheets.summary() and " m² of sheets" in sheets.summary()
+
+
+@pytest.mark.parametrize(
+    ("x", "up"), [(614.2, 620.0), (100.0, 100.0), (100.4, 110.0), (1234.0, 1300.0), (88.9, 89.0)]
+)
+def test_a_default_size_is_rounded_up_to_two_digits(x, up):
+    from filletfold.units import ceil_digits
+
+    assert ceil_digits(x) == pytest.approx(up)
+
+
+def test_the_default_size_is_the_largest_of_its_three_bounds():
+    from filletfold.layout.arrange import TAB_MAX, default_size
+    from filletfold.layout.tabs import LABEL_SHARE
+    from filletfold.units import LEAST_SIZE_MM, MIN_LABEL_MM, MIN_PIECE_MM
+
+    assert default_size(10.0, 1.0) == (LEAST_SIZE_MM, "least")  # labels need 88.9 mm
+    labels = 10.0 * MIN_LABEL_MM / (LABEL_SHARE * TAB_MAX * 0.1)  # 888.9 mm
+    assert default_size(10.0, 0.1) == (pytest.approx(890.0), "labels") and labels < 890
+    assert default_size(10.0, 0.1, smallest=0.05) == (pytest.approx(890.0), "labels")
+    pieces = 10.0 * MIN_PIECE_MM / 0.01  # 3000 mm
+    assert default_size(10.0, 0.1, smallest=0.01) == (pytest.approx(pieces), "pieces")
+
+
+def test_the_default_size_is_set_by_the_smallest_laid_out_piece():
+    from filletfold.layout.arrange import settle_size, smallest_span
+    from filletfold.surface.piece import Piece
+
+    square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    big = Piece(0, square * 5.0, np.zeros((4, 3)), [[0, 1, 2, 3]])
+    # a piece of two triangles 0.2 across, and a point its faces do not use
+    small = Piece(
+        1, np.vstack([square * 0.2, [[9.0, 9.0]]]), np.zeros((5, 3)), [[0, 1, 2], [0, 2, 3]]
+    )
+    assert smallest_span([big, small]) == pytest.approx(0.2)
+    assert smallest_span([Piece(2)]) is None
+    p, default = settle_size(Parameters(), 10.0, 1.0, [big, small])
+    assert default == {"size": "150mm", "binding": "pieces"}  # 0.2 units are 3 mm at 150 mm
+    assert (p.size, p.units, p.scale) == ("150mm", "mm", pytest.approx(15.0))
+    # on sheets, the pieces were fitted at the labels' size: only the labels and least bound
+    assert settle_size(Parameters(), 10.0, 1.0, None)[1] == {"size": "100mm", "binding": "least"}
+    # a size given stays as it is
+    assert settle_size(Parameters(size="50mm"), 10.0, 1.0, [small]) == (
+        Parameters(size="50mm"),
+        None,
+    )
+
+
+def test_by_default_every_label_and_piece_can_be_made_and_the_summary_says_the_size(tmp_path):
+    """A fine sphere (642 vertices): its labels set the default size, 120 mm; at it every
+    label is 2 mm high and every piece spans 3 mm; at less, the labels are too low."""
+    import trimesh
+
+    from filletfold.export.outputs import piece_sizes_mm
+    from filletfold.units import MIN_LABEL_MM, MIN_PIECE_MM
+
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    mesh = (sphere.vertices, sphere.faces)
+    design = filletfold.round_mesh(mesh, layout="modules")
+    assert design.fabrication["default_size"] == {"size": "120mm", "binding": "labels"}
+    assert (design.params.size, design.params.units) == ("120mm", "mm")
+    extent = float(np.ptp(design.mesh.vertices, axis=0).max())
+    assert design.params.scale * extent == pytest.approx(120.0)
+    sizes = piece_sizes_mm(design)
+    # (label heights are written to 3 digits)
+    assert sizes["smallest_label_mm"] >= MIN_LABEL_MM * (1 - 5e-4)
+    assert sizes["pieces_under_min"] == 0 and sizes["smallest_piece_mm"] >= MIN_PIECE_MM
+    line = next(x for x in design.summary().splitlines() if x.startswith("size: 120mm"))
+    assert "the default: the least with labels 2 mm high; --size to choose" in line
+    assert "warning" not in design.summary()
+    smaller = filletfold.round_mesh(mesh, layout="modules", size="100mm")
+    assert piece_sizes_mm(smaller)["smallest_label_mm"] < MIN_LABEL_MM
+    assert "warning: labels" in smaller.summary() and "default" not in smaller.summary()
+
+
+def test_the_default_size_on_the_command_line_and_how_to_go_without(tmp_path):
+    out = tmp_path / "cube"
+    assert main(["round", "cube", "-q", "-f", "svg,json", "-o", str(out)]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["fabrication"]["default_size"] == {"size": "100mm", "binding": "least"}
+    assert (report["parameters"]["size"], report["parameters"]["units"]) == ("100mm", "mm")
+    assert report["parameters"]["scale"] == pytest.approx(100.0)  # the cube's side is 1
+    assert 'mm" height="' in (out / "pattern.svg").read_text()
+    # --size none: unitless; --units alone: the mesh is in those units (1 unit = 1 mm)
+    for args, units, scale in ((["--size", "none"], "", None), (["--units", "mm"], "mm", None)):
+        out = tmp_path / units
+        assert main(["round", "cube", "-q", "-f", "json", "-o", str(out), *args]) == 0
+        report = json.loads((out / "report.json").read_text())
+        p = report["parameters"]
+        assert (p["size"], p["units"], p["scale"]) == (None, units, scale)
+        assert "default_size" not in report["fabrication"]
+
+
+def test_a_default_size_on_sheets_is_the_labels_and_fits_them(tmp_path):
+    design = filletfold.round_mesh("icosahedron", sheet="A4")
+    assert design.fabrication["default_size"] == {"size": "100mm", "binding": "least"}
+    assert design.params.units == "mm" and design.fabrication["sheets"] >= 1

@@ -222,6 +222,8 @@ def _round_parameters(ctx: typer.Context, from_report: Path | None):
         raise ParameterError("give --size or --scale, not both", name="size")
     if "scale" in given:  # a scale given now replaces a size the report had
         given["size"] = None
+    if str(given.get("size", "")).strip().lower() == "none":
+        given["size"] = None  # a unitless drawing
     return base.replace(**given), source
 
 
@@ -403,7 +405,10 @@ def round_cmd(
             "--size",
             help="The object's size: its mesh's largest side becomes this long (300mm, 30cm, "
             "12in; a bare number is mm). Sets --units (the size's unit unless given) and "
-            "--scale for the cut files and sheets; not with --scale.",
+            "--scale for the cut files and sheets; not with --scale. Default (auto): the "
+            "least size at which every label is 2 mm high and every piece spans 3 mm (at "
+            "least 100 mm), printed in the summary; with --units or --scale, none (the mesh "
+            "is in those units); 'none': a unitless drawing.",
             show_default=False,
         ),
     ] = None,
@@ -501,10 +506,7 @@ def round_cmd(
         written = export_design(
             design,
             target,
-            formats=chosen,
-            units=design.params.units,  # with --size, those the mesh's extent gave
-            scale=design.params.scale,
-            page=params.sheet or "A4",
+            formats=chosen,  # at the design's units and scale (with a size, those it gave)
             preset=preset,
             view=view,
             tables=report_tables,

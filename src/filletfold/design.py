@@ -254,7 +254,7 @@ def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, t
         laid.pattern.vertices_3d = laid.pattern.vertices_3d + job.shift
     return Design(
         mesh=mesh,
-        params=job.params,
+        params=laid.params,
         rounding=rounding,
         vertices=res,
         pattern=laid.pattern,

@@ -26,6 +26,7 @@ from .defaults import (
 )
 from .errors import ParameterError
 from .tolerances import tol
+from .units import AUTO_SIZE
 
 __all__ = ["Parameters", "parse_length", "report_parameters", "resolve_chord_tol", "resolve_depth"]
 
@@ -156,7 +157,12 @@ class Parameters:
         length (``"300mm"``, ``"30cm"``, ``"12in"``; a bare number is mm,
         :func:`~filletfold.units.parse_size`). The design then has ``units`` (the size's unit
         unless given) and ``scale`` derived from it (:func:`sized`): the cut files and sheets
-        are at that size.
+        are at that size. ``"auto"`` (the default): the least size, in millimetres, at which
+        every label is 2 mm high and every piece spans 3 mm (at least 100 mm; on sheets,
+        the labels' size: :func:`~filletfold.layout.arrange.default_size`); ``design.params``
+        then holds the size chosen (``"620mm"``). Given ``units`` or ``scale``, ``"auto"``
+        is no size: the mesh is in those units. None: no size, a unitless drawing unless
+        ``units`` are given.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -179,7 +185,7 @@ class Parameters:
     nest: str = "shelf"
     faces: int | None = None
     edge_length: object = None
-    size: object = None
+    size: object = "auto"
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:
@@ -294,7 +300,7 @@ class Parameters:
                 f"coplanar tolerance must be in [0, 90) degrees, got {self.coplanar_deg!r}",
                 name="coplanar_deg",
             )
-        if self.size is not None:
+        if self.size is not None and self.size != "auto":
             from .units import parse_size
 
             parse_size(self.size)
@@ -375,7 +381,13 @@ def report_parameters(path) -> tuple[Parameters, str]:
     source = doc.get("source")
     if not isinstance(source, str):
         raise ParameterError(f"{path}: not a filletfold report (no string 'source')")
-    return Parameters.from_dict(doc["parameters"], where=f"{path}: parameters"), source
+    params = Parameters.from_dict(doc["parameters"], where=f"{path}: parameters")
+    fab = doc.get("fabrication")
+    default = fab.get("default_size") if isinstance(fab, dict) else None
+    if isinstance(default, dict) and params.size == default.get("size"):
+        # the size was the default: asked again, it settles the same (or anew, on a new mesh)
+        params = params.replace(size=AUTO_SIZE, units="", scale=None)
+    return params, source
 
 
 def _plain(x):
@@ -535,10 +547,17 @@ def resolve_depth(depth, reference: float, n: int):
     return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
 
 
-def sized(params: Parameters, extent: float) -> Parameters:
+def sized(params: Parameters, extent: float, ref: float = 0.0) -> Parameters:
     """``params`` with ``units`` and ``scale`` derived from ``size`` for a mesh whose largest
-    bounding-box side is ``extent`` (unchanged without ``size``): the units are ``units``, or
-    the size's own unit; the scale makes ``extent`` pattern units ``size`` long.
+    bounding-box side is ``extent`` and mean edge length ``ref`` (unchanged without
+    ``size``): the units are ``units``, or the size's own unit; the scale makes ``extent``
+    pattern units ``size`` long.
+
+    ``size="auto"`` (the default) asks for the least size at which the object can be built
+    (:func:`~filletfold.layout.arrange.default_size`): it is left ``"auto"`` here, for the
+    layout to settle once the pieces are known
+    (:func:`~filletfold.layout.arrange.settle_size`). Given ``units`` or ``scale``, or for a
+    mesh of no extent, it is no size (``None``): the mesh is then in those units.
 
     Raises
     ------
@@ -549,6 +568,9 @@ def sized(params: Parameters, extent: float) -> Parameters:
 
     if params.size is None:
         return params
+    if params.size == AUTO_SIZE:
+        given = params.units or params.scale is not None
+        return params.replace(size=None) if given or not (extent > 0 and ref > 0) else params
     mm, unit = parse_size(params.size)
     if not extent > 0:
         raise ParameterError("size needs a mesh of some extent", name="size")

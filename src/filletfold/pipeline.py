@@ -176,13 +176,15 @@ class Edges:
 @dataclass
 class Layout:
     """The layout stage's result: the crease pattern, the layout used (and why another was
-    not), the fabrication figures, and the pieces (empty when released)."""
+    not), the fabrication figures, the pieces (empty when released) and the parameters with
+    the default size settled (:func:`~filletfold.layout.arrange.settle_size`)."""
 
     pattern: CreasePattern
     layout: str
     note: str
     fabrication: dict
     pieces: list
+    params: Parameters
 
 
 @dataclass
@@ -268,7 +270,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)
     size, strict = mesh_size(pm), params.strict
-    params = sized(params, float(np.ptp(pm.vertices, axis=0).max(initial=0.0)))
+    params = sized(params, float(np.ptp(pm.vertices, axis=0).max(initial=0.0)), pm.mean_edge_length)
     return Job(
         params=params,
         mesh=pm,
@@ -596,7 +598,7 @@ def layout_stage(
         # the layout needs neither the frames nor the modules (nets do: net_pieces rebuilds)
         sol.frames = sol.classified = sol.solved = mods.modules = None
     _stage("layout")
-    pattern, layout_used, layout_note, fab = arrange(
+    pattern, layout_used, layout_note, fab, params = arrange(
         pm, sol, mods, pieces, p, stage=_stage, timings=timings, release_pieces=release
     )
     locate_apices(pattern, sol.res)
@@ -607,7 +609,7 @@ def layout_stage(
         ~(sol.rounding.radius > 0),
         tol.closure * job.size,  # the apex and the edges' points, to round-off of the size
     )
-    return Layout(pattern, layout_used, layout_note, fab, pieces)
+    return Layout(pattern, layout_used, layout_note, fab, pieces, params)
 
 
 def _build_modules(pm: PolyMesh, solved: list, centres, points, progress) -> list:

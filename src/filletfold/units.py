@@ -18,9 +18,14 @@ from collections.abc import Iterable
 from .errors import ParameterError
 
 __all__ = [
+    "AUTO_SIZE",
     "CUT_FILE_UNITS",
+    "LEAST_SIZE_MM",
+    "MIN_LABEL_MM",
+    "MIN_PIECE_MM",
     "MM_PER_UNIT",
     "SHEET_SIZES_MM",
+    "ceil_digits",
     "check_units",
     "parse_size",
     "sheet_size_mm",
@@ -39,6 +44,19 @@ SHEET_SIZES_MM = {
 MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "pt": 25.4 / 72.0}
 #: The units every cut file can carry (DXF has no code for points).
 CUT_FILE_UNITS = ("mm", "cm", "m", "in")
+
+#: Pieces that span less than this on the sheet (mm) are too small to cut and fold (the
+#: summary warns; the default size makes none).
+MIN_PIECE_MM = 3.0
+#: Labels lower than this on the sheet (mm) are hard to read (the summary warns; the default
+#: size makes none).
+MIN_LABEL_MM = 2.0
+#: The default size: the least largest side (mm) of an object made at the default size, a
+#: model held in the hand.
+LEAST_SIZE_MM = 100.0
+#: The ``size`` that asks for the default: the least size at which the object can be built
+#: (see :func:`filletfold.layout.arrange.default_size`).
+AUTO_SIZE = "auto"
 
 _NUMBER = r"(\d+(?:\.\d*)?|\.\d+)"
 _SIZE = re.compile(rf"\s*{_NUMBER}\s*(mm|cm|m|in)?\s*")
@@ -135,3 +153,10 @@ def parse_size(size) -> tuple[float, str]:
         )
     unit = m.group(2) or "mm"
     return value * MM_PER_UNIT[unit], unit
+
+
+def ceil_digits(x: float, digits: int = 2) -> float:
+    """``x`` > 0 rounded up to ``digits`` significant digits (``ceil_digits(614.2) == 620``):
+    a size a person can state."""
+    step = 10.0 ** (math.floor(math.log10(x)) - digits + 1)
+    return math.ceil(round(x / step, 9)) * step

@@ -179,7 +179,7 @@ def test_cli_round_and_export_draw_the_mesh_files_at_scale(tmp_path):
 
     plain, scaled = tmp_path / "plain", tmp_path / "scaled"
     formats = ["--format", "fold,glb,ply,stl"]
-    assert main(["round", "cube", "-q", "-o", str(plain), *formats]) == 0
+    assert main(["round", "cube", "-q", "-o", str(plain), *formats, "--size", "none"]) == 0
     args = ["--units", "mm", "--scale", "200"]
     assert main(["round", "cube", "-q", "-o", str(scaled), *formats, *args]) == 0
     base, got = mesh_bounds(plain), mesh_bounds(scaled)

@@ -440,6 +440,8 @@ class AppSession:
             # the shown design was computed as modules without glue tabs: lay it out in nets
             # with tabs, as the command line does (the layout stage only)
             p = design.params
+            if design.fabrication.get("default_size"):  # settled anew for the nets' pieces
+                p = p.replace(size="auto", units="", scale=None)
             source = design.source
             design = round_mesh(design.mesh, p, tabs=True, layout="auto", reuse=design)
             design.source = source
@@ -447,6 +449,8 @@ class AppSession:
             cut_files(
                 design.pattern,
                 ZIP_FORMATS,
+                units=design.params.units,  # at the design's size, as the command line draws
+                scale=design.params.scale,
                 title=f"filletfold design of {design.source}",
                 description="Curved-crease rounded design: vertex modules",
                 fold_extra=mesh_fold_keys(design),

@@ -16,6 +16,7 @@ from ..rounding.edges import loss_from_radius
 from ..surface.pattern import LabelRows, face_arrays
 from ..surface.validate import face_signed_area_2d
 from ..tolerances import tol
+from ..units import MIN_LABEL_MM, MIN_PIECE_MM
 from . import report_json, write_outputs
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .report import Records
@@ -399,14 +400,9 @@ def relative_mismatch(pattern) -> np.ndarray:
     return _mismatches(pattern)[1]
 
 
-#: Pieces that span less than this on the sheet (mm) are too small to cut and fold: the
-#: summary warns (issue 29's default minimum).
-MIN_PIECE_MM = 3.0
 #: A mesh thinner than this share of its length is nearly flat: the summary warns that its
 #: modules could be far fewer pieces.
 FLAT_RATIO = 0.02
-#: Labels lower than this on the sheet (mm) are hard to read: the summary warns.
-MIN_LABEL_MM = 2.0
 #: A design of more pieces gets a line in the summary suggesting ``--faces``.
 MANY_PIECES = 1000
 #: The triangle count that line suggests.
@@ -449,6 +445,14 @@ def piece_sizes_mm(design) -> dict | None:
     }
 
 
+#: What set the default size (:func:`~filletfold.layout.arrange.default_size`), for the summary.
+_DEFAULT_SIZE_WHY = {
+    "least": "a model held in the hand",
+    "labels": f"the least with labels {MIN_LABEL_MM:g} mm high",
+    "pieces": f"the least with every piece {MIN_PIECE_MM:g} mm across",
+}
+
+
 def _size_lines(design) -> list[str]:
     """The summary's lines for the physical size: with ``size``, the scale it gave and the
     smallest piece at it; with any units, a warning for pieces under :data:`MIN_PIECE_MM`."""
@@ -468,9 +472,15 @@ def _size_lines(design) -> list[str]:
         line += f" on {work['sheet_area'] * mm * mm / 1e6:.4g} m² of sheets"
     lines.append(line)
     if p.size is not None:
+        default = design.fabrication.get("default_size")
+        why = (
+            ""
+            if default is None
+            else f", the default: {_DEFAULT_SIZE_WHY[default['binding']]}; --size to choose"
+        )
         lines.append(
-            f"size: {p.size} (the mesh's largest side): 1 unit = {float(p.scale):.4g} {p.units}; "
-            f"the smallest piece spans {smallest:.3g} mm"
+            f"size: {p.size} (the mesh's largest side{why}): 1 unit = {float(p.scale):.4g} "
+            f"{p.units}; the smallest piece spans {smallest:.3g} mm"
         )
     label = sizes["smallest_label_mm"]
     if label is not None and label < MIN_LABEL_MM:
@@ -658,9 +668,9 @@ def export_design(
     *,
     title: str | None = None,
     formats=DEFAULT_FORMATS,
-    units: str = "",
+    units: str | None = None,
     scale: float | None = None,
-    page: str = "A4",
+    page: str | None = None,
     preset=None,
     view=None,
     tables: bool = False,
@@ -682,7 +692,9 @@ def export_design(
         between two runs on the same input.
     units, scale, page
         Real size of the cut files and PDF page (see
-        :func:`~filletfold.export.cutfiles.cut_files`).
+        :func:`~filletfold.export.cutfiles.cut_files`); by default the design's
+        (``design.params``: its units and scale, with the default size those it settled;
+        its sheet, or A4). Units given without a scale: scale 1.
     preset : str or Preset, optional
         Cutter preset of ``pattern.svg`` and ``pattern.dxf``
         (:data:`~filletfold.export.presets.PRESETS`; default ``print``).
@@ -701,6 +713,9 @@ def export_design(
     """
     t = time.perf_counter()
     release_memory()  # what the design's stages freed, before the files are built
+    if units is None:
+        units, scale = design.params.units, design.params.scale if scale is None else scale
+    page = page or design.params.sheet or "A4"
     formats = parse_formats(formats)
     title = title or f"filletfold design of {design.source}"
     pattern_formats = [f for f in formats if f != "json"]

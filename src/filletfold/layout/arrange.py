@@ -14,14 +14,16 @@ import numpy as np
 from ..errors import ParameterError, SolverError
 from ..surface.assemble import assemble_pattern
 from ..surface.module import Modules
+from ..surface.pattern import face_arrays
 from ..surface.piece import piece_area
 from ..tolerances import tol
+from ..units import AUTO_SIZE, LEAST_SIZE_MM, MIN_LABEL_MM, MIN_PIECE_MM, ceil_digits
 from ..vertex.solution import VertexSolution
 from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
 from .nest import SEED, choose_nester, nest_on_sheets, placement_errors, use_figures
 from .sheet import glue_pieces
 from .shelf import shelf_offsets
-from .tabs import add_tabs_and_labels
+from .tabs import LABEL_SHARE, add_tabs_and_labels
 
 #: Height of a glue tab, as a share of the mean edge length, in a drawing without units.
 TAB_HEIGHT = 0.04
@@ -40,6 +42,64 @@ def tab_height(params, ref: float) -> float:
     if not params.units:
         return TAB_HEIGHT * ref
     return min(TAB_MM / params.mm_per_unit, TAB_MAX * ref)
+
+
+def default_size(extent: float, ref: float, smallest: float | None = None) -> tuple[float, str]:
+    """The default size of an object whose mesh's largest side is ``extent`` and mean edge
+    length ``ref``: the least largest side (mm) at which it can be built, rounded up to two
+    significant digits, and what sets it.
+
+    Three lower bounds, the largest of which sets it (``"least"``, ``"labels"``,
+    ``"pieces"``): :data:`~filletfold.units.LEAST_SIZE_MM`; the size at which the labels
+    are :data:`~filletfold.units.MIN_LABEL_MM` high, tabs being at most :data:`TAB_MAX` of
+    the mean edge length and labels :data:`~filletfold.layout.tabs.LABEL_SHARE` of a tab;
+    and, given the ``smallest`` piece's span (pattern units), the size at which it spans
+    :data:`~filletfold.units.MIN_PIECE_MM`.
+
+    Returns
+    -------
+    mm : float
+    binding : str
+    """
+    bounds = {
+        "least": LEAST_SIZE_MM,
+        "labels": extent * MIN_LABEL_MM / (LABEL_SHARE * TAB_MAX * ref),
+    }
+    if smallest is not None and smallest > 0:
+        bounds["pieces"] = extent * MIN_PIECE_MM / smallest
+    binding = max(bounds, key=bounds.__getitem__)
+    return ceil_digits(bounds[binding]), binding
+
+
+def smallest_span(pieces: list) -> float | None:
+    """The least over ``pieces`` of the longer side of a piece's bounding box (of the points
+    its faces use; pattern units); None without a piece that has faces."""
+    spans = []
+    for piece in pieces:
+        flat, _ = face_arrays(piece.faces)
+        if len(flat):
+            xy = np.asarray(piece.points_2d, dtype=np.float64)[flat]
+            spans.append(float(np.ptp(xy, axis=0).max()))
+    return min(spans) if spans else None
+
+
+def settle_size(params, extent: float, ref: float, pieces: list | None):
+    """``params`` with the default size settled (unchanged unless ``size`` is
+    :data:`~filletfold.units.AUTO_SIZE`): :func:`default_size` with the smallest of the laid
+    out ``pieces`` (None: the labels and the least size only, as on sheets, where the pieces
+    were fitted at that size), written as the size in millimetres it is (``"620mm"``), with
+    the units (mm) and scale it gives, and the report's account of it (``{"size",
+    "binding"}``; None when the size was given). A mesh of no extent gets no size."""
+    if params.size != AUTO_SIZE:
+        return params, None
+    if not (extent > 0 and ref > 0):
+        return params.replace(size=None), None
+    mm, binding = default_size(extent, ref, None if pieces is None else smallest_span(pieces))
+    size = f"{mm:g}mm"
+    return params.replace(size=size, units="mm", scale=mm / extent), {
+        "size": size,
+        "binding": binding,
+    }
 
 
 def arrange(
@@ -89,7 +149,10 @@ def arrange(
     layout_used : str
     layout_note : str
     fabrication : dict
-        Cut borders, tabs and sheet figures (the report's ``fabrication``).
+        Cut borders, tabs and sheet figures (the report's ``fabrication``), and
+        ``default_size`` (:func:`settle_size`) when the size was the default.
+    params : Parameters
+        ``params`` with the default size settled (:func:`settle_size`).
     """
     pm, res, ring_closed = mesh, sol.res, sol.ring_closed
     layout, material_loss, sheet, tabs = (
@@ -98,6 +161,9 @@ def arrange(
         params.sheet,
         params.tabs,
     )
+    asked = params  # the size settles once the pieces are known (on sheets, before)
+    extent = float(np.ptp(pm.vertices, axis=0).max(initial=0.0))
+    params, _ = settle_size(params, extent, pm.mean_edge_length, None)
     units, scale = params.sheet_units, params.sheet_scale
     given = pieces  # the caller's list (``pieces`` may be rebound to laid-out copies)
     ref = pm.mean_edge_length
@@ -140,6 +206,10 @@ def arrange(
         if release_pieces:  # the nets hold copies: the modules, and what built them, can go
             given.clear()
             sol.frames = sol.classified = sol.solved = mods.modules = None
+    params, default = settle_size(asked, extent, ref, pieces if sheet is None else None)
+    if sheet is None:  # the tabs at the size settled (on sheets, it is the size fitted to)
+        tab_h = tab_height(params, ref) if tabs else 0.0
+        gap = 0.1 * ref + 2.5 * tab_h
     if sheet is not None:
         pieces = [orient(piece) for piece in pieces]
         t = time.perf_counter()
@@ -174,7 +244,9 @@ def arrange(
             timings["tabs"] = time.perf_counter() - t
     if sheet is not None:
         fab.update(sheet_stats)
-    return pattern, layout_used, layout_note, fab
+    if default is not None:
+        fab["default_size"] = default
+    return pattern, layout_used, layout_note, fab, params
 
 
 def place_on_sheets(pieces: list, sheet_box, gap: float, nest: str):

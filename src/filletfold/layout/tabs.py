@@ -82,6 +82,9 @@ LABEL_GRID = 1e-6
 LABEL_ANGLE_DECIMALS = 2
 LABEL_HEIGHT_DIGITS = 3
 
+#: Height of a seam label, as a share of the full tab height (part numbers are twice as high).
+LABEL_SHARE = 0.45
+
 #: Smallest area of a candidate tab, as a share of its height squared: smaller ones are
 #: degenerate.
 LEAST_TAB = 1e-3
@@ -726,7 +729,7 @@ def _tabs_and_labels(p, tab_height, part_names):
     """The work of :func:`add_tabs_and_labels`."""
     faces = _Faces(p, tab_height)
     ann = Annotations(sheets=p.annotations.sheets)
-    label_h = 0.45 * tab_height
+    label_h = LABEL_SHARE * tab_height
     side_a, side_b, start = _runs(p, _seam_pairs(p))
     ends = np.zeros((0, 2, 2, 2))
     normal = np.zeros((0, 2, 2))
