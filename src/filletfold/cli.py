@@ -141,8 +141,18 @@ ViewOption = Annotated[
     typer.Option(
         "--view",
         help="Direction preview.png is seen from: front, back, top, side or AZIMUTH,ELEVATION "
-        "in degrees, optionally followed by ,y (or ,x) for a model whose up is +y "
+        "in degrees, optionally followed by ,x ,y or ,z: the axis up (else --up's) "
         "[default: front, i.e. -60,25].",
+    ),
+]
+UpOption = Annotated[
+    str | None,
+    typer.Option(
+        "--up",
+        help="The axis up in preview.png (and the app's view): x, y, z or auto, the one the "
+        "mesh stands on (else its format's convention: y for OBJ, PLY and glTF) "
+        "[default: auto; export: the design's].",
+        show_default=False,
     ),
 ]
 SheetOption = Annotated[
@@ -200,6 +210,7 @@ ROUND_PARAMETERS = {
     "faces": "faces",
     "edge_length": "edge_length",
     "size": "size",
+    "up": "up",
 }
 
 
@@ -218,6 +229,8 @@ def _round_parameters(ctx: typer.Context, from_report: Path | None):
         if source_of is not None and source_of.name == "COMMANDLINE":
             value = ctx.params[option]
             given[name] = not value if option == "no_tabs" else value
+    if isinstance(given.get("up"), str):
+        given["up"] = given["up"].strip().lower()
     if "scale" in given and "size" in given:
         raise ParameterError("give --size or --scale, not both", name="size")
     if "scale" in given:  # a scale given now replaces a size the report had
@@ -415,6 +428,7 @@ def round_cmd(
     sheet: SheetOption = None,
     preset: PresetOption = None,
     view: ViewOption = None,
+    up: UpOption = None,
     no_tabs: Annotated[
         bool, typer.Option("--no-tabs", help="No glue tabs, seam labels or part numbers.")
     ] = False,
@@ -614,6 +628,7 @@ def export_cmd(
     sheet: SheetOption = None,
     preset: PresetOption = None,
     view: ViewOption = None,
+    up: UpOption = None,
 ):
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
@@ -621,11 +636,13 @@ def export_cmd(
     (pattern.png and preview.png), simulator (simulator.fold and simulator.svg, for Origami
     Simulator), obj (folded.obj), 3dm (pattern.3dm, folded.3dm), glb, ply, stl (folded.glb,
     .ply, .stl); all of them with --format all. The files are written into
-    FOLDER, all or nothing.
+    FOLDER, all or nothing. Without --units and --scale, at the design's size, and without
+    --up, with the design's up (both from FOLDER/report.json, when it has them).
     """
     from .export import write_outputs
     from .export.cutfiles import cut_files, parse_formats
     from .export.fold_read import read_fold
+    from .export.png import parse_view
 
     try:
         spec = formats if formats is not None else "dxf,pdf,svg,png"
@@ -646,8 +663,20 @@ def export_cmd(
         if not source.is_file():
             raise _error(f"{source}: no design.fold in {folder} (write it with 'filletfold round')")
         pattern = read_fold(source)
+        made = _made_with(folder / "report.json")
+        if not units and scale is None:  # at the design's size
+            units, scale = made.get("units", ""), made.get("scale")
+        up = (up or made.get("up") or "z").strip().lower()
+        if up not in ("x", "y", "z"):
+            raise ParameterError(f"up must be 'x', 'y' or 'z', got {up!r}", name="up")
         files = cut_files(
-            pattern, chosen, units=units, scale=scale, page=sheet or "A4", preset=preset, view=view
+            pattern,
+            chosen,
+            units=units,
+            scale=scale,
+            page=sheet or "A4",
+            preset=preset,
+            view=parse_view("front" if view is None else view, up),
         )
         written = write_outputs(folder, files)
     except FilletfoldError as exc:
@@ -656,6 +685,29 @@ def export_cmd(
         f"wrote {len(written)} files to {folder}/: {', '.join(p.name for p in written)}",
         highlight=False,
     )
+
+
+def _made_with(path: Path) -> dict:
+    """The drawing ``units`` and ``scale`` and the ``up`` axis a design's ``report.json``
+    gives (those it has, of the right types; none when it cannot be read)."""
+    from .export.fold_read import load_json
+
+    try:
+        doc = load_json(path, "a filletfold report")
+    except FilletfoldError:
+        return {}
+    out = {}
+    params = doc.get("parameters") if isinstance(doc, dict) else None
+    if isinstance(params, dict):
+        if isinstance(params.get("units"), str):
+            out["units"] = params["units"]
+        scale = params.get("scale")
+        if isinstance(scale, int | float) and not isinstance(scale, bool):
+            out["scale"] = float(scale)
+    up = doc.get("up") if isinstance(doc, dict) else None
+    if isinstance(up, dict) and isinstance(up.get("axis"), str):
+        out["up"] = up["axis"]
+    return out
 
 
 @app.command("check")

@@ -20,6 +20,7 @@ from .errors import callers_progress, named_stages
 from .errors import stage as _stage
 from .mesh.coarsen import Coarsening
 from .mesh.polymesh import PolyMesh
+from .mesh.upright import up_axis
 from .parameters import Parameters
 from .pipeline import (
     Edges,
@@ -80,6 +81,12 @@ class Design:
     coarsening : Coarsening or None
         With ``faces``: the triangles and vertices before and after the mesh was coarsened
         (:func:`~filletfold.mesh.coarsen.coarsen_mesh`), and how far its surface moved.
+    up : str
+        The axis up in its pictures and the app's view (``"x"``, ``"y"``, ``"z"``): the
+        parameter ``up``, or the one the mesh stands on
+        (:func:`~filletfold.mesh.upright.up_axis`).
+    up_why : str
+        How ``up`` was chosen.
     fitting : dict
         ``radius_requested`` (n_edges,) float, the radii asked for (0 at boundary and flat
         edges); ``fitted_radius`` (n_edges,) float, the radii after fitting to the limits and
@@ -113,6 +120,8 @@ class Design:
     fitting: dict = field(default_factory=dict)
     certificate: object = None
     coarsening: Coarsening | None = None
+    up: str = "z"
+    up_why: str = ""
 
     @property
     def vertex_status(self) -> list:
@@ -252,6 +261,7 @@ def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, t
     if job.shift is not None:
         mesh, rounding, res, pieces = _shifted(job.mesh, sol.rounding, sol.res, pieces, job.shift)
         laid.pattern.vertices_3d = laid.pattern.vertices_3d + job.shift
+    up, why = _up(mesh, job.params.up, job.source)
     return Design(
         mesh=mesh,
         params=laid.params,
@@ -268,8 +278,21 @@ def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, t
         stages=stages,
         repairs=list(job.clean_log.repairs),
         coarsening=job.coarsening,
+        up=up,
+        up_why=why,
         fitting=_fitting(rounding, edges.requested, edges.fitted, sol.rescue, sol.res, sol.work),
     )
+
+
+def _up(mesh: PolyMesh, up: str, source: str) -> tuple[str, str]:
+    """The up axis of a design and why: ``up`` as given, or the one ``mesh`` stands on."""
+    if up != "auto":
+        return up, "given"
+    if not mesh.n_faces:
+        return "z", "no faces: the default"
+    size = np.diff(mesh.face_start)
+    centres = np.add.reduceat(mesh.vertices[mesh.halfedge_from], mesh.face_start[:-1], axis=0)
+    return up_axis(mesh.vertices, centres / size[:, None], mesh.face_area, source)
 
 
 def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, shift):

@@ -54,6 +54,7 @@ _JSON_TYPES = {
     "faces": ("integer", "null"),
     "edge_length": ("number", "string", "null"),
     "size": ("number", "string", "null"),
+    "up": ("string",),
 }
 
 
@@ -163,6 +164,10 @@ class Parameters:
         then holds the size chosen (``"620mm"``). Given ``units`` or ``scale``, ``"auto"``
         is no size: the mesh is in those units. None: no size, a unitless drawing unless
         ``units`` are given.
+    up : str
+        The axis up in the pictures and the app's view (``"x"``, ``"y"``, ``"z"``), or
+        ``"auto"``: the one the mesh stands on (:func:`~filletfold.mesh.upright.up_axis`);
+        ``design.up`` is the axis used.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -186,6 +191,7 @@ class Parameters:
     faces: int | None = None
     edge_length: object = None
     size: object = "auto"
+    up: str = "auto"
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:
@@ -300,6 +306,8 @@ class Parameters:
                 f"coplanar tolerance must be in [0, 90) degrees, got {self.coplanar_deg!r}",
                 name="coplanar_deg",
             )
+        if self.up not in ("auto", "x", "y", "z"):
+            raise ParameterError(f"up must be 'auto', 'x', 'y' or 'z', got {self.up!r}", name="up")
         if self.size is not None and self.size != "auto":
             from .units import parse_size
 

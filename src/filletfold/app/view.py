@@ -73,6 +73,11 @@ CAMERA_POSITION = (1.0, -2.9, 2.9)
 CAMERA_LOOK_AT = (1.0, 0.0, -0.4)
 
 
+#: The design's axes drawn as the scene's x, y, z (up z), by the design's up axis: a cyclic
+#: turn, as the pictures' (:func:`~filletfold.export.render.view_frame`).
+UP_AXES = {"z": (0, 1, 2), "y": (2, 0, 1), "x": (1, 2, 0)}
+
+
 @dataclass
 class SceneArrays:
     """Everything the 3D view shows of a design, in scene coordinates.
@@ -100,6 +105,9 @@ class SceneArrays:
         The design point drawn at the origin.
     pattern_scale : float
         Drawn size of the pattern relative to the model (at most 1).
+    axes : (3,) int
+        The design's axes that are the scene's x, y and z: the design's up axis
+        (``design.up``) is the scene's z, the others turned cyclically (:data:`UP_AXES`).
     """
 
     folded: dict = field(default_factory=dict)
@@ -112,14 +120,17 @@ class SceneArrays:
     scale: float = 1.0
     centre: np.ndarray = field(default_factory=lambda: np.zeros(3))
     pattern_scale: float = 1.0
+    axes: tuple = (0, 1, 2)
 
     def to_scene(self, points) -> np.ndarray:
-        """Design coordinates (..., 3) to scene coordinates."""
-        return (np.asarray(points, dtype=float) - self.centre) * self.scale
+        """Design coordinates (..., 3) to scene coordinates (turned so that ``axes`` are
+        the scene's x, y, z)."""
+        return (np.asarray(points, dtype=float)[..., self.axes] - self.centre) * self.scale
 
 
 def scene_arrays(design: Design) -> SceneArrays:
-    """Triangles, crease segments and vertex markers of a design, in scene coordinates.
+    """Triangles, crease segments and vertex markers of a design, in scene coordinates
+    (turned so that the design's up axis is the scene's z).
 
     The crease pattern lies in the plane through the lowest folded point, to the right (+x)
     of the folded form with a gap of :data:`PATTERN_GAP` times the form's size, centred in y,
@@ -127,7 +138,8 @@ def scene_arrays(design: Design) -> SceneArrays:
     are scaled to :data:`SCENE_WIDTH` and centred at the origin.
     """
     pattern = design.pattern
-    v2, v3 = pattern.vertices_2d, pattern.vertices_3d
+    axes = UP_AXES[design.up]
+    v2, v3 = pattern.vertices_2d, pattern.vertices_3d[:, axes]  # turned: up is z
     lo, hi = v3.min(axis=0), v3.max(axis=0)
     size = float(np.max(hi - lo)) or 1.0
     p_lo, p_hi = v2.min(axis=0), v2.max(axis=0)
@@ -144,8 +156,10 @@ def scene_arrays(design: Design) -> SceneArrays:
         scale=SCENE_WIDTH / (float(np.max(all_hi - all_lo)) or 1.0),
         centre=0.5 * (all_lo + all_hi),
         pattern_scale=shrink,
+        axes=axes,
     )
-    v3, flat3 = out.to_scene(v3), out.to_scene(flat3)
+    v3 = out.to_scene(pattern.vertices_3d)
+    flat3 = (flat3 - out.centre) * out.scale  # laid out in the turned frame already
 
     triangles, owner = triangulate_faces(v2, pattern.faces)
     kind_of = {patch: patch_kind(patch) for patch in set(pattern.face_patch)}

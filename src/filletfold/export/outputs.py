@@ -19,6 +19,7 @@ from ..tolerances import tol
 from ..units import MIN_LABEL_MM, MIN_PIECE_MM
 from . import report_json, write_outputs
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
+from .png import parse_view
 from .report import Records
 
 #: The files :func:`export_design` writes by default (and ``assembly.txt`` with glue tabs).
@@ -109,6 +110,7 @@ def report_records(design) -> dict:
         "certificate": design.certificate.as_dict() if design.certificate is not None else None,
         "fitting": _fitting_report(design),
         "layout": {"kind": design.layout, "note": design.layout_note or None},
+        "up": {"axis": design.up, "why": design.up_why},
         "fabrication": _fabrication_report(design),
         "material_loss": _loss_report(design.material_loss),
     }
@@ -548,6 +550,8 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"(relative {relative.max(initial=0.0):.2e})"
     )
     lines += _size_lines(design)
+    if design.up_why != "given":
+        lines.append(f"up: +{design.up} ({design.up_why}; in the pictures; --up to choose)")
     thin = thickness_ratio(mesh.vertices)
     if thin < FLAT_RATIO and pat.n_pieces > 1 and design.layout == "modules":
         lines.append(
@@ -700,7 +704,8 @@ def export_design(
         (:data:`~filletfold.export.presets.PRESETS`; default ``print``).
     view : str or (2,) float, optional
         The direction ``preview.png`` is seen from (see
-        :func:`~filletfold.export.cutfiles.cut_files`).
+        :func:`~filletfold.export.cutfiles.cut_files`), up the design's ``up`` unless it
+        names its own.
     tables : bool
         Whether ``report.json`` holds the per-element tables ``mesh``, ``edges`` and
         ``vertices`` (:data:`REPORT_TABLES`); by default it is a summary, and ``design.fold``
@@ -716,6 +721,7 @@ def export_design(
     if units is None:
         units, scale = design.params.units, design.params.scale if scale is None else scale
     page = page or design.params.sheet or "A4"
+    view = parse_view("front" if view is None else view, design.up)  # up: the design's
     formats = parse_formats(formats)
     title = title or f"filletfold design of {design.source}"
     pattern_formats = [f for f in formats if f != "json"]

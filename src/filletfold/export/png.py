@@ -179,7 +179,7 @@ _BACK_SIDE = 0.8  # the back of a face (seen through a hole, or inside an open s
 _SEAM_COLOR = "#606060"
 
 
-def parse_view(view) -> tuple[float, float, str]:
+def parse_view(view, up: str = "z") -> tuple[float, float, str]:
     """Azimuth, elevation (degrees) and up axis of a view.
 
     Parameters
@@ -189,6 +189,8 @@ def parse_view(view) -> tuple[float, float, str]:
         ``",x"``, ``",y"`` or ``",z"`` (the axis up in the picture, default z: see
         :func:`~filletfold.export.render.view_frame`); or a sequence ``(azim, elev)`` or
         ``(azim, elev, up)``.
+    up : str
+        The up axis of a view that names none (a design's ``up``).
 
     Raises
     ------
@@ -201,7 +203,6 @@ def parse_view(view) -> tuple[float, float, str]:
         parts = [p.strip().lower() if isinstance(p, str) else p for p in view]
     else:
         parts = []
-    up = "z"
     if len(parts) in (2, 3) and parts[-1] in ("x", "y", "z"):
         up = parts.pop()
     values: tuple = ()

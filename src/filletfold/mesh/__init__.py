@@ -1,8 +1,9 @@
 """Stage 1, the mesh: reading (:mod:`.io`), built-in examples and tessellations
 (:mod:`.examples`, :mod:`.tessellations`), validation, cleaning and repair (:mod:`.clean`,
 :mod:`.repair`, :mod:`.intersect`), half-edge connectivity (:mod:`.polymesh`), the
-measures of polygons the stages share (:mod:`.measures`), and coarsening by quadric
-decimation (:mod:`.coarsen`, the ``faces`` parameter).
+measures of polygons the stages share (:mod:`.measures`), coarsening by quadric
+decimation (:mod:`.coarsen`, the ``faces`` parameter), and which way is up (:mod:`.upright`,
+the ``up`` parameter).
 
 :func:`load_mesh` is the one entry point front ends call: it accepts a file, a built-in example
 name, a ``(vertices, faces)`` pair or a :class:`PolyMesh`, and returns a cleaned mesh.
