@@ -221,6 +221,7 @@ def test_net_on_sheets_with_all_formats(tmp_path, capsys):
     names = sorted(p.name for p in out.iterdir())
     assert names == [
         "annotations.json",
+        "assembly.pdf",
         "assembly.txt",
         "design.fold",
         "folded.3dm",

@@ -138,6 +138,7 @@ def test_export_design_all_formats(cube, tmp_path):
         "folded.ply",
         "folded.stl",
         "assembly.txt",
+        "assembly.pdf",
         "timings.json",
     ]
     written = export_design(cube, tmp_path / "some", formats="dxf,json")
@@ -223,7 +224,7 @@ def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
     assert main([*args, "--sheet", "A3"]) == 0
-    assert "wrote 18 files" in capsys.readouterr().out
+    assert "wrote 19 files" in capsys.readouterr().out  # assembly.pdf with the pdf
     assert (out / "pattern.pdf").read_bytes().startswith(b"%PDF")
     assert read_dxf((out / "pattern.dxf").read_text()).header["$INSUNITS"] == 5
 

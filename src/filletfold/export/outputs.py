@@ -18,6 +18,7 @@ from ..surface.validate import face_signed_area_2d
 from ..tolerances import tol
 from ..units import MIN_LABEL_MM, MIN_PIECE_MM
 from . import report_json, write_outputs
+from .assembly import assembly_pdf
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .png import parse_view
 from .report import Records
@@ -753,6 +754,11 @@ def export_design(
     if seams:
         files["assembly.txt"] = assembly_text(seams)
         names.append("assembly.txt")
+        if "pdf" in formats:  # the guide, with pictures
+            files["assembly.pdf"] = lambda: assembly_pdf(
+                design.pattern, seams, up=design.up, page=page
+            )
+            names.append("assembly.pdf")
     if "json" in formats:
         names.append("timings.json")  # last: its export time covers the other files
     written = write_outputs(folder, {k: files[k] for k in names})

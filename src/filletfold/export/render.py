@@ -25,7 +25,7 @@ import numpy as np
 
 from ..arrays import run_owners, run_starts
 
-__all__ = ["MARGIN", "png_bytes", "render", "view_frame"]
+__all__ = ["MARGIN", "face_image", "png_bytes", "project", "render", "view_frame"]
 
 #: Share of the image left blank on each side of the fitted picture.
 MARGIN = 0.04
@@ -79,6 +79,44 @@ def _fit(xy: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float]:
         return 0.5 * (lo + hi), 1.0
     span = np.maximum(span, 1e-12 * big)
     return 0.5 * (lo + hi), float((usable / span).min())
+
+
+def project(points, fit, width: int, height: int, azim: float, elev: float, up: str = "z"):
+    """Pixel positions (x right, y down) of ``points`` (n, 3) in a picture of
+    :func:`render` framed on the points ``fit`` (its ``points``, with no lines).
+
+    Returns
+    -------
+    (n, 2) float
+    """
+    frame = view_frame(azim, elev, up)
+    cam = np.asarray(points, dtype=np.float64).reshape(-1, 3) @ frame.T
+    centre, scale = _fit(
+        (np.asarray(fit, dtype=np.float64).reshape(-1, 3) @ frame.T)[:, :2], width, height
+    )
+    return np.column_stack(
+        [
+            (cam[:, 0] - centre[0]) * scale + 0.5 * width,
+            0.5 * height - (cam[:, 1] - centre[1]) * scale,
+        ]
+    )
+
+
+def face_image(
+    points, triangles, triangle_face, width: int, height: int, azim: float, elev: float, up="z"
+) -> np.ndarray:
+    """(height, width) int: the face seen at each pixel (-1: none) of a picture of
+    :func:`render` (hidden surfaces removed, no lines, framed on ``points``), drawn once and
+    coloured by the caller as often as it likes.
+    """
+    frame = view_frame(azim, elev, up)
+    cam = np.asarray(points, dtype=np.float64).reshape(-1, 3) @ frame.T
+    centre, scale = _fit(cam[:, :2], width, height)
+    px = (cam[:, 0] - centre[0]) * scale + 0.5 * width
+    py = 0.5 * height - (cam[:, 1] - centre[1]) * scale
+    _, ident = _zbuffer(px, py, cam[:, 2] * scale, np.asarray(triangles, np.int64), width, height)
+    face = np.where(ident >= 0, np.asarray(triangle_face, dtype=np.int64)[ident], -1)
+    return face.reshape(height, width)
 
 
 def _zbuffer(px, py, depth, triangles, width, height):
