@@ -270,7 +270,40 @@ def test_the_default_size_on_the_command_line_and_how_to_go_without(tmp_path):
         assert "default_size" not in report["fabrication"]
 
 
-def test_a_default_size_on_sheets_is_the_labels_and_fits_them(tmp_path):
-    design = filletfold.round_mesh("icosahedron", sheet="A4")
-    assert design.fabrication["default_size"] == {"size": "100mm", "binding": "least"}
-    assert design.params.units == "mm" and design.fabrication["sheets"] >= 1
+def test_a_default_size_on_sheets_fits_the_pieces_again_when_they_ask_more(monkeypatch):
+    """On sheets the pieces are fitted at the labels' size first; when they need a larger
+    size, they are fitted again at it, unless a module would not fit a sheet there."""
+    from filletfold.layout import arrange
+    from filletfold.layout.arrange import spacing
+    from filletfold.units import sheet_size_mm
+
+    tab, gap, box, room = spacing(Parameters(units="mm", scale=10.0, sheet="A4"), 1.0)
+    assert (tab, gap) == (pytest.approx(0.5), pytest.approx(1.35))  # 5 mm tabs, in units
+    assert box == pytest.approx((21.0, 29.7)) and room == pytest.approx((17.3, 26.0))
+    with pytest.raises(ParameterError, match="too small for any piece"):
+        spacing(Parameters(units="mm", scale=1000.0, sheet="A4"), 1.0)
+    plain = filletfold.round_mesh("icosahedron", sheet="A4", layout="modules")
+    assert plain.fabrication["default_size"] == {"size": "100mm", "binding": "least"}
+    monkeypatch.setattr(arrange, "MIN_PIECE_MM", 120.0)  # pieces 120 mm across (63 at 100)
+    big = filletfold.round_mesh("icosahedron", sheet="A4", layout="modules")
+    assert big.fabrication["default_size"]["binding"] == "pieces"
+    from filletfold.export.outputs import piece_spans
+
+    mm = piece_spans(big.pattern) * big.params.mm_per_unit
+    assert mm.min() >= 120.0 and big.params.scale > plain.params.scale
+    w, h = sheet_size_mm("A4")  # every piece on a sheet of that size
+    sheets = np.asarray(big.pattern.annotations.sheets) * big.params.mm_per_unit
+    assert np.allclose(np.sort(sheets[:, 2:] - sheets[:, :2], axis=1), [w, h])
+    monkeypatch.setattr(arrange, "MIN_PIECE_MM", 2000.0)  # a module would not fit A4
+    kept = filletfold.round_mesh("icosahedron", sheet="A4", layout="modules")
+    assert kept.fabrication["default_size"] == {"size": "100mm", "binding": "least"}
+
+
+def test_a_design_on_many_sheets_is_warned_of(monkeypatch):
+    from filletfold.export import outputs
+
+    design = filletfold.round_mesh("cube", sheet="A4", layout="modules", size="150mm")
+    n = len(design.pattern.annotations.sheets)
+    assert n > 1 and "sheets are more than" not in design.summary()
+    monkeypatch.setattr(outputs, "MANY_SHEETS", n - 1)
+    assert f"warning: {n} sheets are more than a person prints" in design.summary()

@@ -408,6 +408,8 @@ def relative_mismatch(pattern) -> np.ndarray:
 FLAT_RATIO = 0.02
 #: A design of more pieces gets a line in the summary suggesting ``--faces``.
 MANY_PIECES = 1000
+#: A design on more sheets gets a warning in the summary.
+MANY_SHEETS = 30
 #: The triangle count that line suggests.
 COARSE_FACES = 2000
 
@@ -580,6 +582,12 @@ def design_summary(design, max_listed: int = 8) -> str:
             f" ({nesting['nester']}, material use {nesting['material_use']:.0%})" if nesting else ""
         )
         lines.append(f"sheets: {len(pat.annotations.sheets)}{placed}")
+        if len(pat.annotations.sheets) > MANY_SHEETS:
+            lines.append(
+                f"  warning: {len(pat.annotations.sheets)} sheets are more than a person prints "
+                f"and cuts (over {MANY_SHEETS}): a smaller --size, fewer faces (--faces N), or "
+                "--nest sparrow (the 'nest' extra) to place the pieces closer"
+            )
     flagged = [u for u, st in enumerate(design.vertices.status) if st not in ("ok", "boundary")]
     for u in flagged[:max_listed]:
         reason = design.vertices.reason[u]

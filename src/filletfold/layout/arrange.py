@@ -21,6 +21,7 @@ from ..units import AUTO_SIZE, LEAST_SIZE_MM, MIN_LABEL_MM, MIN_PIECE_MM, ceil_d
 from ..vertex.solution import VertexSolution
 from .fabrication import net_pieces, orient, pack_on_sheets, sheet_in_pattern_units
 from .nest import SEED, choose_nester, nest_on_sheets, placement_errors, use_figures
+from .net import fits_sheet
 from .sheet import glue_pieces
 from .shelf import shelf_offsets
 from .tabs import LABEL_SHARE, add_tabs_and_labels
@@ -86,8 +87,8 @@ def smallest_span(pieces: list) -> float | None:
 def settle_size(params, extent: float, ref: float, pieces: list | None):
     """``params`` with the default size settled (unchanged unless ``size`` is
     :data:`~filletfold.units.AUTO_SIZE`): :func:`default_size` with the smallest of the laid
-    out ``pieces`` (None: the labels and the least size only, as on sheets, where the pieces
-    were fitted at that size), written as the size in millimetres it is (``"620mm"``), with
+    out ``pieces`` (None: the labels and the least size only, the size pieces are first fitted
+    to sheets at), written as the size in millimetres it is (``"620mm"``), with
     the units (mm) and scale it gives, and the report's account of it (``{"size",
     "binding"}``; None when the size was given). A mesh of no extent gets no size."""
     if params.size != AUTO_SIZE:
@@ -100,6 +101,33 @@ def settle_size(params, extent: float, ref: float, pieces: list | None):
         "size": size,
         "binding": binding,
     }
+
+
+def spacing(params, ref: float):
+    """The glue tabs' height, the gap between pieces, and with ``params.sheet`` the sheet's
+    size and the room a piece has on it (pattern units; else None), for a mesh of mean edge
+    length ``ref`` drawn at ``params``' units and scale.
+
+    Raises
+    ------
+    ParameterError
+        A sheet too small for any piece at that scale.
+    """
+    tab_h = tab_height(params, ref) if params.tabs else 0.0
+    gap = 0.1 * ref + 2.5 * tab_h
+    if params.sheet is None:
+        return tab_h, gap, None, None
+    units, scale = params.sheet_units, params.sheet_scale
+    sheet_box = sheet_in_pattern_units(params.sheet, units, scale)
+    margin = 2 * (gap + tab_h)
+    room = (sheet_box[0] - margin, sheet_box[1] - margin)
+    if min(room) <= 0:
+        raise ParameterError(
+            f"the sheet {params.sheet} at scale {scale:g} {units} per unit is too small for any "
+            "piece",
+            name="sheet",
+        )
+    return tab_h, gap, sheet_box, room
 
 
 def arrange(
@@ -164,7 +192,6 @@ def arrange(
     asked = params  # the size settles once the pieces are known (on sheets, before)
     extent = float(np.ptp(pm.vertices, axis=0).max(initial=0.0))
     params, _ = settle_size(params, extent, pm.mean_edge_length, None)
-    units, scale = params.sheet_units, params.sheet_scale
     given = pieces  # the caller's list (``pieces`` may be rebound to laid-out copies)
     ref = pm.mean_edge_length
     layout_used, layout_note = "modules", ""
@@ -188,28 +215,33 @@ def arrange(
             pieces, layout_used = [glued], "sheet"
         elif layout == "sheet":
             raise SolverError(f"the modules do not form one sheet: {layout_note}")
-    tab_h = tab_height(params, ref) if tabs else 0.0
-    gap = 0.1 * ref + 2.5 * tab_h
-    sheet_box = room = None
-    if sheet is not None:
-        sheet_box = sheet_in_pattern_units(sheet, units, scale)
-        margin = 2 * (gap + tab_h)
-        room = (sheet_box[0] - margin, sheet_box[1] - margin)
-        if min(room) <= 0:
-            raise ParameterError(
-                f"the sheet {sheet} at scale {scale:g} {units} per unit is too small for any piece",
-                name="sheet",
-            )
-    if layout == "net" or (layout == "auto" and layout_used == "modules"):
+    tab_h, gap, sheet_box, room = spacing(params, ref)
+    net = layout == "net" or (layout == "auto" and layout_used == "modules")
+    if net:
         pieces = net_pieces(pm, sol, mods.modules, mods.points, eps, sheet=room)
         layout_used = "net"
-        if release_pieces:  # the nets hold copies: the modules, and what built them, can go
-            given.clear()
-            sol.frames = sol.classified = sol.solved = mods.modules = None
-    params, default = settle_size(asked, extent, ref, pieces if sheet is None else None)
-    if sheet is None:  # the tabs at the size settled (on sheets, it is the size fitted to)
-        tab_h = tab_height(params, ref) if tabs else 0.0
-        gap = 0.1 * ref + 2.5 * tab_h
+    labels_size = params.scale
+    params, default = settle_size(asked, extent, ref, pieces)
+    if default is not None and sheet is not None and params.scale != labels_size:
+        # the pieces ask for a larger size: fitted to the sheets again at it, if every
+        # module fits one (else the labels' size stays, and the summary warns of them)
+        try:
+            larger = spacing(params, ref)
+        except ParameterError:  # the gaps alone fill the sheet
+            larger = None
+        if larger is not None and all(
+            fits_sheet(np.asarray(piece.points_2d), larger[3]) for piece in given
+        ):
+            tab_h, gap, sheet_box, room = larger
+            if net:
+                pieces = net_pieces(pm, sol, mods.modules, mods.points, eps, sheet=room)
+        else:
+            params, default = settle_size(asked, extent, ref, None)
+    elif sheet is None:  # the tabs at the size settled
+        tab_h, gap, _, _ = spacing(params, ref)
+    if net and release_pieces:  # the nets hold copies: the modules, and what built them, go
+        given.clear()
+        sol.frames = sol.classified = sol.solved = mods.modules = None
     if sheet is not None:
         pieces = [orient(piece) for piece in pieces]
         t = time.perf_counter()

@@ -107,7 +107,7 @@ def _moved(shapes, m: np.ndarray):
     return shapely.transform(shapes, lambda xy: _apply(m, xy))
 
 
-def _fits(points: np.ndarray, sheet) -> bool:
+def fits_sheet(points: np.ndarray, sheet) -> bool:
     """Whether points (k, 2) fit a ``sheet`` (width, height) in some rotation (their smallest
     rotated bounding rectangle does)."""
     if sheet is None:
@@ -347,7 +347,7 @@ def build_nets(
         if target.clashes(moved, placed, overlap_tol, 1e3 * eps, 16 * exact):
             continue
         hull = _hull(np.vstack([target.hull, _apply(m, nets[nb].hull)]))
-        if sheet is not None and not _fits(hull, sheet):
+        if sheet is not None and not fits_sheet(hull, sheet):
             continue
         place[moving] = m @ place[moving]
         shapes[moving] = moved
