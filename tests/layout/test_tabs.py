@@ -276,3 +276,27 @@ def test_tab_conflicts_agree_with_shapely(seed, far):
     want = [shapes[a].intersects(shapes[b].buffer(-s)) for a, b in zip(i, j, strict=True)]
     assert got.tolist() == want
     assert (bound | ~got).all()  # without shapely: a bound
+
+
+@pytest.mark.slow
+def test_tabs_found_in_small_blocks_are_the_same(monkeypatch):
+    """The tabs' faces are found a few tabs at a time and their neighbours paired a few
+    candidates at a time (to bound the memory of tabs half an edge high): the same tabs."""
+    tabs_module = tabs
+    design = filletfold.round_mesh("blob", tabs=False)
+    h = arrange.tab_height(design.params, design.mesh.mean_edge_length)  # 5 mm at 100 mm
+    assert h > 0.3 * design.mesh.mean_edge_length  # large tabs: many faces each
+
+    def tabs_of():
+        p = copy.deepcopy(design.pattern)
+        stats = tabs_module.add_tabs_and_labels(p, h)
+        labels = LabelRows.of(p.annotations.labels)
+        return stats["tabs"], np.asarray(p.annotations.tabs.points), labels.position, labels.text
+
+    whole = tabs_of()
+    monkeypatch.setattr(tabs_module, "QUERY_BLOCK", 7)
+    monkeypatch.setattr(tabs_module, "PAIR_CHUNK", 5)
+    blocks = tabs_of()
+    assert whole[0] == blocks[0] > 0
+    assert np.array_equal(whole[1], blocks[1]) and np.array_equal(whole[2], blocks[2])
+    assert list(whole[3]) == list(blocks[3])

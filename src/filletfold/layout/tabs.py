@@ -62,6 +62,14 @@ LEVELS = ((1.0, None), (0.5, None), (0.5, 0), (0.5, 1), (0.25, 0), (0.25, 1))
 #: A tab is tested shrunk by this share of the full tab height (touching is not overlapping).
 SHRINK = 1e-9
 
+#: New candidate tabs whose neighbours are paired at a time (:func:`_choose`): bounds the
+#: pairs of tabs half an edge high, some 200 per candidate.
+PAIR_CHUNK = 4096
+
+#: Tabs whose faces are found at a time (:meth:`_Faces.clear_block`): the grid's query of
+#: 8,192 tabs half an edge high met 7.7 million faces and took 1.7 GB on a 9,352-vertex design.
+QUERY_BLOCK = 512
+
 #: Tabs tested against the faces at a time (:meth:`_Faces.clear`), and pairs of tabs tested
 #: at a time (:func:`conflicts`): bounds the temporaries (some 2 KB per tab).
 CLEAR_CHUNK = 8192
@@ -532,11 +540,19 @@ class _Faces:
             t = np.flatnonzero(hint >= 0)
             self._pairs(frame, t, hint[t], blocker, None)
         rest = np.flatnonzero(blocker < 0)
-        i, faces = self.grid.query(*boxes(take_rows(quads, rest)))
-        tabs = np.take(rest, i)
-        slow = []
-        self._pairs(frame, tabs, faces, blocker, slow)
-        slow = np.concatenate(slow)
+        pairs = []  # (tab, face) pairs the arrays leave undecided
+        for lo in range(0, len(rest), QUERY_BLOCK):  # the grid's query of tabs half an edge
+            # high took 1.7 GB for 8,192 of them (7.7 million faces met)
+            some = rest[lo : lo + QUERY_BLOCK]
+            i, faces = self.grid.query(*boxes(take_rows(quads, some)))
+            tabs = np.take(some, i)
+            part = []
+            self._pairs(frame, tabs, faces, blocker, part)
+            at = np.concatenate(part)
+            pairs.append((tabs[at], faces[at]))
+        tabs = np.concatenate([t for t, _ in pairs]) if pairs else np.zeros(0, dtype=np.int64)
+        faces = np.concatenate([f for _, f in pairs]) if pairs else np.zeros(0, dtype=np.int64)
+        slow = np.arange(len(tabs))
         slow = slow[blocker[tabs[slow]] < 0]
         if len(slow):
             hit = self._exact(quads, tabs[slow], faces[slow])
@@ -884,6 +900,38 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         numbers each time: a table of all of them would take 1 KB per border)."""
         return _candidates(ends, normal, tab_height, c)[0]
 
+    def pairs(c, chunk):
+        """For the new candidates ``chunk`` (of the round's ``c``): record in ``state`` the
+        tested candidates of other borders they intersect, and the untested ones of earlier
+        borders they might."""
+        # the sides of other borders near the new candidates
+        i, j = sides.query(*boxes(quads_of(chunk)))
+        pc, ps = chunk[i], j
+        other = ps // 2 != pc // n_cand
+        pc, ps = pc[other], ps[other]
+        # earlier borders still undecided: the candidates not tested yet that each new one
+        # might meet (tested a few together: a full tab holds the half-height one, a half
+        # border's tab the quarter-height one)
+        lo = np.flatnonzero(ps // 2 < pc // n_cand)
+        lo = lo[state.undecided[ps[lo] // 2]]
+        lo = lo[conflicts(take_rows(envelope, ps[lo]), quads_of(pc[lo]), s, exact=False)]
+        a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
+        holder = np.asarray(COVER)[b % n_cand]
+        cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
+        key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
+        held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
+        maybe = conflicts(held, quads_of(key // (n * n_cand)), s, exact=False) | ~fits
+        state.might_meet(a[maybe[inv]], b[maybe[inv]])
+        # the tested candidates of those sides: which tabs intersect which
+        rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
+        a, b = pc[rows], (ps[rows] // 2) * n_cand + ps[rows] % 2 + 2 * col
+        new_b = np.isin(b, c)
+        a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
+        later = np.where(a // n_cand > b // n_cand, a, b)
+        earlier = a + b - later
+        hit = conflicts(quads_of(earlier), quads_of(later), s)
+        state.meets(later[hit], earlier[hit])
+
     # where any candidate of a border's side may lie: the rectangle of the full height on
     # the border (per side 2 * border + A or B)
     up = tab_height * normal[..., None, :]
@@ -924,33 +972,9 @@ def _choose(faces: _Faces, ends, normal, tab_height):
         c = c[~blocked]
         good.flat[c] = True
         state.tested(tried, good.flat[tried])
-        # the sides of other borders near the new candidates
-        i, j = sides.query(*boxes(quads_of(c)))
-        pc, ps = c[i], j
-        other = ps // 2 != pc // n_cand
-        pc, ps = pc[other], ps[other]
-        # earlier borders still undecided: the candidates not tested yet that each new one
-        # might meet (tested a few together: a full tab holds the half-height one, a half
-        # border's tab the quarter-height one)
-        lo = np.flatnonzero(ps // 2 < pc // n_cand)
-        lo = lo[state.undecided[ps[lo] // 2]]
-        lo = lo[conflicts(take_rows(envelope, ps[lo]), quads_of(pc[lo]), s, exact=False)]
-        a, b = _untested(pc[lo], ps[lo], ks[-1] + 1, n_cand)
-        holder = np.asarray(COVER)[b % n_cand]
-        cover = np.where(holder > ks[-1], b - b % n_cand + holder, b)  # if untested too
-        key, inv = np.unique(a * (n * n_cand) + cover, return_inverse=True)
-        held, _, fits, _ = _candidates(ends, normal, tab_height, key % (n * n_cand))
-        maybe = conflicts(held, quads_of(key // (n * n_cand)), s, exact=False) | ~fits
-        state.might_meet(a[maybe[inv]], b[maybe[inv]])
-        # the tested candidates of those sides: which tabs intersect which
-        rows, col = np.nonzero(good[(ps // 2)[:, None], ps[:, None] % 2 + np.arange(0, n_cand, 2)])
-        a, b = pc[rows], (ps[rows] // 2) * n_cand + ps[rows] % 2 + 2 * col
-        new_b = np.isin(b, c)
-        a, b = a[~new_b | (b < a)], b[~new_b | (b < a)]
-        later = np.where(a // n_cand > b // n_cand, a, b)
-        earlier = a + b - later
-        hit = conflicts(quads_of(earlier), quads_of(later), s)
-        state.meets(later[hit], earlier[hit])
+        for lo_c in range(0, len(c), PAIR_CHUNK):  # in blocks: the pairs of large tabs
+            # (half an edge high) took 800 MB at once on a 9,352-vertex design
+            pairs(c, c[lo_c : lo_c + PAIR_CHUNK])
         undecided = state.run(undecided, good, tested=ks[-1] + 1)
         if not len(undecided):
             break
