@@ -225,31 +225,31 @@ def test_the_default_size_is_set_by_the_smallest_laid_out_piece():
     )
 
 
-def test_by_default_every_label_and_piece_can_be_made_and_the_summary_says_the_size(tmp_path):
-    """A fine sphere (642 vertices): its labels set the default size, 120 mm; at it every
-    label is 2 mm high and every piece spans 3 mm; at less, the labels are too low."""
+def test_by_default_every_label_and_piece_can_be_made_and_the_summary_says_the_size():
+    """A capsule of 66 vertices: its smallest piece sets the default size, 110 mm; at it every
+    label is 2 mm high and every piece spans 3 mm; at less, pieces are too small."""
     import trimesh
 
     from filletfold.export.outputs import piece_sizes_mm
     from filletfold.units import MIN_LABEL_MM, MIN_PIECE_MM
 
-    sphere = trimesh.creation.icosphere(subdivisions=3)
-    mesh = (sphere.vertices, sphere.faces)
+    capsule = trimesh.creation.capsule(height=6.0, radius=0.5, count=[8, 8])
+    mesh = (capsule.vertices, capsule.faces)
     design = filletfold.round_mesh(mesh, layout="modules")
-    assert design.fabrication["default_size"] == {"size": "120mm", "binding": "labels"}
-    assert (design.params.size, design.params.units) == ("120mm", "mm")
+    assert design.fabrication["default_size"] == {"size": "110mm", "binding": "pieces"}
+    assert (design.params.size, design.params.units) == ("110mm", "mm")
     extent = float(np.ptp(design.mesh.vertices, axis=0).max())
-    assert design.params.scale * extent == pytest.approx(120.0)
+    assert design.params.scale * extent == pytest.approx(110.0)
     sizes = piece_sizes_mm(design)
     # (label heights are written to 3 digits)
     assert sizes["smallest_label_mm"] >= MIN_LABEL_MM * (1 - 5e-4)
     assert sizes["pieces_under_min"] == 0 and sizes["smallest_piece_mm"] >= MIN_PIECE_MM
-    line = next(x for x in design.summary().splitlines() if x.startswith("size: 120mm"))
-    assert "the default: the least with labels 2 mm high; --size to choose" in line
+    line = next(x for x in design.summary().splitlines() if x.startswith("size: 110mm"))
+    assert "the default: the least with every piece 3 mm across; --size to choose" in line
     assert "warning" not in design.summary()
-    smaller = filletfold.round_mesh(mesh, layout="modules", size="100mm")
-    assert piece_sizes_mm(smaller)["smallest_label_mm"] < MIN_LABEL_MM
-    assert "warning: labels" in smaller.summary() and "default" not in smaller.summary()
+    smaller = filletfold.round_mesh(mesh, layout="modules", size="100mm", reuse=design)
+    assert piece_sizes_mm(smaller)["pieces_under_min"] > 0
+    assert "pieces span less than 3 mm" in smaller.summary() and "default" not in smaller.summary()
 
 
 def test_the_default_size_on_the_command_line_and_how_to_go_without(tmp_path):

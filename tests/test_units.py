@@ -154,7 +154,7 @@ def test_cli_round_a1_pdf(tmp_path):
 
 #: The sheets the fast tier writes every cut format on (an ISO, a US and a custom size); the
 #: slow tier runs the others too (1.6 s each).
-FAST_SHEETS = ("A4", "Letter", "600x400")
+FAST_SHEETS = ("A4",)  # the others in the slow tier (the fast one under 3 minutes)
 
 
 @pytest.mark.parametrize(

@@ -59,18 +59,18 @@ def test_the_guide_has_an_overview_and_a_page_per_six_steps_and_the_same_bytes()
     assert assembly_pdf(design.pattern, seams, up=design.up, width_px=160) == pdf
 
 
-def test_round_writes_the_guide_with_the_pdf_and_not_without_tabs(tmp_path):
-    from filletfold.cli import main
+def test_the_guide_is_written_with_the_pdf_and_not_without_tabs(tmp_path):
+    from filletfold.export.outputs import export_design
 
-    out = tmp_path / "house"
-    assert main(["round", "house", "-q", "-f", "pdf", "-o", str(out)]) == 0
-    assert (out / "assembly.pdf").read_bytes().startswith(b"%PDF")
-    bare = tmp_path / "bare"
-    assert main(["round", "house", "-q", "-f", "pdf", "--no-tabs", "-o", str(bare)]) == 0
-    assert not (bare / "assembly.pdf").exists()  # no numbered borders: nothing to guide
-    plain = tmp_path / "plain"
-    assert main(["round", "house", "-q", "-o", str(plain)]) == 0
-    assert not (plain / "assembly.pdf").exists()  # not among the default formats
+    design = filletfold.round_mesh("tetrahedron")
+    written = [p.name for p in export_design(design, tmp_path / "t", formats="pdf")]
+    assert written == ["pattern.pdf", "assembly.txt", "assembly.pdf"]
+    assert (tmp_path / "t" / "assembly.pdf").read_bytes().startswith(b"%PDF")
+    written = [p.name for p in export_design(design, tmp_path / "f", formats="fold")]
+    assert "assembly.pdf" not in written  # not without the pdf (nor by default)
+    bare = filletfold.round_mesh("tetrahedron", tabs=False, reuse=design)
+    written = [p.name for p in export_design(bare, tmp_path / "b", formats="pdf")]
+    assert written == ["pattern.pdf"]  # no numbered borders: nothing to guide
 
 
 @pytest.mark.parametrize("up", ["y", "z"])

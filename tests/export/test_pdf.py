@@ -63,9 +63,12 @@ def test_pdf_one_page_group_per_sheet():
     pattern = arc_pattern(annotated=True)
     pattern.annotations.sheets = np.array([[-2.6, -0.3, 0.0, 2.6], [0.0, -0.3, 2.6, 2.6]])
     tiles = pdf_tiles(pattern, units="mm", scale=100.0)
-    per_sheet = math.ceil((260.0 + 4.0) / 190.0) * math.ceil((290.0 + 4.0) / 277.0)
-    assert [t.region for t in tiles] == [0] * per_sheet + [1] * per_sheet
-    assert pdf_pages(pattern_pdf(pattern, units="mm", scale=100.0)) == 2 * per_sheet
+    # what is drawn on each sheet, tiled (its box, 260 x 290 mm, would take 4 pages)
+    per_sheet = [sum(t.region == r for t in tiles) for r in (0, 1)]
+    assert [t.region for t in tiles] == [0] * per_sheet[0] + [1] * per_sheet[1]
+    whole = math.ceil((260.0 + 4.0) / 190.0) * math.ceil((290.0 + 4.0) / 277.0)
+    assert 1 <= min(per_sheet) and max(per_sheet) < whole
+    assert pdf_pages(pattern_pdf(pattern, units="mm", scale=100.0)) == len(tiles)
 
 
 def test_pdf_of_the_cube_design(cube):
@@ -104,3 +107,23 @@ def test_page_sizes(page, size):
 def test_pdf_parameters_rejected(kw, match):
     with pytest.raises(ParameterError, match=match):
         pattern_pdf(tiny_square(), **kw)
+
+
+def test_a_sheet_prints_what_is_drawn_on_it_on_pages_turned_to_fit():
+    """Pieces lie inside their sheet by a gap: the drawing on an A4 sheet fits one A4
+    page's printable area, turned for a landscape sheet (the sheet's box with the printer's
+    margins took two or four pages)."""
+    import filletfold
+
+    design = filletfold.round_mesh("icosahedron", sheet="A4")
+    p = design.params
+    sheets = np.asarray(design.pattern.annotations.sheets) * p.mm_per_unit
+    tiles = pdf_tiles(design.pattern, page="A4", units=p.units, scale=p.scale)
+    assert len(tiles) == len(sheets) == 3 and [t.region for t in tiles] == [0, 1, 2]
+    assert any(t.landscape for t in tiles)  # a drawing wider than a portrait page
+    for tile in tiles:
+        x0, y0, x1, y1 = sheets[tile.region]
+        bx0, _, _, by1 = tile.box  # tiled from the drawing's top left, on its sheet
+        assert x0 - 2.5 <= bx0 < x1 and y0 < by1 <= y1 + 2.5
+    data = pattern_pdf(design.pattern, page="A4", units=p.units, scale=p.scale)
+    assert pdf_pages(data) == 3

@@ -79,7 +79,7 @@ def test_a_design_knows_its_up_says_so_and_draws_it(tmp_path):
     v3 = scene.to_scene(design.pattern.vertices_3d)
     extent = np.ptp(design.pattern.vertices_3d, axis=0)
     assert np.ptp(v3, axis=0)[2] == pytest.approx(extent[1] * scene.scale)
-    given = filletfold.round_mesh(turned, layout="modules", up="x")
+    given = filletfold.round_mesh(turned, layout="modules", up="x", reuse=design)
     assert (given.up, given.up_why) == ("x", "given") and "up: " not in given.summary()
     with pytest.raises(filletfold.errors.ParameterError, match="up must be"):
         filletfold.round_mesh("cube", up="w")

@@ -30,7 +30,14 @@ from .palette import LABEL_COLOR
 from .png import DEFAULT_VIEW
 from .render import face_image, project, view_frame
 
-__all__ = ["CAPTION_BORDERS", "STEPS_PER_PAGE", "Step", "assembly_pdf", "assembly_steps"]
+__all__ = [
+    "CAPTION_BORDERS",
+    "STEPS_PER_PAGE",
+    "Step",
+    "assembly_pages",
+    "assembly_pdf",
+    "assembly_steps",
+]
 
 #: Steps drawn on one page (3 rows of 2).
 STEPS_PER_PAGE = 6
@@ -174,15 +181,10 @@ class _View:
         )
         self.piece = np.asarray(pattern.face_piece, dtype=np.int64)
         n = int(pattern.n_pieces)
-        owner = np.append(np.where(self.piece < n, self.piece, -1), -1)[self.samples]
-        self.pixels = np.bincount(owner[owner >= 0], minlength=n)  # samples seen per piece
-        own = owner.ravel()
-        ok = own >= 0
-        key = np.unique(
-            own[ok] * (self.h * self.w) + np.repeat(np.arange(self.h * self.w), ss * ss)[ok]
-        )
-        of, at = np.divmod(key, self.h * self.w)  # (piece, pixel) pairs, by piece
-        self.by_piece = np.split(at, np.searchsorted(of, np.arange(1, n)))
+        self.owner = np.append(np.where(self.piece < n, self.piece, -1), -1)[self.samples]
+        seen = self.owner[self.owner >= 0]
+        self.pixels = np.bincount(seen, minlength=n)  # samples seen per piece
+        self.by_piece = None  # the pixels of each piece, made on the first repaint
         self.rgb = np.ones((n_faces + 1, 3), dtype=np.float32)
         self.img = np.ones((self.h * self.w, 3), dtype=np.float32)
 
@@ -199,8 +201,24 @@ class _View:
         self.img = self.rgb[self.samples].mean(axis=1)
         return self.picture()
 
+    def _pixels_by_piece(self) -> list:
+        """The pixels each piece shows in, ascending (a pixel whose samples show two pieces
+        is each's)."""
+        n = len(self.pixels)
+        own = self.owner
+        first = np.ones(own.shape, dtype=bool)  # a piece's first sample in its pixel
+        for j in range(1, own.shape[1]):
+            first[:, j] = (own[:, :j] != own[:, j : j + 1]).all(axis=1)
+        pixel = np.broadcast_to(np.arange(len(own))[:, None], own.shape)
+        keep = first & (own >= 0)
+        piece, pixel = own[keep], pixel[keep]
+        order = np.argsort(piece, kind="stable")  # pixels ascending within each piece
+        return np.split(pixel[order], np.searchsorted(piece[order], np.arange(1, n)))
+
     def repaint(self, pieces, face_rgb: np.ndarray, faint: np.ndarray) -> np.ndarray:
         """:meth:`paint` after only the faces of ``pieces`` changed."""
+        if self.by_piece is None:
+            self.by_piece = self._pixels_by_piece()
         for k in pieces:
             faces = np.flatnonzero(self.piece == k)
             self.rgb[faces] = self._lit(face_rgb, faint, faces)
@@ -242,13 +260,83 @@ def _place(fig, image: np.ndarray, x: float, y: float):
     return lambda p: ((xo + p[0]) / width, (yo + h - p[1]) / height)
 
 
+def assembly_pages(
+    pattern: CreasePattern,
+    seams,
+    *,
+    up: str = "z",
+    page: str = "A4",
+    width_px: int = 400,
+):
+    """The pages of the assembly guide, one matplotlib Figure at a time (see
+    :func:`assembly_pdf`, which writes them; a picture of a page: ``fig.savefig(...)``)."""
+    from matplotlib.figure import Figure
+
+    width_mm, height_mm = sheet_size_mm(page, name="page")
+    size_in = (width_mm / _MM_PER_IN, height_mm / _MM_PER_IN)
+    n = int(pattern.n_pieces)
+    piece = np.asarray(pattern.face_piece, dtype=np.int64)
+    inside = (piece >= 0) & (piece < n)
+    area2 = np.abs(face_signed_area_2d(pattern.vertices_2d, pattern.faces))
+    area = np.bincount(piece[inside], weights=area2[inside], minlength=n)
+    steps = assembly_steps(seams.pieces, area)
+    names = list(seams.names) if len(seams.names) == n else [f"P{k + 1}" for k in range(n)]
+    azim, elev = DEFAULT_VIEW
+    colors = _piece_colors(n)
+    face_rgb = np.where(inside[:, None], colors[np.clip(piece, 0, None)], _DONE)
+    big = [_View(pattern, azim + turn, elev, up, 2 * width_px) for turn in (0.0, 180.0)]
+    dpi = 2 * width_px / (0.8 * size_in[0])  # the overview's pictures 0.8 of the width
+    fig = Figure(figsize=size_in, dpi=dpi)
+    fig.text(0.06, 0.965, f"Assembly: {n} pieces, {len(seams)} numbered borders", size=12)
+    fig.text(
+        0.06,
+        0.945,
+        "Glue each numbered border to the border with the same number, in the order of "
+        "the steps (largest piece first).",
+        size=_FONT_PT,
+    )
+    for row, view in enumerate(big):
+        at = _place(fig, view.paint(face_rgb, ~inside), 0.1, 0.47 - 0.455 * row)
+        xy, seen = view.label_points(area2)
+        for k in np.flatnonzero(seen).tolist():
+            fig.text(*at(xy[k]), names[k], size=7, ha="center", va="center", **_LABEL)
+        caption = ("from the front", "from the back")[row]
+        fig.text(0.5, 0.915 - 0.455 * row, caption, ha="center", size=_FONT_PT)
+    yield fig
+    del big
+    views = [_View(pattern, azim + turn, elev, up, width_px) for turn in (0.0, 180.0)]
+    state = np.zeros(n, dtype=np.int64)  # 0 to come, 1 placed, 2 placed at this step
+    palette = np.array([_LATER, _DONE, _NEW])
+    rgb = np.where(inside[:, None], palette[state[np.clip(piece, 0, None)]], _DONE)
+    for view in views:
+        view.paint(rgb, inside)
+    for first in range(0, len(steps), STEPS_PER_PAGE):
+        fig = Figure(figsize=size_in, dpi=dpi)
+        for slot, step in enumerate(steps[first : first + STEPS_PER_PAGE]):
+            changed = [*np.flatnonzero(state == 2).tolist(), step.piece]
+            state[state == 2] = 1
+            state[step.piece] = 2
+            face_state = np.where(inside, state[np.clip(piece, 0, None)], 1)
+            rgb, faint = palette[face_state], face_state == 0
+            images = [view.repaint(changed, rgb, faint) for view in views]
+            best = max(range(len(views)), key=lambda v: views[v].pixels[step.piece])
+            row, col = divmod(slot, 2)
+            x, y = 0.07 + 0.47 * col, 0.68 - 0.31 * row
+            _place(fig, images[best], x, y)  # from where it shows most
+            caption = textwrap.fill(f"{first + slot + 1}. {_caption(step, names)}", CAPTION_WIDTH)
+            fig.text(x, y + 0.215, caption, size=_FONT_PT - 1, va="bottom")
+        last = min(first + STEPS_PER_PAGE, len(steps))
+        fig.text(0.5, 0.02, f"steps {first + 1}-{last} of {len(steps)}", ha="center", size=_FONT_PT)
+        yield fig
+
+
 def assembly_pdf(
     pattern: CreasePattern,
     seams,
     *,
     up: str = "z",
     page: str = "A4",
-    width_px: int = 480,
+    width_px: int = 400,
 ) -> bytes:
     """The assembly guide of a laid-out design with glue tabs.
 
@@ -268,73 +356,17 @@ def assembly_pdf(
     Returns
     -------
     bytes
-        The PDF: the overview, then :data:`STEPS_PER_PAGE` steps per page.
+        The PDF (:func:`assembly_pages`): the overview, then :data:`STEPS_PER_PAGE` steps per
+        page.
     """
     import matplotlib
     from matplotlib.backends.backend_pdf import PdfPages
-    from matplotlib.figure import Figure
 
-    width_mm, height_mm = sheet_size_mm(page, name="page")
-    size_in = (width_mm / _MM_PER_IN, height_mm / _MM_PER_IN)
-    n = int(pattern.n_pieces)
-    piece = np.asarray(pattern.face_piece, dtype=np.int64)
-    inside = (piece >= 0) & (piece < n)
-    area2 = np.abs(face_signed_area_2d(pattern.vertices_2d, pattern.faces))
-    area = np.bincount(piece[inside], weights=area2[inside], minlength=n)
-    steps = assembly_steps(seams.pieces, area)
-    names = list(seams.names) if len(seams.names) == n else [f"P{k + 1}" for k in range(n)]
-    azim, elev = DEFAULT_VIEW
-    colors = _piece_colors(n)
-    face_rgb = np.where(inside[:, None], colors[np.clip(piece, 0, None)], _DONE)
-    big = [_View(pattern, azim + turn, elev, up, 2 * width_px) for turn in (0.0, 180.0)]
-    views = [_View(pattern, azim + turn, elev, up, width_px) for turn in (0.0, 180.0)]
-    dpi = 2 * width_px / (0.8 * size_in[0])  # the overview's pictures 0.8 of the width
     buf = io.BytesIO()
     with (
         matplotlib.rc_context({"image.composite_image": False}),  # each picture on its own
         PdfPages(buf, metadata={"CreationDate": None, "Creator": "filletfold"}) as pdf,
     ):
-        fig = Figure(figsize=size_in, dpi=dpi)
-        fig.text(0.06, 0.965, f"Assembly: {n} pieces, {len(seams)} numbered borders", size=12)
-        fig.text(
-            0.06,
-            0.945,
-            "Glue each numbered border to the border with the same number, in the order of "
-            "the steps (largest piece first).",
-            size=_FONT_PT,
-        )
-        for row, view in enumerate(big):
-            at = _place(fig, view.paint(face_rgb, ~inside), 0.1, 0.47 - 0.455 * row)
-            xy, seen = view.label_points(area2)
-            for k in np.flatnonzero(seen).tolist():
-                fig.text(*at(xy[k]), names[k], size=7, ha="center", va="center", **_LABEL)
-            caption = ("from the front", "from the back")[row]
-            fig.text(0.5, 0.915 - 0.455 * row, caption, ha="center", size=_FONT_PT)
-        pdf.savefig(fig)
-        state = np.zeros(n, dtype=np.int64)  # 0 to come, 1 placed, 2 placed at this step
-        palette = np.array([_LATER, _DONE, _NEW])
-        rgb = np.where(inside[:, None], palette[state[np.clip(piece, 0, None)]], _DONE)
-        for view in views:
-            view.paint(rgb, inside)
-        for first in range(0, len(steps), STEPS_PER_PAGE):
-            fig = Figure(figsize=size_in, dpi=dpi)
-            for slot, step in enumerate(steps[first : first + STEPS_PER_PAGE]):
-                changed = [*np.flatnonzero(state == 2).tolist(), step.piece]
-                state[state == 2] = 1
-                state[step.piece] = 2
-                face_state = np.where(inside, state[np.clip(piece, 0, None)], 1)
-                rgb, faint = palette[face_state], face_state == 0
-                images = [view.repaint(changed, rgb, faint) for view in views]
-                best = max(range(len(views)), key=lambda v: views[v].pixels[step.piece])
-                row, col = divmod(slot, 2)
-                x, y = 0.07 + 0.47 * col, 0.68 - 0.31 * row
-                _place(fig, images[best], x, y)  # from where it shows most
-                caption = textwrap.fill(
-                    f"{first + slot + 1}. {_caption(step, names)}", CAPTION_WIDTH
-                )
-                fig.text(x, y + 0.215, caption, size=_FONT_PT - 1, va="bottom")
-            last = min(first + STEPS_PER_PAGE, len(steps))
-            pages = f"steps {first + 1}-{last} of {len(steps)}"
-            fig.text(0.5, 0.02, pages, ha="center", size=_FONT_PT)
+        for fig in assembly_pages(pattern, seams, up=up, page=page, width_px=width_px):
             pdf.savefig(fig)
     return buf.getvalue()

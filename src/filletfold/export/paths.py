@@ -24,6 +24,7 @@ __all__ = [
     "chain_is_smooth",
     "chain_runs",
     "dash_polylines",
+    "drawn_points",
     "edge_chains",
     "edge_layer_masks",
     "label_positions",
@@ -655,17 +656,25 @@ def pattern_extent(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray]:
     lo, hi : (2,) float
         ``(0, 0)`` and ``(1, 1)`` for an empty pattern.
     """
+    allp = drawn_points(pattern)
+    if len(allp) == 0:
+        return np.zeros(2), np.ones(2)
+    return allp.min(axis=0), allp.max(axis=0)
+
+
+def drawn_points(pattern: CreasePattern, sheets: bool = True) -> np.ndarray:
+    """(k, 2) float: the points that bound what is drawn of a pattern: its vertices, its
+    annotations' points (the sheets' corners unless ``sheets`` is False), and each label's
+    text (its anchor and an estimate of its width)."""
     labels = LabelRows.of(pattern.annotations.labels)
     centre, height = labels.position, labels.height
     chars = np.fromiter(map(len, labels.text), np.int64, len(labels))
     half = (0.5 * height * np.maximum(chars, 1).astype(np.float64) * 0.6)[:, None]
+    ann = pattern.annotations
     pts = [
         np.asarray(pattern.vertices_2d, dtype=np.float64).reshape(-1, 2),
-        _annotation_points(pattern.annotations, centre),
+        _annotation_points(ann, centre) if sheets else point_rows(ann.tabs)[0],
         centre - half,
         centre + half,
     ]
-    allp = np.concatenate(pts)
-    if len(allp) == 0:
-        return np.zeros(2), np.ones(2)
-    return allp.min(axis=0), allp.max(axis=0)
+    return np.concatenate(pts)

@@ -1,9 +1,10 @@
 """Printable PDF of the flat crease pattern at true scale, tiled over pages.
 
 The drawing is printed so that one pattern length unit is ``scale`` ``units`` on paper. It is cut
-into *regions*: one per sheet of material when the pattern's annotations have sheets (each sheet
-is tiled on its own pages; anything outside every sheet is not printed), otherwise one region
-around everything (pattern, tabs, labels). Each
+into *regions*: one per sheet of material when the pattern's annotations have sheets (what is
+drawn on each sheet, tiled on its own pages: pieces lie a tab and a gap inside their sheet, so
+a sheet the size of the page prints on one page; anything outside every sheet is not printed),
+otherwise one region around everything (pattern, tabs, labels). Each
 region, grown by :data:`REGION_PAD_MM` on every side, is tiled from its top-left corner by tiles
 the size of the printable area (the page minus ``margin_mm`` on each side), in rows top to bottom
 and columns left to right: ``ceil(width / tile_width) * ceil(height / tile_height)`` pages per
@@ -13,7 +14,8 @@ row and column it is; the first page also carries a scale bar.
 
 Lines: mountain red, valley blue, borders/cuts black, tab outlines black and tab hinges green
 dashed, sheet outlines grey, labels dark grey. Pages are portrait (custom ``"WxH"`` sizes are used
-as given). The output is deterministic (no creation date).
+as given), or landscape for a sheet that takes fewer pages so. The output is deterministic (no
+creation date).
 """
 
 from __future__ import annotations
@@ -31,10 +33,10 @@ from ..tolerances import tol
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
 from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
-from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
+from .paths import drawn_points, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 from .svg import nice_length
 
-__all__ = ["MAX_PAGES", "REGION_PAD_MM", "Tile", "pattern_pdf"]
+__all__ = ["MAX_PAGES", "REGION_PAD_MM", "Tile", "pattern_pages", "pattern_pdf"]
 
 #: Blank border (mm) added around each region before it is tiled.
 REGION_PAD_MM = 2.0
@@ -61,6 +63,8 @@ class Tile:
         Tiles of the region.
     box : (4,) tuple of float
         ``(xmin, ymin, xmax, ymax)`` of the tile in drawing millimetres.
+    landscape : bool
+        Whether the page is turned (a sheet of material that takes fewer pages so).
     """
 
     region: int
@@ -69,6 +73,7 @@ class Tile:
     rows: int
     cols: int
     box: tuple
+    landscape: bool = False
 
 
 def _check_units(units: str) -> float:
@@ -114,7 +119,7 @@ def pdf_tiles(
     tw, th = width - 2 * margin_mm, height - 2 * margin_mm
     sheets = np.asarray(pattern.annotations.sheets, dtype=np.float64).reshape(-1, 4)
     if len(sheets):
-        regions = sheets * k
+        regions = _sheet_contents(pattern, sheets) * k
     else:
         lo, hi = pattern_extent(pattern)
         regions = np.array([[*(lo * k), *(hi * k)]])
@@ -126,8 +131,12 @@ def pdf_tiles(
             x1 + REGION_PAD_MM,
             y1 + REGION_PAD_MM,
         )
-        cols = max(1, math.ceil((x1 - x0) / tw - tol.relative))
-        rows = max(1, math.ceil((y1 - y0) / th - tol.relative))
+        turned = bool(len(sheets)) and (  # a sheet of material on pages of its own turn
+            _count(x1 - x0, y1 - y0, th, tw) < _count(x1 - x0, y1 - y0, tw, th)
+        )
+        pw, ph = (th, tw) if turned else (tw, th)
+        cols = max(1, math.ceil((x1 - x0) / pw - tol.relative))
+        rows = max(1, math.ceil((y1 - y0) / ph - tol.relative))
         if len(tiles) + rows * cols > MAX_PAGES:
             raise ParameterError(
                 f"the PDF would need more than {MAX_PAGES} {width:g} x {height:g} mm pages; "
@@ -136,9 +145,28 @@ def pdf_tiles(
             )
         for i in range(rows):
             for j in range(cols):
-                box = (x0 + j * tw, y1 - (i + 1) * th, x0 + (j + 1) * tw, y1 - i * th)
-                tiles.append(Tile(r, i + 1, j + 1, rows, cols, tuple(float(b) for b in box)))
+                box = (x0 + j * pw, y1 - (i + 1) * ph, x0 + (j + 1) * pw, y1 - i * ph)
+                box = tuple(float(b) for b in box)
+                tiles.append(Tile(r, i + 1, j + 1, rows, cols, box, turned))
     return tiles
+
+
+def _count(w: float, h: float, tw: float, th: float) -> int:
+    """Pages of printable area ``tw`` x ``th`` that a region ``w`` x ``h`` is tiled on."""
+    return max(1, math.ceil(w / tw - tol.relative)) * max(1, math.ceil(h / th - tol.relative))
+
+
+def _sheet_contents(pattern: CreasePattern, sheets: np.ndarray) -> np.ndarray:
+    """(n, 4) the box of what is drawn on each sheet (within it; the sheet where nothing
+    is): pieces lie inside their sheet by a tab and a gap, so a sheet the size of the page
+    prints on one page (its box would need four, the printer's margins taken off)."""
+    pts = drawn_points(pattern, sheets=False)
+    out = sheets.copy()
+    for r, (x0, y0, x1, y1) in enumerate(sheets):
+        on = pts[(pts[:, 0] >= x0) & (pts[:, 0] <= x1) & (pts[:, 1] >= y0) & (pts[:, 1] <= y1)]
+        if len(on):
+            out[r] = [*on.min(axis=0), *on.max(axis=0)]
+    return out
 
 
 def pattern_pdf(
@@ -182,33 +210,52 @@ def pattern_pdf(
     """
     from matplotlib.backends.backend_pdf import PdfPages
 
-    tiles = pdf_tiles(pattern, page=page, units=units, scale=scale, margin_mm=margin_mm)
-    validate_pattern(pattern)
-    width, height = sheet_size_mm(page, name="page")
-    k = MM_PER_UNIT[units] * float(scale)
-    layers = _drawing_mm(pattern, k)
-    n_regions = 1 + max(t.region for t in tiles)
+    pages = pattern_pages(pattern, page=page, units=units, scale=scale, margin_mm=margin_mm)
     buf = io.BytesIO()
     with PdfPages(buf, metadata={"CreationDate": None, "Creator": "filletfold"}) as pdf:
-        for number, tile in enumerate(tiles):
-            fig = _page_figure(layers, tile, width, height, margin_mm)
-            head = f"row {tile.row} / col {tile.col}"
-            if n_regions > 1:
-                head = f"sheet {tile.region + 1} / {n_regions} - {head}"
-            fig.axes[0].text(
-                margin_mm,
-                height - 0.5 * margin_mm,
-                f"{head}    (page {number + 1} of {len(tiles)}; trim at the grey frame, "
-                "abut, align the crosses)",
-                fontsize=_FONT_PT,
-                va="center",
-                ha="left",
-                color="#000000",
-            )
-            if number == 0:
-                _scale_bar(fig.axes[0], units, float(scale), margin_mm, width)
+        for fig in pages:
             pdf.savefig(fig)
     return buf.getvalue()
+
+
+def pattern_pages(
+    pattern: CreasePattern,
+    *,
+    page: str = "A4",
+    units: str = "mm",
+    scale: float = 1.0,
+    margin_mm: float = 10.0,
+):
+    """The pages of :func:`pattern_pdf`, one matplotlib Figure at a time (checked first: the
+    same errors; a picture of a page: ``fig.savefig(...)``)."""
+    tiles = pdf_tiles(pattern, page=page, units=units, scale=scale, margin_mm=margin_mm)
+    validate_pattern(pattern)
+    return _pages(pattern, tiles, page, units, float(scale), margin_mm)
+
+
+def _pages(pattern, tiles, page, units, scale, margin_mm):
+    width, height = sheet_size_mm(page, name="page")
+    layers = _drawing_mm(pattern, MM_PER_UNIT[units] * scale)
+    n_regions = 1 + max(t.region for t in tiles)
+    for number, tile in enumerate(tiles):
+        w, h = (height, width) if tile.landscape else (width, height)
+        fig = _page_figure(layers, tile, w, h, margin_mm)
+        head = f"row {tile.row} / col {tile.col}"
+        if n_regions > 1:
+            head = f"sheet {tile.region + 1} / {n_regions} - {head}"
+        fig.axes[0].text(
+            margin_mm,
+            h - 0.5 * margin_mm,
+            f"{head}    (page {number + 1} of {len(tiles)}; trim at the grey frame, "
+            "abut, align the crosses)",
+            fontsize=_FONT_PT,
+            va="center",
+            ha="left",
+            color="#000000",
+        )
+        if number == 0:
+            _scale_bar(fig.axes[0], units, scale, margin_mm, w)
+        yield fig
 
 
 def _drawing_mm(pattern: CreasePattern, k: float) -> dict:
