@@ -264,16 +264,15 @@ def bpy_python(venv: Path, setup: bool) -> Path:
     return py
 
 
-def corpus() -> tuple[dict[str, Path], dict[str, dict]]:
-    """Corpus meshes by ``collection/name`` and by file stem; collections' licences."""
+def corpus(names) -> tuple[list[tuple[str, Path]], dict[str, dict]]:
+    """The cases ``names`` (corpus meshes or files) as ``(name, file)``, and the corpus
+    collections (with their licences) by name."""
+    sys.path.insert(0, str(HERE))  # not at the top: the Blender worker has no filletfold
+    from real_meshes import corpus_cases
+
     manifest = json.loads((HERE / "corpus_manifest.json").read_text())
-    files = {}
-    for item in manifest["meshes"]:
-        local = ROOT / "out" / "corpus-meshes" / item["collection"] / item["name"]
-        if local.is_file():
-            files[f"{item['collection']}/{item['name']}"] = local
-            files.setdefault(Path(item["name"]).stem, local)
-    return files, {c["collection"]: c for c in manifest["collections"]}
+    cases = [(name, path.resolve()) for name, path in corpus_cases(names)]
+    return cases, {c["collection"]: c for c in manifest["collections"]}
 
 
 def file_vertices(path: Path) -> int | None:
@@ -463,14 +462,7 @@ def main(argv=None) -> int:
     bpy_version = subprocess.run(
         [py, "-c", "import bpy; print(bpy.app.version_string)"], capture_output=True, text=True
     ).stdout.strip()
-    known, collections = corpus()
-    cases = []
-    for name in args.cases or DEFAULT_CASES:
-        path = known.get(name) or (Path(name) if Path(name).is_file() else None)
-        if path is None:
-            print(f"# {name}: not found (run benchmarks/fetch_corpus.py, or give a file)")
-            continue
-        cases.append((name, path.resolve()))
+    cases, collections = corpus(args.cases or DEFAULT_CASES)
 
     sys.path.insert(0, str(HERE))
     from examples import machine

@@ -118,6 +118,20 @@ def input_vertices(path: str) -> int | None:
         return None
 
 
+def corpus_cases(names) -> list[tuple[str, Path]]:
+    """``(name, file)`` of each of ``names``: a corpus mesh (``collection/name`` or file stem)
+    or a mesh file; one not found is said so and left out."""
+    known = corpus_files()
+    cases = []
+    for name in names:
+        path = known.get(name) or (Path(name) if Path(name).is_file() else None)
+        if path is None:
+            print(f"# {name}: not found (run benchmarks/fetch_corpus.py, or give a file)")
+            continue
+        cases.append((name, path))
+    return cases
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--against", required=True, help="the commit to compare with (git rev)")
@@ -126,14 +140,7 @@ def main(argv=None) -> int:
     ap.add_argument("--json", help="write the results to this file")
     ap.add_argument("cases", nargs="*")
     args = ap.parse_args(argv)
-    known = corpus_files()
-    cases = []
-    for name in args.cases or DEFAULT_CASES:
-        path = known.get(name) or (Path(name) if Path(name).is_file() else None)
-        if path is None:
-            print(f"# {name}: not found (run benchmarks/fetch_corpus.py, or give a file)")
-            continue
-        cases.append((name, str(path)))
+    cases = [(name, str(path)) for name, path in corpus_cases(args.cases or DEFAULT_CASES)]
     rev = subprocess.run(
         ["git", "rev-parse", "--short", args.against], cwd=ROOT, capture_output=True, text=True
     ).stdout.strip()
