@@ -197,6 +197,7 @@ def test_material_loss_without_solution_is_an_error(capsys, tmp_path):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.slow  # every format, written by the command: the fast tier under 3 minutes
 def test_net_on_sheets_with_all_formats(tmp_path, capsys):
     out = tmp_path / "n"
     args = [

@@ -220,6 +220,7 @@ def test_cli_export_missing_inputs(tmp_path, capsys):
     assert "not a filletfold FOLD file" in " ".join(capsys.readouterr().err.split())
 
 
+@pytest.mark.slow  # every format, written by the command: the fast tier under 3 minutes
 def test_cli_round_with_all_formats(tmp_path, capsys):
     out = tmp_path / "cube"
     args = ["round", "cube", "-o", str(out), "-q", "--format", "all", "--units", "cm"]
