@@ -290,9 +290,7 @@ def _up(mesh: PolyMesh, up: str, source: str) -> tuple[str, str]:
         return up, "given"
     if not mesh.n_faces:
         return "z", "no faces: the default"
-    size = np.diff(mesh.face_start)
-    centres = np.add.reduceat(mesh.vertices[mesh.halfedge_from], mesh.face_start[:-1], axis=0)
-    return up_axis(mesh.vertices, centres / size[:, None], mesh.face_area, source)
+    return up_axis(mesh.vertices, mesh.face_centroid, mesh.face_area, source)
 
 
 def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, shift):

@@ -178,7 +178,11 @@ class PolyMesh:
     @cached_property
     def face_centroid(self) -> np.ndarray:
         """(n_faces, 3) float: mean of each face's vertices."""
-        return np.array([self.vertices[f].mean(axis=0) for f in self.faces]).reshape(-1, 3)
+        if not self.n_faces:
+            return np.zeros((0, 3))
+        size = np.diff(self.face_start)
+        corners = self.vertices[self.halfedge_from]  # the faces' corners, face after face
+        return np.add.reduceat(corners, self.face_start[:-1], axis=0) / size[:, None]
 
     @cached_property
     def edge_length(self) -> np.ndarray:
