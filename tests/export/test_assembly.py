@@ -78,7 +78,10 @@ def test_labels_of_the_overview_sit_on_their_pieces(up):
     from filletfold.export.assembly import _View
 
     design = filletfold.round_mesh("cube", layout="modules")
-    view = _View(design.pattern, -60.0, 25.0, up, 200)
+    from filletfold.surface.triangulate import triangulate_faces
+
+    tri = triangulate_faces(design.pattern.vertices_2d, design.pattern.faces)
+    view = _View(design.pattern, tri, (-60.0, 25.0, up), 200)
     from filletfold.surface.validate import face_signed_area_2d
 
     area = np.abs(face_signed_area_2d(design.pattern.vertices_2d, design.pattern.faces))

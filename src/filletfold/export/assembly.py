@@ -27,7 +27,7 @@ from ..surface.triangulate import triangulate_faces
 from ..surface.validate import face_signed_area_2d
 from ..units import sheet_size_mm
 from .palette import LABEL_COLOR
-from .png import DEFAULT_VIEW
+from .png import DEFAULT_VIEW, face_shades
 from .render import face_image, project, view_frame
 
 __all__ = [
@@ -119,14 +119,6 @@ def assembly_steps(seams: np.ndarray, area: np.ndarray) -> list[Step]:
     return steps
 
 
-def _shades(pattern: CreasePattern, eye: np.ndarray, light: np.ndarray) -> np.ndarray:
-    """(n_faces,) brightness of each face seen from ``eye`` (as ``preview.png`` shades)."""
-    normal = np.nan_to_num(pattern.face_normal_3d())
-    facing = normal @ eye
-    shade = 0.3 + 0.5 * np.abs(normal @ light) + 0.2 * np.abs(facing)
-    return np.where(facing < 0.0, 0.8 * shade, shade)
-
-
 def _piece_colors(n: int) -> np.ndarray:
     """(n, 3) distinct light colours, one per piece (hues by the golden angle)."""
     import colorsys
@@ -159,15 +151,14 @@ class _View:
     :data:`SUPERSAMPLE` times the size) and coloured per picture: all at once
     (:meth:`paint`), or again only where given pieces show (:meth:`repaint`)."""
 
-    def __init__(self, pattern: CreasePattern, azim: float, elev: float, up: str, px: int):
-        tri, tri_face = triangulate_faces(pattern.vertices_2d, pattern.faces)
-        right, upward, eye = view_frame(azim, elev, up)
-        light = eye + 0.6 * upward - 0.4 * right
+    def __init__(self, pattern: CreasePattern, triangles, view: tuple, px: int):
+        azim, elev, up = view
+        tri, tri_face = triangles  # the pattern's faces' (triangulate_faces)
         ss = SUPERSAMPLE
         self.p, self.azim, self.elev, self.up = pattern, azim, elev, up
         self.w, self.h = px, round(0.75 * px)
-        self.eye = eye
-        self.shade = _shades(pattern, eye, light / np.linalg.norm(light)).astype(np.float32)
+        self.eye = view_frame(azim, elev, up)[2]
+        self.shade = face_shades(pattern, azim, elev, up).astype(np.float32)
         face = face_image(
             pattern.vertices_3d, tri, tri_face, ss * self.w, ss * self.h, azim, elev, up
         )
@@ -284,7 +275,9 @@ def assembly_pages(
     azim, elev = DEFAULT_VIEW
     colors = _piece_colors(n)
     face_rgb = np.where(inside[:, None], colors[np.clip(piece, 0, None)], _DONE)
-    big = [_View(pattern, azim + turn, elev, up, 2 * width_px) for turn in (0.0, 180.0)]
+    tri = triangulate_faces(pattern.vertices_2d, pattern.faces)  # once for the four views
+    sides = [(azim + turn, elev, up) for turn in (0.0, 180.0)]
+    big = [_View(pattern, tri, side, 2 * width_px) for side in sides]
     dpi = 2 * width_px / (0.8 * size_in[0])  # the overview's pictures 0.8 of the width
     fig = Figure(figsize=size_in, dpi=dpi)
     fig.text(0.06, 0.965, f"Assembly: {n} pieces, {len(seams)} numbered borders", size=12)
@@ -304,7 +297,7 @@ def assembly_pages(
         fig.text(0.5, 0.915 - 0.455 * row, caption, ha="center", size=_FONT_PT)
     yield fig
     del big
-    views = [_View(pattern, azim + turn, elev, up, width_px) for turn in (0.0, 180.0)]
+    views = [_View(pattern, tri, side, width_px) for side in sides]
     state = np.zeros(n, dtype=np.int64)  # 0 to come, 1 placed, 2 placed at this step
     palette = np.array([_LATER, _DONE, _NEW])
     rgb = np.where(inside[:, None], palette[state[np.clip(piece, 0, None)]], _DONE)

@@ -28,6 +28,7 @@ __all__ = [
     "LAYOUT_FILL",
     "PATCH_COLOR",
     "VIEWS",
+    "face_shades",
     "parse_view",
     "pattern_png",
     "preview_png",
@@ -227,6 +228,21 @@ def _rgb(hex_color: str) -> tuple[float, float, float]:
     return tuple(int(h[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
 
 
+def face_shades(pattern: CreasePattern, azim: float, elev: float, up: str = "z") -> np.ndarray:
+    """(n_faces,) brightness of each face of the folded form seen from a view (the
+    ``preview.png`` shading): ambient, plus a light above and to the left of the viewer and
+    one at the viewer, two-sided, the back of a face darker."""
+    from .render import view_frame
+
+    right, upward, eye = view_frame(azim, elev, up)
+    light = eye + 0.6 * upward - 0.4 * right
+    light /= np.linalg.norm(light)
+    normal = np.nan_to_num(pattern.face_normal_3d())
+    facing = normal @ eye
+    shade = _AMBIENT + _KEY * np.abs(normal @ light) + _HEAD * np.abs(facing)
+    return np.where(facing < 0.0, _BACK_SIDE * shade, shade)
+
+
 def preview_png(
     pattern: CreasePattern,
     *,
@@ -269,7 +285,7 @@ def preview_png(
     ExportError
         When the pattern is inconsistent.
     """
-    from .render import png_bytes, render, view_frame
+    from .render import png_bytes, render
 
     width_px = _check_pixels(width_px, "width_px")
     for name, value in (("elev", elev), ("azim", azim)):
@@ -283,20 +299,13 @@ def preview_png(
         raise ParameterError(f"up must be 'x', 'y' or 'z', got {up!r}", name="up")
     validate_pattern(pattern)
     height_px = round(0.75 * width_px)
-    right, upward, eye = view_frame(float(azim), float(elev), up)
-    light = eye + 0.6 * upward - 0.4 * right
-    light /= np.linalg.norm(light)
-
     triangles, tri_face = triangulate_faces(pattern.vertices_2d, pattern.faces)
     if len(pattern.face_patch):
-        normal = np.nan_to_num(pattern.face_normal_3d())
         color_of = {
             p: PATCH_COLOR.get(patch_kind(p), (0.8, 0.8, 0.8)) for p in set(pattern.face_patch)
         }
         base = np.array([color_of[p] for p in pattern.face_patch], dtype=np.float64)
-        facing = normal @ eye
-        shade = _AMBIENT + _KEY * np.abs(normal @ light) + _HEAD * np.abs(facing)
-        shade = np.where(facing < 0.0, _BACK_SIDE * shade, shade)
+        shade = face_shades(pattern, float(azim), float(elev), up)
         face_color = np.clip(base * shade[:, None], 0.0, 1.0)
     else:
         face_color = np.zeros((0, 3))
