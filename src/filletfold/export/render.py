@@ -81,6 +81,16 @@ def _fit(xy: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float]:
     return 0.5 * (lo + hi), float((usable / span).min())
 
 
+def _pixels(cam: np.ndarray, centre: np.ndarray, scale: float, width: int, height: int):
+    """Camera coordinates (n, 3: right, up, towards the eye) to pixel x (right), y (down) and
+    depth (larger nearer, in pixel units) of a picture framed by :func:`_fit`."""
+    return (
+        (cam[:, 0] - centre[0]) * scale + 0.5 * width,
+        0.5 * height - (cam[:, 1] - centre[1]) * scale,
+        cam[:, 2] * scale,
+    )
+
+
 def project(points, fit, width: int, height: int, azim: float, elev: float, up: str = "z"):
     """Pixel positions (x right, y down) of ``points`` (n, 3) in a picture of
     :func:`render` framed on the points ``fit`` (its ``points``, with no lines).
@@ -94,12 +104,7 @@ def project(points, fit, width: int, height: int, azim: float, elev: float, up: 
     centre, scale = _fit(
         (np.asarray(fit, dtype=np.float64).reshape(-1, 3) @ frame.T)[:, :2], width, height
     )
-    return np.column_stack(
-        [
-            (cam[:, 0] - centre[0]) * scale + 0.5 * width,
-            0.5 * height - (cam[:, 1] - centre[1]) * scale,
-        ]
-    )
+    return np.column_stack(_pixels(cam, centre, scale, width, height)[:2])
 
 
 def face_image(
@@ -112,9 +117,8 @@ def face_image(
     frame = view_frame(azim, elev, up)
     cam = np.asarray(points, dtype=np.float64).reshape(-1, 3) @ frame.T
     centre, scale = _fit(cam[:, :2], width, height)
-    px = (cam[:, 0] - centre[0]) * scale + 0.5 * width
-    py = 0.5 * height - (cam[:, 1] - centre[1]) * scale
-    _, ident = _zbuffer(px, py, cam[:, 2] * scale, np.asarray(triangles, np.int64), width, height)
+    px, py, depth = _pixels(cam, centre, scale, width, height)
+    _, ident = _zbuffer(px, py, depth, np.asarray(triangles, np.int64), width, height)
     face = np.where(ident >= 0, np.asarray(triangle_face, dtype=np.int64)[ident], -1)
     return face.reshape(height, width)
 
@@ -276,11 +280,7 @@ def render(
     centre, scale = _fit(fit_pts, w_ss, h_ss)
 
     def to_pixels(c):
-        return (
-            (c[:, 0] - centre[0]) * scale + 0.5 * w_ss,
-            0.5 * h_ss - (c[:, 1] - centre[1]) * scale,
-            c[:, 2] * scale,  # depth in pixel units
-        )
+        return _pixels(c, centre, scale, w_ss, h_ss)
 
     tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     px, py, pd = to_pixels(cam)
