@@ -131,12 +131,13 @@ def pdf_tiles(
             x1 + REGION_PAD_MM,
             y1 + REGION_PAD_MM,
         )
+        cols, rows = _grid(x1 - x0, y1 - y0, tw, th)
         turned = bool(len(sheets)) and (  # a sheet of material on pages of its own turn
-            _count(x1 - x0, y1 - y0, th, tw) < _count(x1 - x0, y1 - y0, tw, th)
+            math.prod(_grid(x1 - x0, y1 - y0, th, tw)) < cols * rows
         )
         pw, ph = (th, tw) if turned else (tw, th)
-        cols = max(1, math.ceil((x1 - x0) / pw - tol.relative))
-        rows = max(1, math.ceil((y1 - y0) / ph - tol.relative))
+        if turned:
+            cols, rows = _grid(x1 - x0, y1 - y0, pw, ph)
         if len(tiles) + rows * cols > MAX_PAGES:
             raise ParameterError(
                 f"the PDF would need more than {MAX_PAGES} {width:g} x {height:g} mm pages; "
@@ -151,9 +152,10 @@ def pdf_tiles(
     return tiles
 
 
-def _count(w: float, h: float, tw: float, th: float) -> int:
-    """Pages of printable area ``tw`` x ``th`` that a region ``w`` x ``h`` is tiled on."""
-    return max(1, math.ceil(w / tw - tol.relative)) * max(1, math.ceil(h / th - tol.relative))
+def _grid(w: float, h: float, tw: float, th: float) -> tuple[int, int]:
+    """Columns and rows of pages of printable area ``tw`` x ``th`` that tile a region
+    ``w`` x ``h``."""
+    return max(1, math.ceil(w / tw - tol.relative)), max(1, math.ceil(h / th - tol.relative))
 
 
 def _sheet_contents(pattern: CreasePattern, sheets: np.ndarray) -> np.ndarray:

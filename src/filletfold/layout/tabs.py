@@ -552,11 +552,11 @@ class _Faces:
             pairs.append((tabs[at], faces[at]))
         tabs = np.concatenate([t for t, _ in pairs]) if pairs else np.zeros(0, dtype=np.int64)
         faces = np.concatenate([f for _, f in pairs]) if pairs else np.zeros(0, dtype=np.int64)
-        slow = np.arange(len(tabs))
-        slow = slow[blocker[tabs[slow]] < 0]
-        if len(slow):
-            hit = self._exact(quads, tabs[slow], faces[slow])
-            blocker[tabs[slow[hit]]] = faces[slow[hit]]
+        open_ = blocker[tabs] < 0  # the tabs no face blocked yet
+        tabs, faces = tabs[open_], faces[open_]
+        if len(tabs):
+            hit = self._exact(quads, tabs, faces)
+            blocker[tabs[hit]] = faces[hit]
         return blocker, frame["wide"]
 
     def _pairs(self, frame, tabs, faces, blocker, slow):
