@@ -308,7 +308,7 @@ class Parameters:
             )
         if self.up not in ("auto", "x", "y", "z"):
             raise ParameterError(f"up must be 'auto', 'x', 'y' or 'z', got {self.up!r}", name="up")
-        if self.size is not None and self.size != "auto":
+        if self.size is not None and self.size != AUTO_SIZE:
             from .units import parse_size
 
             parse_size(self.size)

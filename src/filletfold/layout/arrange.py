@@ -189,11 +189,11 @@ def arrange(
         params.sheet,
         params.tabs,
     )
+    ref = pm.mean_edge_length
     asked = params  # the size settles once the pieces are known (on sheets, before)
     extent = float(np.ptp(pm.vertices, axis=0).max(initial=0.0))
-    params, _ = settle_size(params, extent, pm.mean_edge_length, None)
+    params, _ = settle_size(params, extent, ref, None)
     given = pieces  # the caller's list (``pieces`` may be rebound to laid-out copies)
-    ref = pm.mean_edge_length
     layout_used, layout_note = "modules", ""
     eps = tol.relative * ref
     if layout in ("auto", "sheet") and (material_loss or layout == "sheet"):
