@@ -28,7 +28,14 @@ from .errors import ParameterError
 from .tolerances import tol
 from .units import AUTO_SIZE
 
-__all__ = ["Parameters", "parse_length", "report_parameters", "resolve_chord_tol", "resolve_depth"]
+__all__ = [
+    "Parameters",
+    "parse_length",
+    "report_parameters",
+    "resolve_chord_tol",
+    "resolve_depth",
+    "unsettled",
+]
 
 #: The JSON types each field of :class:`Parameters` may take in a report (``number`` is an int
 #: or a float, never a bool).
@@ -391,11 +398,16 @@ def report_parameters(path) -> tuple[Parameters, str]:
         raise ParameterError(f"{path}: not a filletfold report (no string 'source')")
     params = Parameters.from_dict(doc["parameters"], where=f"{path}: parameters")
     fab = doc.get("fabrication")
-    default = fab.get("default_size") if isinstance(fab, dict) else None
-    if isinstance(default, dict) and params.size == default.get("size"):
-        # the size was the default: asked again, it settles the same (or anew, on a new mesh)
-        params = params.replace(size=AUTO_SIZE, units="", scale=None)
-    return params, source
+    return unsettled(params, fab.get("default_size") if isinstance(fab, dict) else None), source
+
+
+def unsettled(params: Parameters, default_size) -> Parameters:
+    """``params`` of a design whose size was the default (``default_size``: its
+    ``fabrication["default_size"]``, or None) with the default asked again (``"auto"``, no
+    units or scale): it settles the same on the same mesh, anew on another layout or mesh."""
+    if isinstance(default_size, dict) and params.size == default_size.get("size"):
+        return params.replace(size=AUTO_SIZE, units="", scale=None)
+    return params
 
 
 def _plain(x):

@@ -31,7 +31,7 @@ from ..layout.tabs import assembly_text
 from ..mesh import SUPPORTED_EXTENSIONS, load_mesh
 from ..mesh.coarsen import Coarsening, coarsen_and_clean
 from ..mesh.polymesh import PolyMesh
-from ..parameters import Parameters
+from ..parameters import Parameters, unsettled
 
 log = logging.getLogger(__name__)
 
@@ -439,9 +439,8 @@ class AppSession:
         ):
             # the shown design was computed as modules without glue tabs: lay it out in nets
             # with tabs, as the command line does (the layout stage only)
-            p = design.params
-            if design.fabrication.get("default_size"):  # settled anew for the nets' pieces
-                p = p.replace(size="auto", units="", scale=None)
+            # a default size settles anew for the nets' pieces
+            p = unsettled(design.params, design.fabrication.get("default_size"))
             source = design.source
             design = round_mesh(design.mesh, p, tabs=True, layout="auto", reuse=design)
             design.source = source
