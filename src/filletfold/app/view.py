@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..design import Design
+from ..export.render import UP_AXES
 from ..surface.patch import patch_kind
 from ..surface.triangulate import triangulate_faces
 
@@ -73,11 +74,6 @@ CAMERA_POSITION = (1.0, -2.9, 2.9)
 CAMERA_LOOK_AT = (1.0, 0.0, -0.4)
 
 
-#: The design's axes drawn as the scene's x, y, z (up z), by the design's up axis: a cyclic
-#: turn, as the pictures' (:func:`~filletfold.export.render.view_frame`).
-UP_AXES = {"z": (0, 1, 2), "y": (2, 0, 1), "x": (1, 2, 0)}
-
-
 @dataclass
 class SceneArrays:
     """Everything the 3D view shows of a design, in scene coordinates.
@@ -107,7 +103,8 @@ class SceneArrays:
         Drawn size of the pattern relative to the model (at most 1).
     axes : (3,) int
         The design's axes that are the scene's x, y and z: the design's up axis
-        (``design.up``) is the scene's z, the others turned cyclically (:data:`UP_AXES`).
+        (``design.up``) is the scene's z, the others turned cyclically as in the pictures
+        (:data:`~filletfold.export.render.UP_AXES`).
     """
 
     folded: dict = field(default_factory=dict)
@@ -138,7 +135,7 @@ def scene_arrays(design: Design) -> SceneArrays:
     are scaled to :data:`SCENE_WIDTH` and centred at the origin.
     """
     pattern = design.pattern
-    axes = UP_AXES[design.up]
+    axes = tuple(np.argsort(UP_AXES[design.up]).tolist())  # the pictures' turn, undone
     v2, v3 = pattern.vertices_2d, pattern.vertices_3d[:, axes]  # turned: up is z
     lo, hi = v3.min(axis=0), v3.max(axis=0)
     size = float(np.max(hi - lo)) or 1.0

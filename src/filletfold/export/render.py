@@ -25,7 +25,7 @@ import numpy as np
 
 from ..arrays import run_owners, run_starts
 
-__all__ = ["MARGIN", "face_image", "png_bytes", "project", "render", "view_frame"]
+__all__ = ["MARGIN", "UP_AXES", "face_image", "png_bytes", "project", "render", "view_frame"]
 
 #: Share of the image left blank on each side of the fitted picture.
 MARGIN = 0.04
@@ -38,7 +38,7 @@ _LINE_STEP = 0.5
 
 #: World coordinates of the (x, y, z) of the z-up view frame, for each up axis: a cyclic
 #: renaming of the axes (a rotation, never a mirror image).
-_UP_AXES = {"z": [0, 1, 2], "y": [1, 2, 0], "x": [2, 0, 1]}
+UP_AXES = {"z": [0, 1, 2], "y": [1, 2, 0], "x": [2, 0, 1]}
 
 
 def view_frame(azim: float, elev: float, up: str = "z") -> np.ndarray:
@@ -63,7 +63,7 @@ def view_frame(azim: float, elev: float, up: str = "z") -> np.ndarray:
     eye = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
     right = np.array([-math.sin(a), math.cos(a), 0.0])
     frame = np.vstack([right, np.cross(eye, right), eye])
-    return frame[:, _UP_AXES[up]]
+    return frame[:, UP_AXES[up]]
 
 
 def _fit(xy: np.ndarray, width: int, height: int) -> tuple[np.ndarray, float]:
