@@ -59,8 +59,19 @@ def test_a_net_design_has_fewer_pieces_than_modules():
 
 
 def _clash(placed, shape, corners, *tolerances) -> bool:
-    """Whether one piece (its outline and border points) clashes with a net's placed pieces."""
-    return placed.clashes(np.array([shape], dtype=object), [corners], *tolerances)
+    """Whether one piece (its outline and border points, unmoved) clashes with a net of one
+    placed piece ``placed`` (its outline and border points)."""
+    import shapely
+
+    from filletfold.layout.net import _Moving, _Placed
+
+    net = _Placed([0], np.array([placed[0]], dtype=object), shapely.bounds([placed[0]]))
+    border = [placed[1], corners]
+    moving = _Moving(
+        np.array([1]), np.array([shape], dtype=object), np.eye(3), np.tile(np.eye(3), (2, 1, 1)),
+        border,
+    )  # fmt: skip
+    return net.clashes(moving, *tolerances)
 
 
 def _square(x0: float, y0: float):
@@ -70,11 +81,8 @@ def _square(x0: float, y0: float):
 
 
 def test_a_piece_touching_a_placed_one_at_two_points_of_the_surface_clashes():
-    from filletfold.layout.net import _Placed
-
-    placed = _Placed(cell=1.0)
     corner = np.array([[1.0, 1.0]])
-    placed.add(_square(0, 0), (corner, np.array([[0.0, 0.0, 0.0]])), np.zeros((0, 2)))
+    placed = (_square(0, 0), (corner, np.array([[0.0, 0.0, 0.0]])))
     same = (corner, np.array([[0.0, 0.0, 0.0]]))  # one point of the surface: glued there
     other = (corner, np.array([[0.0, 0.0, 1.0]]))  # two points at one place: a pinch
     assert not _clash(placed, _square(1, 1), same, 1e-9, 1e-9, 1e-12)
@@ -108,11 +116,8 @@ def test_a_small_overlap_clashes_unless_it_is_a_sliver_along_a_glued_border():
     a border apart by round-off do not."""
     import shapely
 
-    from filletfold.layout.net import _Placed
-
-    placed = _Placed(cell=100.0)
     nowhere = (np.zeros((0, 2)), np.zeros((0, 3)))
-    placed.add(shapely.box(0, 0, 100, 100), nowhere, np.zeros((0, 2)))
+    placed = (shapely.box(0, 0, 100, 100), nowhere)
     corner = shapely.box(99.999, 99.999, 200, 200)  # 1e-6 of the area overlapped, 1e-3 wide
     assert _clash(placed, corner, nowhere, 1e-9 * 1e5, 1e-9, 1e-12)
     beside = shapely.box(100 - 1e-13, 0, 200, 100)  # round-off of the shared border

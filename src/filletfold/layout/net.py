@@ -119,52 +119,41 @@ def fits_sheet(points: np.ndarray, sheet) -> bool:
 
 
 class _Placed:
-    """The outlines of the pieces placed in one net, in a uniform grid of their bounding
-    boxes: a piece that would join is tested against the placed ones whose boxes meet its own
-    only, so growing a net of ``n`` modules costs about ``n`` small intersections, not ``n``
-    unions of the whole net."""
+    """The outlines of the pieces placed in one net and their bounding boxes: a net that would
+    join is tested against the placed pieces whose boxes meet its own pieces' boxes only
+    (all pairs of boxes compared at once), so growing a net costs a few small intersections
+    per piece, not unions of the whole net. The pieces' border points stay in their own
+    frames; ``place`` (shared by all nets) places them."""
 
-    def __init__(self, cell: float):
-        self.cell = cell
-        self.shapes: list = []
-        self.corners: list[tuple] = []
-        self.boxes: list = []
-        self.grid: dict[tuple[int, int], list[int]] = {}
+    def __init__(self, ids, shapes, boxes):
+        self.ids = np.asarray(ids, dtype=np.int64)
+        self.shapes = shapes
+        self.boxes = boxes
         self.hull = np.zeros((0, 2))
 
-    def _cells(self, box):
-        lo = np.floor(np.asarray(box[:2]) / self.cell).astype(np.int64)
-        hi = np.floor(np.asarray(box[2:]) / self.cell).astype(np.int64)
-        return [(i, j) for i in range(lo[0], hi[0] + 1) for j in range(lo[1], hi[1] + 1)]
+    def near(self, boxes: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs (index into ``boxes``, index of a placed piece) whose boxes meet within
+        ``eps``, by the first then the second."""
+        lo, hi = self.boxes[None, :, :2], self.boxes[None, :, 2:]
+        return np.nonzero(
+            ((lo <= boxes[:, None, 2:] + eps) & (boxes[:, None, :2] <= hi + eps)).all(axis=-1)
+        )
 
-    def clashes(self, shapes, corners: list, overlap_tol: float, eps: float, thin: float) -> bool:
-        """Whether any of ``shapes`` (the outlines of the pieces of a net that would join,
-        placed) overlaps the placed outlines by more than ``overlap_tol`` of its area (summed
-        over them: they overlap one another by no more than that), or its piece touches a
-        placed piece at a point that is two points of the surface (a pinch: a cutter cuts it
-        apart, Origami Simulator welds it). ``corners`` are each piece's border points,
-        placed, (k, 2) and (k, 3); points within ``eps`` are one. Any overlap wider than
-        ``thin`` (twice its area over its perimeter, for each part of it) clashes too. The
-        pairs of a new and a placed outline whose boxes meet are tested all at once."""
-        boxes = shapely.bounds(shapes)
-        new, old = [], []
-        for i, box in enumerate(boxes):
-            near = np.fromiter(
-                {k for c in self._cells(box) for k in self.grid.get(c, ())}, dtype=np.int64
-            )
-            b = np.array([self.boxes[k] for k in near.tolist()]).reshape(-1, 4)
-            near = near[
-                (b[:, 0] <= box[2] + eps) & (box[0] <= b[:, 2] + eps)
-                & (b[:, 1] <= box[3] + eps) & (box[1] <= b[:, 3] + eps)
-            ]  # fmt: skip
-            new.append(np.full(len(near), i))
-            old.append(near)
-        new, old = np.concatenate(new), np.concatenate(old)
+    def clashes(self, moving: _Moving, overlap_tol: float, eps: float, thin: float) -> bool:
+        """Whether any piece of ``moving`` (a net that would join, placed) overlaps the placed
+        outlines by more than ``overlap_tol`` of its area (summed over them: they overlap one
+        another by no more than that), or touches a placed piece at a point that is two points
+        of the surface (a pinch: a cutter cuts it apart, Origami Simulator welds it). Points
+        within ``eps`` are one. Any overlap wider than ``thin`` (twice its area over its
+        perimeter, for each part of it) clashes too. The pairs of a moving and a placed
+        outline whose boxes meet are tested all at once."""
+        shapes = moving.shapes
+        new, old = self.near(shapely.bounds(shapes), eps)
         if not len(new):
             return False
-        mine = shapes[new]
-        theirs = np.empty(len(old), dtype=object)
-        theirs[:] = [self.shapes[k] for k in old.tolist()]
+        mine, theirs = shapes[new], self.shapes[old]
+        close = shapely.dwithin(theirs, mine, eps)  # only these can overlap
+        new, old, mine, theirs = new[close], old[close], mine[close], theirs[close]
         both = shapely.intersection(theirs, mine)
         area = shapely.area(both)
         overlap = np.bincount(new, weights=area, minlength=len(shapes))
@@ -176,23 +165,39 @@ class _Placed:
         parts = shapely.get_parts(both[area > 0])
         if len(parts) and (2 * shapely.area(parts) > thin * shapely.length(parts)).any():
             return True
-        close = shapely.dwithin(theirs, mine, eps)
-        for i, k in zip(new[close].tolist(), old[close].tolist(), strict=True):
-            (p2, p3), (q2, q3) = corners[i], self.corners[k]
+        for i, k in zip(new.tolist(), self.ids[old].tolist(), strict=True):
+            p2, p3 = moving.corners(i)
+            q2, q3 = moving.placed_corners(k)
             flat = np.linalg.norm(p2[:, None] - q2[None], axis=-1) <= eps
             if (np.linalg.norm(p3[:, None] - q3[None], axis=-1)[flat] > eps).any():
                 return True
         return False
 
-    def add(self, shape, corners: tuple, hull: np.ndarray) -> None:
-        box = shapely.bounds(shape)
-        k = len(self.shapes)
-        self.shapes.append(shape)
-        self.corners.append(corners)
-        self.boxes.append(box)
-        for c in self._cells(box):
-            self.grid.setdefault(c, []).append(k)
+    def add(self, other: _Placed, shapes, hull: np.ndarray) -> None:
+        """The pieces of ``other`` placed in this net, with their outlines ``shapes`` moved."""
+        self.ids = np.concatenate([self.ids, other.ids])
+        self.shapes = np.concatenate([self.shapes, shapes])
+        self.boxes = np.concatenate([self.boxes, shapely.bounds(shapes)])
         self.hull = hull
+
+
+class _Moving:
+    """A net's pieces moved by the rigid motion ``m``: their outlines, and their border points
+    (2D placed, 3D) on demand."""
+
+    def __init__(self, ids, shapes, m, place, border):
+        self.ids, self.shapes, self.m, self.place, self.border = ids, shapes, m, place, border
+
+    def placed_corners(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Border points of piece ``k`` where it is placed: (k, 2) and (k, 3)."""
+        p2, p3 = self.border[k]
+        return _apply(self.place[k], p2), p3
+
+    def corners(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """Border points of the ``i``-th moving piece, moved."""
+        k = int(self.ids[i])
+        p2, p3 = self.border[k]
+        return _apply(self.m @ self.place[k], p2), p3
 
 
 def _border_points(piece: Piece) -> np.ndarray:
@@ -300,18 +305,18 @@ def build_nets(
     shared = shared_points(pieces, eps)
     arrays = [p.arrays()[0] for p in pieces]
     shapes = np.array([_outline(p) for p in pieces], dtype=object)  # placed: moved with nets
-    spans = [np.ptp(a, axis=0).max() for a in arrays if len(a)]
-    cell = float(np.median(spans)) if spans else 1.0
     n = len(pieces)
     net_of = np.arange(n)
-    members = {k: [k] for k in range(n)}
     place = np.tile(np.eye(3), (n, 1, 1))
-    nets = {}
-    border = [_border_points(p) for p in pieces]
-    corners = [(p2[i], p.arrays()[1][i]) for p, p2, i in zip(pieces, arrays, border, strict=True)]
-    for k in range(n):
-        nets[k] = _Placed(cell)
-        nets[k].add(shapes[k], corners[k], _hull(shapely.get_coordinates(shapes[k])))
+    border = []  # each piece's border points in its own frame, (k, 2) and (k, 3)
+    for p, p2 in zip(pieces, arrays, strict=True):
+        i = _border_points(p)
+        border.append((p2[i], p.arrays()[1][i]))
+    boxes = shapely.bounds(shapes)
+    nets = {k: _Placed([k], shapes[k : k + 1], boxes[k : k + 1]) for k in range(n)}
+    if sheet is not None:
+        for k in range(n):
+            nets[k].hull = _hull(shapely.get_coordinates(shapes[k]))
     heap = [
         (2, -len(matches), a, b)
         for (a, b), matches in shared.items()
@@ -323,12 +328,13 @@ def build_nets(
         na, nb = int(net_of[a]), int(net_of[b])
         if na == nb:
             continue
-        now = len(members[na]) + len(members[nb])
+        target, source = nets[na], nets[nb]
+        now = len(target.ids) + len(source.ids)
         if now != size:  # a net grew since: back in line at its size
             heapq.heappush(heap, (now, longer, a, b))
             continue
-        if (len(members[na]), -na) < (len(members[nb]), -nb):  # move the smaller net
-            a, b, na, nb = b, a, nb, na
+        if (len(target.ids), -na) < (len(source.ids), -nb):  # move the smaller net
+            a, b, na, nb, target, source = b, a, nb, na, source, target
         matches = shared[(a, b)]
         src = _apply(place[b], arrays[b][[j for _, j in matches]])
         dst = _apply(place[a], arrays[a][[i for i, _ in matches]])
@@ -340,27 +346,24 @@ def build_nets(
         exact = _round_off(dst)
         if np.abs(_apply(m, src) - dst).max() > exact:
             continue
-        moving = members[nb]
-        moved = _moved(shapes[moving], m)
-        target = nets[na]
-        placed = [(_apply(m, corners[k][0]), corners[k][1]) for k in moving]
-        if target.clashes(moved, placed, overlap_tol, 1e3 * eps, 16 * exact):
+        moving = _Moving(source.ids, _moved(source.shapes, m), m, place, border)
+        if target.clashes(moving, overlap_tol, 1e3 * eps, 16 * exact):
             continue
-        hull = _hull(np.vstack([target.hull, _apply(m, nets[nb].hull)]))
-        if sheet is not None and not fits_sheet(hull, sheet):
-            continue
-        place[moving] = m @ place[moving]
-        shapes[moving] = moved
-        for k, s, c in zip(moving, moved, placed, strict=True):
-            corners[k] = c
-            target.add(s, c, hull)
-        net_of[moving] = na
-        members[na].extend(members.pop(nb))
+        hull = target.hull
+        if sheet is not None:
+            hull = _hull(np.vstack([target.hull, _apply(m, source.hull)]))
+            if not fits_sheet(hull, sheet):
+                continue
+        place[source.ids] = m @ place[source.ids]
+        target.add(source, moving.shapes, hull)
+        net_of[source.ids] = na
         del nets[nb]
-    groups = sorted((sorted(v) for v in members.values()), key=lambda v: (-len(v), v[0]))
+    members = [sorted(net.ids.tolist()) for net in nets.values()]
+    groups = sorted(members, key=lambda v: (-len(v), v[0]))
     out = []
     for ids in groups:  # the glued points, merged at the round-off of where they lie
-        reach = max((np.abs(corners[i][0]).max() for i in ids if len(corners[i][0])), default=0)
+        placed = [_apply(place[i], border[i][0]) for i in ids if len(border[i][0])]
+        reach = max((np.abs(q).max() for q in placed), default=0)
         exact = _round_off(np.array([reach]))
         out.append(merge_pieces([pieces[i] for i in ids], list(place[ids]), exact))
     return out, groups
