@@ -37,6 +37,8 @@ import numpy as np
 from .errors import FilletfoldError, InternalError, SolverError, is_callers, one_line
 from .errors import stage as _stage
 from .layout.arrange import arrange
+from .layout.fabrication import cut_first, recut_solved
+from .layout.net import cut_edges_for_nets
 from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
 from .mesh.polymesh import PolyMesh, mesh_size
@@ -548,6 +550,10 @@ def module_stage(job: Job, sol: VertexSolution, st: Stages | None) -> Modules:
         points, cone_sample_counts(sol.solved, sol.centres, pm.n_edges, p.arc_step, sol.needs)
     )
     sol.needs.clear()  # its last use: it holds every cone's frame, which the layout may not need
+    if cut_first(p, pm.n_vertices):  # built where the nets will cut them: not built twice
+        sol.solved = list(sol.solved)
+        for u, entry in recut_solved(pm, sol.rounding, sol.solved, cut_edges_for_nets(pm)).items():
+            sol.solved[u] = entry
     same_samples = st is not None and np.array_equal(st.samples, points)
     modules = [
         st.modules[u] if same_samples and u in sol.kept else None for u in range(len(sol.solved))

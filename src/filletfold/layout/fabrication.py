@@ -86,7 +86,6 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
     # a larger mesh tries the glue tree's cuts alone: never more nets than the ring starts'
     # on the corpus (cow: 334 against 355; spot 288 against 365; airplane 509 against 670)
     # a vertex the tree cuts where its module is cut keeps its module
-    start = np.array([f.ring.edges[0] if f.ring.closed else -1 for f, _, _ in solved])
     choices = [None, cut_edges_for_nets(mesh)]
     if tries == 1:
         choices = choices[1:]
@@ -96,26 +95,12 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
         choices.append(cut_edges_for_nets(mesh, root=int(root)))
     best = None
     for cut in choices[:tries]:
-        cut_at = []  # the vertices cut elsewhere than their module is
-        if cut is not None:
-            cut_at = [u for u, (f, _, _) in enumerate(solved) if f.ring.closed and cut[u] >= 0]
-            cut_at = [u for u in cut_at if cut[u] != start[u]]
-        sharp = np.array([f.sharp for f, _, _ in solved], dtype=bool)
-        new_frames = vertex_frames(
-            mesh, rounding, cut_at, [int(cut[u]) for u in cut_at], sharp=sharp
-        )
-        batch = []  # (frame, apex, developed apex) of each vertex re-cut
-        for u, new in zip(cut_at, new_frames, strict=True):
-            frame, apex, v = solved[u]
-            k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
-            if v is not None and k:
-                v = apply(invert(frame.face_map[k - 1]), v)[0]
-            batch.append((new, apex, v))
+        recut = {} if cut is None else recut_solved(mesh, rounding, solved, cut)
         rebuilt = {}
-        if batch:
-            frames, apices, developed = (list(c) for c in zip(*batch, strict=True))
+        if recut:
+            frames, apices, developed = (list(c) for c in zip(*recut.values(), strict=True))
             built = build_modules(mesh, frames, centres, samples, apices, developed)
-            rebuilt = dict(zip(cut_at, built, strict=True))
+            rebuilt = dict(zip(recut, built, strict=True))
         pieces = [piece for u, module in enumerate(modules) for piece in rebuilt.get(u, module)]
         nets, _ = build_nets(pieces, eps, sheet)
         if best is None or len(nets) < len(best):
@@ -123,6 +108,51 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
         if len(best) == 1:
             break
     return best
+
+
+def cut_first(params, n_vertices: int) -> bool:
+    """Whether the modules are built cut where the nets will cut them
+    (:func:`recut_solved` of the glue tree's cuts, before they are built): where the layout
+    will be nets of one choice of cuts (more than :data:`SMALL` vertices, ``layout`` net, or
+    auto without the material-loss radii, which may glue into one sheet instead), so that
+    :func:`net_pieces` finds every module cut where it would cut it and builds none again."""
+    nets = params.layout == "net" or (params.layout == "auto" and not params.material_loss)
+    return nets and n_vertices > SMALL
+
+
+def recut_solved(mesh, rounding, solved: list, cut: np.ndarray) -> dict:
+    """The vertices whose module a net cuts elsewhere than it is cut, framed again there.
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : Rounding
+    solved : list of (VertexFrame, apex, developed apex)
+        Per vertex (:class:`~filletfold.vertex.solution.VertexSolution`'s ``solved``).
+    cut : (n_vertices,) int
+        The edge each vertex's module is to be cut along (:func:`cut_edges_for_nets`; -1:
+        none).
+
+    Returns
+    -------
+    dict
+        Vertex -> (frame, apex, developed apex) for every closed vertex whose ring starts at
+        another edge than ``cut`` names: its frame starting at that edge, the developed apex
+        in it (the spatial apex is the same).
+    """
+    start = np.array([f.ring.edges[0] if f.ring.closed else -1 for f, _, _ in solved])
+    cut_at = [u for u, (f, _, _) in enumerate(solved) if f.ring.closed and cut[u] >= 0]
+    cut_at = [u for u in cut_at if cut[u] != start[u]]
+    sharp = np.array([f.sharp for f, _, _ in solved], dtype=bool)
+    new_frames = vertex_frames(mesh, rounding, cut_at, [int(cut[u]) for u in cut_at], sharp=sharp)
+    out = {}
+    for u, new in zip(cut_at, new_frames, strict=True):
+        frame, apex, v = solved[u]
+        k = int(np.nonzero(frame.ring.edges == cut[u])[0][0])
+        if v is not None and k:
+            v = apply(invert(frame.face_map[k - 1]), v)[0]
+        out[u] = (new, apex, v)
+    return out
 
 
 def orient(piece: Piece) -> Piece:
