@@ -589,3 +589,14 @@ def test_a_radius_changed_in_the_fold_fails_the_cylinders(tmp_path):
     cert = check_folder(folder)
     assert "on cylinders" in _failed(cert)
     assert "cylinder 3" in cert["on cylinders"].detail
+
+
+@pytest.mark.parametrize("name", ["report.json", "design.fold", "annotations.json"])
+def test_a_file_nested_too_deeply_is_a_named_error(tmp_path, capsys, name):
+    """JSON nested past Python's recursion limit in any file ``check`` reads is one line naming
+    the file, never a RecursionError (issue 30)."""
+    folder = tmp_path / "deep"
+    design_of("icosahedron").export(folder, formats="fold,json")
+    (folder / name).write_text('{"a": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    err = _error_line(["check", str(folder)], capsys)
+    assert name in err and "nested too deeply" in err, err

@@ -48,7 +48,6 @@ a folder written by ``filletfold round`` (``design.fold`` and ``report.json``).
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass, field
@@ -61,7 +60,7 @@ from .arrays import run_next, run_owners
 from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
-from .export.fold_read import read_fold_document
+from .export.fold_read import load_json, read_fold_document
 from .layout.convex import BoxGrid
 from .mesh.measures import dihedral_turns, newell_vectors
 from .surface.patch import PATCH_KINDS, Patch
@@ -1341,12 +1340,7 @@ def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | Non
     has them, else from the tables of its ``report.json`` (written with ``--report-tables``,
     or by filletfold before 0.2); the arc step the report's parameters name, else the
     default."""
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MeshReadError(f"{path}: cannot read: {exc}") from None
-    except json.JSONDecodeError as exc:
-        raise MeshReadError(f"{path}: not a report (invalid JSON: {exc.msg})") from None
+    doc = load_json(path, "a report")  # a named error for any file that is not JSON
     if not isinstance(doc, dict) or "parameters" not in doc:
         raise MeshReadError(f"{path}: not a filletfold report (no key 'parameters')")
     in_fold = fold_doc is not None and MESH_KEY + "vertices_coords" in fold_doc

@@ -271,7 +271,7 @@ def _report_beside(fold_file: Path) -> dict | None:
         return None
     try:
         r = json.loads(p.read_text())
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     return r if isinstance(r, dict) else None
 
