@@ -57,6 +57,7 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # help texts are plain: "filletfold[app]", "[default: ...]" kept
 )
 console = Console()
 err_console = Console(stderr=True)
