@@ -262,7 +262,7 @@ def test_the_default_size_on_the_command_line_and_how_to_go_without(tmp_path):
     assert 'mm" height="' in (out / "pattern.svg").read_text()
     # --size none: unitless; --units alone: the mesh is in those units (1 unit = 1 mm)
     for args, units, scale in ((["--size", "none"], "", None), (["--units", "mm"], "mm", None)):
-        out = tmp_path / units
+        out = tmp_path / (units or "unitless")
         assert main(["round", "cube", "-q", "-f", "json", "-o", str(out), *args]) == 0
         report = json.loads((out / "report.json").read_text())
         p = report["parameters"]

@@ -187,6 +187,18 @@ def _default_out(mesh: str) -> Path:
     return Path("out") / Path(mesh).stem
 
 
+def _out_folder(out: str | None, mesh: str, force: bool) -> Path:
+    """The output folder of ``round``: ``-o`` (an empty path is refused: it would be the
+    working folder) or ``out/<mesh name>``, checked for what writing would refuse."""
+    from .export.folder import check_design_folder
+
+    if out is not None and not out.strip():
+        raise ParameterError("the output folder (-o) is an empty path; name a folder", name="out")
+    target = Path(out) if out is not None else _default_out(mesh)
+    check_design_folder(target, force=force, inputs=(mesh,))
+    return target
+
+
 #: The options of ``filletfold round`` that are design parameters: option -> field of
 #: :class:`~filletfold.parameters.Parameters` (``--no-tabs`` is ``tabs`` negated).
 ROUND_PARAMETERS = {
@@ -263,8 +275,23 @@ def round_cmd(
         ),
     ] = None,
     out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="Output folder [default: out/<mesh name>].")
+        str | None,
+        typer.Option(
+            "-o",
+            "--out",
+            metavar="<path>",
+            help="Output folder [default: out/<mesh name>]. It must be new, empty or hold a "
+            "design only (see --force); it is replaced whole.",
+        ),
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Write into an output folder that holds files filletfold did not write "
+            "(they are kept, the old design's files replaced).",
+        ),
+    ] = False,
     radius: Annotated[
         str,
         typer.Option(
@@ -478,7 +505,10 @@ def round_cmd(
         _check_export_options(params.units, params.scale, params.sheet, preset, view)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
-    target = out if out is not None else _default_out(mesh)
+    try:  # the output folder is checked before the (slow) design
+        target = _out_folder(out, mesh, force)
+    except FilletfoldError as exc:
+        raise _error(str(exc)) from None
     try:
         log = StageLog(err_console) if not quiet and not err_console.is_terminal else None
         with (
@@ -525,6 +555,7 @@ def round_cmd(
             preset=preset,
             view=view,
             tables=report_tables,
+            force=force,
         )
         if log is not None:
             log.finish()

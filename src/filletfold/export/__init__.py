@@ -1,6 +1,8 @@
 """Exporters: one module per format, each a function from a crease pattern to text.
 
-Writing goes through :func:`write_outputs` (all files or none) or :func:`write_file_atomic`.
+Writing goes through :func:`~filletfold.export.folder.write_design_folder` (a design's
+folder, replaced whole), :func:`write_outputs` (files added, all or none) or
+:func:`write_file_atomic`.
 """
 
 from __future__ import annotations

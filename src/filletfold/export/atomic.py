@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator, Mapping
@@ -21,7 +22,12 @@ from pathlib import Path
 
 from ..errors import ExportError
 
-__all__ = ["write_file_atomic", "write_outputs"]
+__all__ = ["STAGING_MARK", "write_file_atomic", "write_outputs"]
+
+#: What a staging folder's name holds after its target's name: ``.NAME.filletfold-PID-...``
+#: (the writing process, so that a later run can tell a killed run's folder from a live one).
+STAGING_MARK = "filletfold"
+_STAGING = re.compile(rf"^\.(?P<name>.*)\.{STAGING_MARK}-(?P<pid>\d+)-(?P<kind>new|old)-")
 
 
 def _encode(name: str, data) -> str | bytes | Iterator[str]:
@@ -137,6 +143,47 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
+def _prefix(folder: Path, kind: str) -> str:
+    return f".{folder.name or 'out'}.{STAGING_MARK}-{os.getpid()}-{kind}-"
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
+
+
+def _clean_stale(folder: Path) -> None:
+    """Remove the staging folders beside ``folder`` of runs whose process is gone; put back
+    an old design a run killed between its two renames left aside (the folder missing)."""
+    parent = folder.parent
+    if not parent.is_dir():
+        return
+    try:
+        entries = list(parent.iterdir())
+    except OSError:
+        return
+    for entry in sorted(entries):
+        m = _STAGING.match(entry.name)
+        if not m or m["name"] != (folder.name or "out") or not entry.is_dir():
+            continue
+        if _alive(int(m["pid"])):
+            continue
+        kept = entry / "design"
+        if m["kind"] == "old" and kept.is_dir() and not folder.exists():
+            try:
+                os.rename(kept, folder)
+            except OSError:
+                continue
+        shutil.rmtree(entry, ignore_errors=True)
+
+
 def _keep_old(target: Path, backup: Path) -> bool:
     """Preserve the current ``target`` (if any) at ``backup``; return whether there was one."""
     if not target.exists():
@@ -183,9 +230,10 @@ def write_outputs(folder, files: Mapping[str, str | bytes]) -> list[Path]:
         if (folder / n).is_dir():
             raise ExportError(f"cannot write {folder / n}: a folder of that name exists")
 
+    _clean_stale(folder)
     created = _make_dirs(folder)
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name or 'out'}.", dir=folder.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=_prefix(folder, "new"), dir=folder.parent))
     except OSError as exc:
         _remove_dirs(created)
         raise ExportError(_os_message(exc, f"temporary folder beside {folder}")) from exc

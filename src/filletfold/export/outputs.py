@@ -17,9 +17,10 @@ from ..surface.pattern import LabelRows, face_arrays
 from ..surface.validate import face_signed_area_2d
 from ..tolerances import tol
 from ..units import MIN_LABEL_MM, MIN_PIECE_MM
-from . import report_json, write_outputs
+from . import report_json
 from .assembly import assembly_pdf
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
+from .folder import write_design_folder
 from .png import parse_view
 from .report import Records
 
@@ -674,6 +675,12 @@ def _fitting_lines(design) -> list[str]:
     return out
 
 
+def _input_files(design) -> tuple:
+    """The file the design was read from, when it was read from one."""
+    source = getattr(design, "source", None)
+    return (source,) if isinstance(source, str) and Path(source).is_file() else ()
+
+
 @named_stages("export")
 def export_design(
     design,
@@ -687,8 +694,10 @@ def export_design(
     preset=None,
     view=None,
     tables: bool = False,
+    force: bool = False,
 ) -> list[Path]:
-    """Write the design's files into ``folder`` atomically (all of them or none).
+    """Write the design's files as the contents of the design folder ``folder``: the old
+    design or the new one, never a mix (:func:`~filletfold.export.folder.write_design_folder`).
 
     Parameters
     ----------
@@ -715,6 +724,10 @@ def export_design(
         The direction ``preview.png`` is seen from (see
         :func:`~filletfold.export.cutfiles.cut_files`), up the design's ``up`` unless it
         names its own.
+    force : bool
+        Write into a folder that holds files this tool did not write (they are kept); by
+        default such a folder is refused. A folder holding the input mesh under a name of the
+        design's files is always refused.
     tables : bool
         Whether ``report.json`` holds the per-element tables ``mesh``, ``edges`` and
         ``vertices`` (:data:`REPORT_TABLES`); by default it is a summary, and ``design.fold``
@@ -769,6 +782,8 @@ def export_design(
             names.append("assembly.pdf")
     if "json" in formats:
         names.append("timings.json")  # last: its export time covers the other files
-    written = write_outputs(folder, {k: files[k] for k in names})
+    written = write_design_folder(
+        folder, {k: files[k] for k in names}, force=force, inputs=_input_files(design)
+    )
     design.timings["export"] = time.perf_counter() - t
     return written
