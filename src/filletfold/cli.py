@@ -42,6 +42,7 @@ from .defaults import (
     DEFAULT_ARC_STEP,
     DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
+    DEFAULT_MAX_CORNERS,
     DEFAULT_RADIUS,
     DEFAULT_SAMPLES,
     DEFAULT_SHARP,
@@ -224,6 +225,7 @@ ROUND_PARAMETERS = {
     "edge_length": "edge_length",
     "size": "size",
     "up": "up",
+    "max_corners": "max_corners",
 }
 
 
@@ -411,6 +413,15 @@ def round_cmd(
             "--coplanar-tol", help="Merge neighbouring faces within this angle (degrees)."
         ),
     ] = tol.coplanar_deg,
+    max_corners: Annotated[
+        int,
+        typer.Option(
+            "--max-corners",
+            metavar="<int>",
+            help="The most corners a face may have; a larger face is refused before anything "
+            "is solved (time grows about with the square of a face's corners).",
+        ),
+    ] = DEFAULT_MAX_CORNERS,
     faces: Annotated[
         int | None,
         typer.Option(

@@ -5,6 +5,13 @@ pipeline)."""
 DEFAULT_RADIUS = "10%"
 DEFAULT_DEPTH = "30%"
 DEFAULT_SAMPLES = 24
+#: The most points per arc a design may ask for: the certificate's memory grows with the square
+#: of the points per arc (a cube with 256 on every arc: 12 s, 1.1 GB; 1000: 62 s, 3.9 GB).
+MAX_SAMPLES = 256
+#: The most corners a face may have (see round_mesh(max_corners=...)): a face's corners cost
+#: time about quadratic in their number (a prism of two 256-gons: 7 s; of two 400-gons: 38 s;
+#: one 10,000-gon filled 24 GB).
+DEFAULT_MAX_CORNERS = 256
 #: Largest turn (degrees) between two samples of an arc (0: no limit): the chord tolerance
 #: decides, this bounds the turn of a chord on a small fillet (see round_mesh(arc_step=...)).
 DEFAULT_ARC_STEP = 10.0

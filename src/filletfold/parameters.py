@@ -20,9 +20,11 @@ from .defaults import (
     DEFAULT_ARC_STEP,
     DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
+    DEFAULT_MAX_CORNERS,
     DEFAULT_RADIUS,
     DEFAULT_SAMPLES,
     DEFAULT_SHARP,
+    MAX_SAMPLES,
 )
 from .errors import ParameterError
 from .tolerances import tol
@@ -62,6 +64,7 @@ _JSON_TYPES = {
     "edge_length": ("number", "string", "null"),
     "size": ("number", "string", "null"),
     "up": ("string",),
+    "max_corners": ("integer",),
 }
 
 
@@ -175,6 +178,11 @@ class Parameters:
         The axis up in the pictures and the app's view (``"x"``, ``"y"``, ``"z"``), or
         ``"auto"``: the one the mesh stands on (:func:`~filletfold.mesh.upright.up_axis`);
         ``design.up`` is the axis used.
+    max_corners : int
+        The most corners a face of the mesh (as cleaned and coarsened) may have; a larger
+        face is refused with its index before anything is solved (a face's corners cost
+        time about quadratic in their number: a prism of two 256-gons takes 7 s, one
+        10,000-gon filled 24 GB). ``faces`` triangulates and coarsens a mesh instead.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -199,6 +207,7 @@ class Parameters:
     edge_length: object = None
     size: object = "auto"
     up: str = "auto"
+    max_corners: int = DEFAULT_MAX_CORNERS
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:
@@ -293,6 +302,17 @@ class Parameters:
         if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 3:
             raise ParameterError(
                 f"samples must be an integer >= 3, got {samples!r}", name="samples"
+            )
+        if samples > MAX_SAMPLES:
+            raise ParameterError(
+                f"samples must be at most {MAX_SAMPLES} points per arc, got {samples} (the "
+                "check's memory grows with their square: 1000 took 3.9 GB on a cube)",
+                name="samples",
+            )
+        corners = self.max_corners
+        if isinstance(corners, bool) or not isinstance(corners, int | np.integer) or corners < 3:
+            raise ParameterError(
+                f"max corners must be an integer >= 3, got {corners!r}", name="max_corners"
             )
         if isinstance(arc_step, bool) or not isinstance(arc_step, int | float | np.number):
             raise ParameterError(

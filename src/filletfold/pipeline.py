@@ -41,7 +41,7 @@ from .layout.fabrication import cut_first, recut_solved
 from .layout.net import cut_edges_for_nets
 from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
-from .mesh.polymesh import PolyMesh, mesh_size
+from .mesh.polymesh import PolyMesh, check_corners, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth, sized
 from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
@@ -260,7 +260,10 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         _, pm, clean_log, shift, coarsening = cleaned  # the same input, cleaned the same way
     else:
         _stage("reading the mesh")
-        pm, clean_log = load_mesh(mesh, coplanar_deg=params.coplanar_deg, strict=params.strict)
+        pm, clean_log = load_mesh(
+            mesh, coplanar_deg=params.coplanar_deg, strict=params.strict,
+            max_corners=params.max_corners,
+        )  # fmt: skip
         coarsening, target = None, coarse_target(pm, params.faces, params.edge_length)
         if target is not None:  # decimated, then cleaned as any input (repairs kept)
             _stage("coarsening the mesh")
@@ -268,6 +271,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
                 pm, target, coplanar_deg=params.coplanar_deg, strict=params.strict
             )
             clean_log.repairs.extend(repairs)
+        check_corners(pm, params.max_corners)  # before anything is solved
         shift = far_offset(pm.vertices)
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)

@@ -49,6 +49,7 @@ def load_mesh(
     coplanar_deg: float = tol.coplanar_deg,
     merge_coplanar: bool = True,
     strict: bool = False,
+    max_corners: int | None = None,
 ) -> tuple[PolyMesh, CleanLog]:
     """Load and clean a mesh from a file, a built-in example, arrays, or a PolyMesh.
 
@@ -63,6 +64,10 @@ def load_mesh(
         * a :class:`PolyMesh`, cleaned again.
     coplanar_deg, merge_coplanar, strict
         Passed to :func:`clean_mesh` (``strict``: refuse defects instead of repairing them).
+    max_corners : int, optional
+        Refuse, before it is cleaned, a face with more distinct corners than this
+        (:func:`~filletfold.mesh.polymesh.check_corners` then bounds the cleaned mesh): the
+        cleaning's work on a face grows faster than its corners (a 10,000-gon: 35 s).
 
     Returns
     -------
@@ -102,6 +107,8 @@ def load_mesh(
             f"cannot load a mesh from a {type(source).__name__}: expected a file path, a "
             f"built-in example name, a (vertices, faces) pair or a PolyMesh"
         )
+    if max_corners is not None:
+        _check_raw_corners(faces, max_corners, path)
     try:
         return clean_mesh(
             vertices, faces, coplanar_deg=coplanar_deg, merge_coplanar=merge_coplanar, strict=strict
@@ -112,3 +119,17 @@ def load_mesh(
         named = type(exc)(f"{path}: {exc}")
         named.vertex, named.edge, named.face = exc.vertex, exc.edge, exc.face
         raise named from None
+
+
+def _check_raw_corners(faces, limit: int, path) -> None:
+    """A :class:`MeshError` naming the first face of ``faces`` (as read) with more distinct
+    corners than ``limit`` (a face that repeats its corners is the cleaning's to repair)."""
+    for f, face in enumerate(faces):
+        if len(face) > limit and len(set(np.asarray(face).tolist())) > limit:
+            where = f"{path}: " if path is not None else ""
+            raise MeshError(
+                f"{where}face {f} has {len(set(np.asarray(face).tolist()))} corners, more than "
+                f"{limit} (--max-corners: each face's corners cost time about quadratic in "
+                "their number); raise it, or --faces N to triangulate and coarsen the mesh",
+                face=f,
+            )

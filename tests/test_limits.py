@@ -1,0 +1,60 @@
+"""Resources bounded before they are spent (issue 30): a face of too many corners, a vertex
+of too many edges and too many samples per arc are refused at once, naming the element and
+the option that raises the limit."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+import filletfold
+from filletfold.defaults import DEFAULT_MAX_CORNERS, MAX_SAMPLES
+from filletfold.errors import MeshError, ParameterError
+from filletfold.mesh import load_mesh
+
+
+def _ngon_cone(n: int):
+    """An n-gon closed by a cone of n triangles (the n-gon's corners and the tip)."""
+    v = [(math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n), 0.0) for i in range(n)]
+    faces = [list(range(n - 1, -1, -1))] + [[i, (i + 1) % n, n] for i in range(n)]
+    return np.array([*v, (0.0, 0.0, 1.0)]), faces
+
+
+def _bipyramid(n: int):
+    """Two cones of n triangles on an n-gon: two vertices of n edges, no face larger than 3."""
+    v = [(math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n), 0.0) for i in range(n)]
+    faces = [[i, (i + 1) % n, n] for i in range(n)] + [[(i + 1) % n, i, n + 1] for i in range(n)]
+    return np.array([*v, (0.0, 0.0, 1.0), (0.0, 0.0, -1.0)]), faces
+
+
+def test_a_face_of_too_many_corners_is_refused_before_it_is_cleaned():
+    mesh = _ngon_cone(10_000)  # cleaned, it took 35 s; its vertex normals asked for 2.2 GB
+    t = time.perf_counter()
+    with pytest.raises(MeshError, match=r"face 0 has 10000 corners, more than 256 \(--max-corners"):
+        filletfold.round_mesh(mesh)
+    assert time.perf_counter() - t < 5.0
+    with pytest.raises(MeshError, match="more than 300"):
+        load_mesh(_ngon_cone(301), max_corners=300)
+    load_mesh(_ngon_cone(300), max_corners=300)  # at the limit: read
+
+
+def test_a_face_that_repeats_its_corners_is_repaired_not_refused():
+    v = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)], dtype=float)
+    faces = [[0, 1, 2] * 2000, [0, 1, 3], [1, 2, 3], [2, 0, 3]]
+    mesh, log = load_mesh((v, faces), max_corners=DEFAULT_MAX_CORNERS)
+    assert mesh.n_faces == 4 and any(r.what == "split-face" for r in log.repairs)
+
+
+def test_a_vertex_of_too_many_edges_is_refused():
+    with pytest.raises(MeshError, match=r"vertex 300 meets 300 edges, more than 256"):
+        filletfold.round_mesh(_bipyramid(300))
+
+
+def test_samples_are_bounded():
+    with pytest.raises(ParameterError, match=f"at most {MAX_SAMPLES} points per arc"):
+        filletfold.round_mesh("cube", samples=MAX_SAMPLES + 1)
+    with pytest.raises(ParameterError, match="max corners must be an integer >= 3"):
+        filletfold.round_mesh("cube", max_corners=2)
