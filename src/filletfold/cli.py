@@ -800,6 +800,14 @@ def app_cmd(
     open_browser: Annotated[
         bool, typer.Option("--open", help="Open the page in the default browser.")
     ] = False,
+    allow_remote: Annotated[
+        bool,
+        typer.Option(
+            "--allow-remote",
+            help="Let --host be an address other machines reach (whoever reaches the app can "
+            "drive it and upload files to it); without it such an address is refused.",
+        ),
+    ] = False,
 ):
     """Start the browser app (needs the 'app' extra: pip install 'filletfold[app]').
 
@@ -810,10 +818,18 @@ def app_cmd(
     if not 0 <= port <= 65535:
         raise _error(f"port must be in 0..65535, got {port}")
     try:
-        server = run_app(mesh, host=host, port=port, open_browser=open_browser)
+        server = run_app(
+            mesh, host=host, port=port, open_browser=open_browser, allow_remote=allow_remote
+        )
     except FilletfoldError as exc:
         raise _error(str(exc)) from None
     console.print(f"filletfold app at {server.url}  (Ctrl-C to stop)", highlight=False)
+    if allow_remote and server.remote:
+        err_console.print(
+            f"warning: the app at {server.url} is open to other machines: whoever reaches "
+            "this address can drive it and upload files to it",
+            highlight=False,
+        )
     server.wait()
 
 

@@ -22,9 +22,10 @@ import time
 import webbrowser
 
 from ..defaults import DEFAULT_ARC_STEP, DEFAULT_SAMPLES
-from ..errors import FilletfoldError
+from ..errors import FilletfoldError, ParameterError
 from ..mesh import example_names
 from ..vertex.batch import warm_kernel
+from .bind import check_bind
 from .session import AppSession, nearest_vertex_to_ray
 from .view import (
     CAMERA_LOOK_AT,
@@ -65,6 +66,8 @@ class AppServer:
     port : int
     url : str
         ``http://HOST:PORT``.
+    remote : bool
+        Whether other machines reach it (``--allow-remote``).
     status : str
         The status line shown in the page (Markdown).
     progress : tuple or None
@@ -81,6 +84,7 @@ class AppServer:
         self.host = host
         self.port = int(server.get_port())
         self.url = f"http://{host}:{self.port}"
+        self.remote = False
         self.status = "starting"
         self._wake = threading.Condition()
         self._dirty = False
@@ -554,6 +558,7 @@ def run_app(
     host: str = "127.0.0.1",
     port: int = 0,
     open_browser: bool = False,
+    allow_remote: bool = False,
 ) -> AppServer:
     """Start the browser app on ``mesh`` and return at once (the server runs in threads).
 
@@ -567,6 +572,10 @@ def run_app(
         Port to bind; 0 picks a free one.
     open_browser : bool
         Open the page in the default browser.
+    allow_remote : bool
+        Let ``host`` be an address other machines reach (see
+        :func:`~filletfold.app.bind.check_bind`, which checks the address and the port
+        before the design is made).
 
     Returns
     -------
@@ -580,6 +589,7 @@ def run_app(
         viser is missing, or the mesh cannot be read or rounded.
     """
     viser = _import_viser()
+    bind = check_bind(host, port, allow_remote=allow_remote)  # before the design: fail at once
     session = AppSession(
         radius=f"{DEFAULT_RADIUS_PERCENT}%",
         depth=f"{DEFAULT_DEPTH_PERCENT}%",
@@ -595,7 +605,14 @@ def run_app(
         # set before any page connects (moving a connected page's camera can blank its canvas)
         server.initial_camera.position = CAMERA_POSITION
         server.initial_camera.look_at = CAMERA_LOOK_AT
+        if port and server.get_port() != port:  # taken since it was checked: no other port
+            raise ParameterError(
+                f"port {port} on {host} is in use by another program; choose another --port, "
+                "or --port 0 for a free one",
+                name="port",
+            )
         app = AppServer(server, session, host)
+        app.remote = bind.remote
         app._draw()
     except BaseException:
         server.stop()

@@ -1,0 +1,122 @@
+"""Where the app may listen: checked before anything is computed (issue 30).
+
+The app drives a design (and reads the files a user uploads) for whoever can reach its port,
+so it listens on this machine only unless told otherwise: :func:`check_bind` refuses an
+address other machines can reach (``0.0.0.0``, a LAN address, a public name) unless
+``allow_remote``, fails at once on an address that does not resolve (within
+:data:`RESOLVE_SECONDS`) and on a port something else listens on (unless the port is 0: a free
+one), instead of hanging or moving silently to another port.
+"""
+
+from __future__ import annotations
+
+import errno
+import ipaddress
+import socket
+import threading
+from dataclasses import dataclass
+
+from ..errors import ParameterError
+
+__all__ = ["RESOLVE_SECONDS", "Bind", "check_bind"]
+
+#: How long an address may take to resolve before the app gives up on it.
+RESOLVE_SECONDS = 3.0
+
+
+@dataclass(frozen=True)
+class Bind:
+    """A checked address: ``host`` as given, its ``addresses``, and whether other machines
+    can reach it (``remote``)."""
+
+    host: str
+    addresses: tuple
+    remote: bool
+
+
+def check_bind(host: str, port: int, *, allow_remote: bool = False) -> Bind:
+    """Check that the app may listen on ``host``:``port``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``host`` or ``port``: an empty host, one that does not resolve in
+        :data:`RESOLVE_SECONDS`, one other machines can reach without ``allow_remote``, a port
+        outside 0..65535 or one in use.
+    """
+    if not isinstance(port, int) or isinstance(port, bool) or not 0 <= port <= 65535:
+        raise ParameterError(f"port must be in 0..65535, got {port!r}", name="port")
+    host = (host or "").strip()
+    if not host:
+        raise ParameterError(
+            "--host is empty; give an address (127.0.0.1: this machine only)", name="host"
+        )
+    addresses = _resolve(host)
+    remote = not all(_local(a) for a in addresses)
+    if remote and not allow_remote:
+        raise ParameterError(
+            f"--host {host} lets other machines reach the app (whoever reaches it can drive "
+            "it and upload files to it); give --allow-remote to serve it so, or bind "
+            "127.0.0.1",
+            name="host",
+        )
+    if port:
+        _check_free(addresses[0], port, host)
+    return Bind(host, addresses, remote)
+
+
+def _resolve(host: str) -> tuple:
+    """The addresses of ``host``, resolved in a thread so that a name server that does not
+    answer costs :data:`RESOLVE_SECONDS`, not minutes."""
+    found: list = []
+
+    def resolve():
+        try:
+            infos = socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)
+            found.append(tuple(dict.fromkeys(info[4][0] for info in infos)))
+        except (OSError, UnicodeError) as exc:
+            found.append(exc)
+
+    worker = threading.Thread(target=resolve, name="filletfold-resolve", daemon=True)
+    worker.start()
+    worker.join(RESOLVE_SECONDS)
+    if not found:
+        raise ParameterError(
+            f"--host {host} did not resolve within {RESOLVE_SECONDS:g} s", name="host"
+        )
+    if isinstance(found[0], Exception) or not found[0]:
+        why = getattr(found[0], "strerror", None) or str(found[0]) or "no address"
+        raise ParameterError(f"--host {host} is not an address of this machine: {why}", name="host")
+    return found[0]
+
+
+def _local(address: str) -> bool:
+    """Whether only this machine reaches ``address`` (a loopback address)."""
+    try:
+        return ipaddress.ip_address(address.split("%")[0]).is_loopback
+    except ValueError:
+        return False
+
+
+def _check_free(address: str, port: int, host: str) -> None:
+    """A :class:`ParameterError` naming ``port`` when something listens there already, or
+    when ``host`` is not an address of this machine."""
+    family = socket.AF_INET6 if ":" in address else socket.AF_INET
+    with socket.socket(family, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as servers bind
+        try:
+            probe.bind((address, port))
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                raise ParameterError(
+                    f"port {port} on {host} is in use by another program; choose another "
+                    "--port, or --port 0 for a free one",
+                    name="port",
+                ) from None
+            if exc.errno == errno.EADDRNOTAVAIL:
+                raise ParameterError(
+                    f"--host {host} is not an address of this machine", name="host"
+                ) from None
+            raise ParameterError(
+                f"cannot listen on {host}:{port}: {exc.strerror or exc}", name="port"
+            ) from None
