@@ -45,3 +45,21 @@ def test_the_command_refuses_before_it_makes_a_design(capsys):
     assert main(["app", "cube", "--host", "0.0.0.0"]) == 2
     assert "--allow-remote" in capsys.readouterr().err
     assert time.perf_counter() - t < 5
+
+
+def test_a_page_of_another_site_cannot_open_a_local_apps_websocket():
+    pytest.importorskip("viser")
+    from websockets.exceptions import InvalidStatus
+    from websockets.sync.client import connect
+
+    from filletfold.app import run_app
+
+    app = run_app("tetrahedron", host="127.0.0.1", port=0)
+    try:
+        url = f"ws://127.0.0.1:{app.port}"
+        with pytest.raises(InvalidStatus, match="403"):
+            connect(url, origin="http://evil.example", open_timeout=10).close()
+        for page in (f"http://127.0.0.1:{app.port}", f"http://localhost:{app.port}", None):
+            connect(url, origin=page, open_timeout=10).close()  # the app's own page
+    finally:
+        app.stop()

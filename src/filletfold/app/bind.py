@@ -11,14 +11,22 @@ one), instead of hanging or moving silently to another port.
 from __future__ import annotations
 
 import errno
+import functools
 import ipaddress
+import re
 import socket
 import threading
 from dataclasses import dataclass
 
 from ..errors import ParameterError
 
-__all__ = ["RESOLVE_SECONDS", "Bind", "check_bind"]
+__all__ = ["LOCAL_ORIGIN", "RESOLVE_SECONDS", "Bind", "check_bind", "check_origins"]
+
+#: The pages that may open the app's websocket when it listens on this machine only: its own
+#: page, as ``localhost``, a ``127.x.y.z`` address or ``[::1]``, on any port. A page of any
+#: other site open in a browser here is refused (a client that sends no ``Origin``, not a
+#: browser, is let in).
+LOCAL_ORIGIN = re.compile(r"https?://(localhost|127(\.\d{1,3}){3}|\[::1\])(:\d+)?")
 
 #: How long an address may take to resolve before the app gives up on it.
 RESOLVE_SECONDS = 3.0
@@ -120,3 +128,26 @@ def _check_free(address: str, port: int, host: str) -> None:
             raise ParameterError(
                 f"cannot listen on {host}:{port}: {exc.strerror or exc}", name="port"
             ) from None
+
+
+def check_origins() -> None:
+    """Make the websocket server viser starts check the page's ``Origin`` when it listens on
+    this machine only (:data:`LOCAL_ORIGIN`): without it, any site open in a browser on this
+    machine could drive a local app. Installed once, for every app of the process: viser
+    passes no ``origins`` of its own, and a remote bind (``--allow-remote``) keeps none."""
+    import websockets.asyncio.server as ws
+
+    if getattr(ws.serve, "_filletfold_origins", False):
+        return
+    serve = ws.serve
+
+    @functools.wraps(serve)
+    def checked(handler, host=None, port=None, *args, **kwargs):
+        if kwargs.get("origins") is None and host is not None:
+            addresses = [host] if _local(str(host)) or host == "localhost" else []
+            if addresses:
+                kwargs["origins"] = [LOCAL_ORIGIN, None]
+        return serve(handler, host, port, *args, **kwargs)
+
+    checked._filletfold_origins = True
+    ws.serve = checked

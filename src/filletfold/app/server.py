@@ -25,7 +25,7 @@ from ..defaults import DEFAULT_ARC_STEP, DEFAULT_SAMPLES
 from ..errors import FilletfoldError, ParameterError
 from ..mesh import example_names
 from ..vertex.batch import warm_kernel
-from .bind import check_bind
+from .bind import check_bind, check_origins
 from .session import AppSession, nearest_vertex_to_ray
 from .view import (
     CAMERA_LOOK_AT,
@@ -590,6 +590,7 @@ def run_app(
     """
     viser = _import_viser()
     bind = check_bind(host, port, allow_remote=allow_remote)  # before the design: fail at once
+    check_origins()  # a page of another site may not drive a local app
     session = AppSession(
         radius=f"{DEFAULT_RADIUS_PERCENT}%",
         depth=f"{DEFAULT_DEPTH_PERCENT}%",
