@@ -63,3 +63,34 @@ def test_a_page_of_another_site_cannot_open_a_local_apps_websocket():
             connect(url, origin=page, open_timeout=10).close()  # the app's own page
     finally:
         app.stop()
+
+
+def test_an_upload_over_the_limit_is_dropped_while_it_streams():
+    """Issue 30: an upload's size was checked once viser had received all of it (a 1 GB file
+    held 2.3 GB). A transfer announced over the limit keeps nothing; one whose parts exceed
+    what it announced is dropped at the first part over; the page says why."""
+    pytest.importorskip("viser")
+    from viser import _messages as m
+
+    from filletfold.app import run_app
+    from filletfold.app.session import UPLOAD_LIMIT_BYTES
+
+    app = run_app("tetrahedron", host="127.0.0.1", port=0)
+    try:
+        api = app.server.gui
+        button = app._upload_button._impl.uuid
+        big = m.FileTransferStartUpload(button, "t1", "huge.obj", "", 20_000, 1 << 30)
+        api._handle_file_transfer_start("c", big)
+        assert "t1" not in api._current_file_upload_states
+        assert "huge.obj" in app.status and "up to 50 MB" in app.status
+        liar = m.FileTransferStartUpload(button, "t2", "small.obj", "", 3, 1000)
+        api._handle_file_transfer_start("c", liar)
+        assert "t2" in api._current_file_upload_states
+        api._handle_file_transfer_part("c", m.FileTransferPart(button, "t2", 0, b"v" * 600))
+        assert "t2" in api._current_file_upload_states
+        api._handle_file_transfer_part("c", m.FileTransferPart(button, "t2", 1, b"v" * 600))
+        assert "t2" not in api._current_file_upload_states  # 1200 bytes of 1000: dropped
+        assert "small.obj" in app.status
+        assert UPLOAD_LIMIT_BYTES == 50 * 1024 * 1024
+    finally:
+        app.stop()

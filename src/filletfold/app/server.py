@@ -26,7 +26,8 @@ from ..errors import FilletfoldError, ParameterError
 from ..mesh import example_names
 from ..vertex.batch import warm_kernel
 from .bind import check_bind, check_origins
-from .session import AppSession, nearest_vertex_to_ray
+from .session import UPLOAD_LIMIT_BYTES, AppSession, nearest_vertex_to_ray
+from .upload import bound_uploads, on_refused
 from .view import (
     CAMERA_LOOK_AT,
     CAMERA_POSITION,
@@ -242,6 +243,14 @@ class AppServer:
         self._progress_bar.value = 0.0
 
     # -- GUI ------------------------------------------------------------------------------
+    def _upload_refused(self, filename: str, size: int) -> None:
+        """An upload dropped while it streamed (:mod:`~filletfold.app.upload`): say why; the
+        current design stays."""
+        self._set_status(
+            f"**error:** {filename}: the file is {size / 1e6:.1f} MB or more; the app accepts "
+            f"files up to {UPLOAD_LIMIT_BYTES // (1024 * 1024)} MB"
+        )
+
     def _set_status(self, text: str) -> None:
         self.status = text
         handle = getattr(self, "_status_md", None)
@@ -290,6 +299,8 @@ class AppServer:
         def _(event) -> None:
             f = event.target.value
             self.request_load(f.name, f.content)
+
+        on_refused(gui, self._upload_refused)
 
         @self._coarsen_button.on_click
         def _(_event) -> None:
@@ -591,6 +602,7 @@ def run_app(
     viser = _import_viser()
     bind = check_bind(host, port, allow_remote=allow_remote)  # before the design: fail at once
     check_origins()  # a page of another site may not drive a local app
+    bound_uploads()  # an upload's size checked while it streams, not once it is held
     session = AppSession(
         radius=f"{DEFAULT_RADIUS_PERCENT}%",
         depth=f"{DEFAULT_DEPTH_PERCENT}%",
