@@ -58,3 +58,25 @@ def test_samples_are_bounded():
         filletfold.round_mesh("cube", samples=MAX_SAMPLES + 1)
     with pytest.raises(ParameterError, match="max corners must be an integer >= 3"):
         filletfold.round_mesh("cube", max_corners=2)
+
+
+def test_a_gltf_of_many_instances_is_refused_before_they_are_expanded(tmp_path, monkeypatch):
+    """Issue 30: a 1.1 MB GLB of instances expanded to 400,000 triangles and 3.3 GB. The
+    triangles every instance places are counted before any is expanded."""
+    trimesh = pytest.importorskip("trimesh")
+    from filletfold.mesh import io
+
+    sphere = trimesh.creation.icosphere(subdivisions=1)  # 80 triangles
+    scene = trimesh.Scene()
+    for i in range(30):
+        place = np.eye(4)
+        place[0, 3] = 3.0 * i
+        scene.add_geometry(sphere, geom_name="ball", node_name=f"ball{i}", transform=place)
+    path = tmp_path / "instances.glb"
+    scene.export(path)
+    monkeypatch.setattr(io, "MAX_READ_TRIANGLES", 2000)
+    with pytest.raises(MeshError, match=r"2,400 triangles, more than the 2,000 filletfold reads"):
+        io.read_mesh(path)
+    monkeypatch.setattr(io, "MAX_READ_TRIANGLES", 2400)
+    _, faces = io.read_mesh(path)  # at the limit: read, every instance placed
+    assert len(faces) == 2400
