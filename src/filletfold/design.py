@@ -145,15 +145,17 @@ class Design:
         return design_summary(self)
 
     def export(self, folder, **options) -> list[Path]:
-        """Write the design's files into ``folder`` atomically (all of them or none):
+        """Write the design's files as the design folder ``folder`` (replaced whole):
         :func:`~filletfold.export.outputs.export_design` of this design.
 
         Parameters
         ----------
         folder : str or Path
         **options
-            ``title``, ``formats``, ``units``, ``scale``, ``page``, ``preset``, ``view``: those of
-            :func:`~filletfold.export.outputs.export_design` (the same defaults).
+            ``title``, ``formats``, ``units``, ``scale``, ``page``, ``preset``, ``view``,
+            ``tables``, ``force``: those of :func:`~filletfold.export.outputs.export_design`
+            (the same defaults: a folder holding files filletfold does not write is refused
+            unless ``force=True``).
 
         Returns
         -------
