@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
 import filletfold
+from filletfold.defaults import MAX_SAMPLES
 from filletfold.errors import ParameterError
 from filletfold.export.outputs import edge_mismatch, relative_mismatch
 from filletfold.parameters import resolve_chord_tol
@@ -79,7 +80,9 @@ def cylinder_chord_errors(design):
 @pytest.mark.parametrize("name", ["icosahedron", "cube", "torus"])
 @pytest.mark.parametrize("chord_tol", ["0.1%", "0.01%"])
 def test_every_folded_chord_of_a_cylinder_is_within_the_tolerance(name, chord_tol):
-    d = filletfold.round_mesh(name, chord_tol=chord_tol, arc_step=0, samples=1000, tabs=False)
+    d = filletfold.round_mesh(
+        name, chord_tol=chord_tol, arc_step=0, samples=MAX_SAMPLES, tabs=False
+    )
     tol = resolve_chord_tol(chord_tol, d.mesh.mean_edge_length)
     err = cylinder_chord_errors(d)
     size = d.certificate.size
@@ -91,9 +94,11 @@ def test_every_folded_chord_of_a_cylinder_is_within_the_tolerance(name, chord_to
 def test_a_smaller_fillet_gets_fewer_points():
     """Two cubes' edges alike but for their radii: the one with half the radius gets about
     1 / sqrt(2) of the steps for the same tolerance (the arc step would give both alike)."""
-    big = filletfold.round_mesh("cube", radius="20%", chord_tol="0.001%", arc_step=0, samples=1000)
+    big = filletfold.round_mesh(
+        "cube", radius="20%", chord_tol="0.001%", arc_step=0, samples=MAX_SAMPLES
+    )
     small = filletfold.round_mesh(
-        "cube", radius="10%", chord_tol="0.001%", arc_step=0, samples=1000
+        "cube", radius="10%", chord_tol="0.001%", arc_step=0, samples=MAX_SAMPLES
     )
     nb, ns = big.stages.samples, small.stages.samples
     assert len(set(nb.tolist())) == 1 and len(set(ns.tolist())) == 1
@@ -121,7 +126,7 @@ def test_mismatch_converges_as_the_chord_tolerance_shrinks():
     rel, ab = [], []
     for tol in ("0.004%", "0.001%", "0.00025%"):
         p = filletfold.round_mesh(
-            "icosahedron", chord_tol=tol, arc_step=0, samples=1000, tabs=False
+            "icosahedron", chord_tol=tol, arc_step=0, samples=MAX_SAMPLES, tabs=False
         ).pattern
         rel.append(relative_mismatch(p).max())
         ab.append(edge_mismatch(p).max())
