@@ -266,15 +266,19 @@ def write_outputs(folder, files: Mapping[str, str | bytes]) -> list[Path]:
                 f"writing into {folder} failed and {len(restore_errors)} file(s) could not be "
                 f"restored: {', '.join(str(p) for p in restore_errors)}"
             ) from exc
-        if isinstance(exc, ExportError):
-            raise
-        if isinstance(exc, OSError):
-            raise ExportError(_os_message(exc, f"into {folder}")) from exc
-        if isinstance(exc, Exception):
-            raise ExportError(f"writing into {folder} failed: {exc!r}") from exc
-        raise
+        _raise_as_export_error(exc, folder)
     shutil.rmtree(tmp, ignore_errors=True)
     return [folder / n for n in names]
+
+
+def _raise_as_export_error(exc: BaseException, folder: Path) -> None:
+    """Raise ``exc`` as the one-line :class:`ExportError` of a failed write into ``folder``
+    (an ExportError, and an interrupt, as they are)."""
+    if isinstance(exc, ExportError) or not isinstance(exc, Exception):
+        raise exc
+    if isinstance(exc, OSError):
+        raise ExportError(_os_message(exc, f"into {folder}")) from exc
+    raise ExportError(f"writing into {folder} failed: {exc!r}") from exc
 
 
 def _roll_back(moved: list[tuple[Path, Path | None]]) -> list[Path]:

@@ -35,6 +35,7 @@ from .atomic import (
     _make_dirs,
     _os_message,
     _prefix,
+    _raise_as_export_error,
     _remove_dirs,
     _write_synced,
     write_outputs,
@@ -185,13 +186,7 @@ def _swap(folder: Path, files, names: list) -> list[Path]:
     except BaseException as exc:
         shutil.rmtree(stage, ignore_errors=True)
         _remove_dirs(created)
-        if isinstance(exc, ExportError):
-            raise
-        if isinstance(exc, OSError):
-            raise ExportError(_os_message(exc, f"into {folder}")) from exc
-        if isinstance(exc, Exception):
-            raise ExportError(f"writing into {folder} failed: {exc!r}") from exc
-        raise
+        _raise_as_export_error(exc, folder)
     return [folder / n for n in names]
 
 
