@@ -142,3 +142,15 @@ def test_files_without_a_design_are_added_to_the_design_there(tmp_path):
     write_design_folder(out, _files("2", ("pattern.png", "preview.png")))
     names = sorted(p.name for p in out.iterdir())
     assert names == ["design.fold", "pattern.png", "pattern.svg", "preview.png", "report.json"]
+
+
+def test_the_design_folder_has_the_permissions_mkdir_gives(tmp_path):
+    """Not the owner-only ones of a temporary folder: the staged folder becomes the output."""
+    out = tmp_path / "out"
+    write_design_folder(out, _files("1"))
+    mask = os.umask(0)
+    os.umask(mask)
+    assert (out.stat().st_mode & 0o777) == 0o777 & ~mask
+    out.chmod(0o750)
+    write_design_folder(out, _files("2"))  # replaced: its permissions kept
+    assert (out.stat().st_mode & 0o777) == 0o750

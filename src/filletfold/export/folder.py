@@ -20,7 +20,9 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import os
+import secrets
 import shutil
+import stat
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -162,7 +164,9 @@ def _swap(folder: Path, files, names: list) -> list[Path]:
     parent = folder.parent
     created = _make_dirs(parent)
     try:
-        stage = Path(tempfile.mkdtemp(prefix=_prefix(folder, "new"), dir=parent))
+        stage = _new_folder(parent, _prefix(folder, "new"))
+        if folder.is_dir():  # the design folder keeps its permissions
+            os.chmod(stage, stat.S_IMODE(folder.stat().st_mode))
     except OSError as exc:
         _remove_dirs(created)
         raise ExportError(_os_message(exc, f"a staging folder beside {folder}")) from exc
@@ -188,6 +192,19 @@ def _swap(folder: Path, files, names: list) -> list[Path]:
         _remove_dirs(created)
         _raise_as_export_error(exc, folder)
     return [folder / n for n in names]
+
+
+def _new_folder(parent: Path, prefix: str) -> Path:
+    """A new folder ``parent/prefix...`` made as ``mkdir`` makes one (the umask's permissions,
+    not ``mkdtemp``'s owner-only ones: it becomes the output folder)."""
+    for _ in range(100):
+        path = parent / f"{prefix}{secrets.token_hex(4)}"
+        try:
+            path.mkdir()
+        except FileExistsError:
+            continue
+        return path
+    raise FileExistsError(f"no free name for a staging folder in {parent}")
 
 
 _RENAME_EXCHANGE = 2
