@@ -105,15 +105,22 @@ while True:
 """
 
 
-@pytest.mark.parametrize("mode", ["exchange", "renames"])
-def test_a_run_killed_at_any_moment_leaves_the_old_design_or_the_new(tmp_path, mode):
+@pytest.mark.parametrize(
+    ("mode", "kills"),
+    [
+        pytest.param("exchange", 2, id="exchange-2"),
+        pytest.param("exchange", 12, id="exchange-12", marks=pytest.mark.slow),
+        pytest.param("renames", 12, id="renames-12", marks=pytest.mark.slow),
+    ],
+)
+def test_a_run_killed_at_any_moment_leaves_the_old_design_or_the_new(tmp_path, mode, kills):
     """A writer killed (SIGKILL) at random moments: the folder is always one whole design
     (every file of one generation), once the next run has put back what the kill left."""
     rng = random.Random(30)
     env = {**os.environ, "PYTHONPATH": str(Path(ff.__file__).parents[2])}
     out = tmp_path / "out"
     seen = set()
-    for _ in range(6):
+    for _ in range(kills):
         child = subprocess.Popen([sys.executable, "-c", _CHILD, str(out), mode], env=env)
         time.sleep(0.6 + rng.random() * 0.6)
         child.send_signal(signal.SIGKILL)
