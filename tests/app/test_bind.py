@@ -3,6 +3,7 @@ or a busy port refused at once, naming them, before any design is made."""
 
 from __future__ import annotations
 
+import os
 import socket
 import time
 
@@ -35,7 +36,8 @@ def test_a_busy_port_is_refused_not_replaced():
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        with pytest.raises(ParameterError, match=f"port {port} on 127.0.0.1 is in use"):
+        busy = f"port {port} on 127.0.0.1 is in use by .+ \\(pid {os.getpid()}\\)"
+        with pytest.raises(ParameterError, match=busy):
             check_bind("127.0.0.1", port)
     check_bind("127.0.0.1", port)  # free again
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import errno
 import functools
 import ipaddress
+import os
 import re
 import socket
 import threading
@@ -116,9 +117,11 @@ def _check_free(address: str, port: int, host: str) -> None:
             probe.bind((address, port))
         except OSError as exc:
             if exc.errno == errno.EADDRINUSE:
+                owner = port_owner(port)
+                by = f"by {owner}" if owner else "by another program"
                 raise ParameterError(
-                    f"port {port} on {host} is in use by another program; choose another "
-                    "--port, or --port 0 for a free one",
+                    f"port {port} on {host} is in use {by}; choose another --port, or --port 0 "
+                    "for a free one",
                     name="port",
                 ) from None
             if exc.errno == errno.EADDRNOTAVAIL:
@@ -151,3 +154,36 @@ def check_origins() -> None:
 
     checked._filletfold_origins = True
     ws.serve = checked
+
+
+def port_owner(port: int) -> str | None:
+    """The program listening on TCP ``port`` (``"python3 (pid 123)"``), where the system says
+    (Linux ``/proc``: the socket's inode in ``/proc/net/tcp*``, then the process holding it;
+    only this user's processes can be looked into); None when it cannot be told."""
+    inodes = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            with open(table) as fh:
+                rows = fh.readlines()[1:]
+        except OSError:
+            continue
+        for row in rows:
+            cols = row.split()
+            if len(cols) > 9 and cols[3] == "0A" and int(cols[1].rsplit(":", 1)[1], 16) == port:
+                inodes.add(f"socket:[{cols[9]}]")  # 0A: listening
+    if not inodes:
+        return None
+    try:
+        pids = [d for d in os.listdir("/proc") if d.isdigit()]
+    except OSError:
+        return None
+    for pid in sorted(pids, key=int):
+        try:
+            fds = os.listdir(f"/proc/{pid}/fd")
+            if not any(os.readlink(f"/proc/{pid}/fd/{fd}") in inodes for fd in fds):
+                continue
+            with open(f"/proc/{pid}/comm") as fh:
+                return f"{fh.read().strip()} (pid {pid})"
+        except OSError:
+            continue
+    return None
