@@ -675,7 +675,8 @@ def export_cmd(
 ):
     """Write cut files and pictures of the design in FOLDER (read from FOLDER/design.fold).
 
-    Formats: dxf (pattern.dxf), pdf (pattern.pdf, tiled at true scale), svg (pattern.svg), png
+    Formats: dxf (pattern.dxf), pdf (pattern.pdf, tiled at true scale, and assembly.pdf, the
+    assembly guide, for a design with glue tabs), svg (pattern.svg), png
     (pattern.png and preview.png), simulator (simulator.fold and simulator.svg, for Origami
     Simulator), obj (folded.obj), 3dm (pattern.3dm, folded.3dm), glb, ply, stl (folded.glb,
     .ply, .stl); all of them with --format all. The files are written into
@@ -721,6 +722,11 @@ def export_cmd(
             preset=preset,
             view=parse_view("front" if view is None else view, up),
         )
+        seams = pattern.annotations.seams  # from annotations.json: the assembly guide too
+        if "pdf" in chosen and seams is not None and len(seams):
+            from .export.assembly import assembly_pdf
+
+            files["assembly.pdf"] = assembly_pdf(pattern, seams, up=up, page=sheet or "A4")
         written = write_outputs(folder, files)
     except FilletfoldError as exc:
         raise _error(str(exc)) from None

@@ -73,6 +73,22 @@ def test_the_guide_is_written_with_the_pdf_and_not_without_tabs(tmp_path):
     assert written == ["pattern.pdf"]  # no numbered borders: nothing to guide
 
 
+def test_export_writes_the_guide_from_the_files(tmp_path):
+    """``filletfold export DIR --format pdf`` makes assembly.pdf from the design's files: the
+    seams are in annotations.json (they were only in memory), read back equal."""
+    from filletfold.cli import main
+    from filletfold.export.fold_read import read_fold
+
+    design = filletfold.round_mesh("cube", layout="modules")
+    folder = tmp_path / "cube"
+    design.export(folder)
+    read = read_fold(folder / "design.fold").annotations.seams
+    assert read == list(design.fabrication["seams"])
+    assert main(["export", str(folder), "--format", "pdf"]) == 0
+    guide = (folder / "assembly.pdf").read_bytes()
+    assert _pages(guide) == 1 + -(-design.pattern.n_pieces // STEPS_PER_PAGE)
+
+
 @pytest.mark.parametrize("up", ["y", "z"])
 def test_labels_of_the_overview_sit_on_their_pieces(up):
     from filletfold.export.assembly import _View
@@ -88,3 +104,18 @@ def test_labels_of_the_overview_sit_on_their_pieces(up):
     xy, seen = view.label_points(area)
     assert seen.sum() >= 3  # a cube seen from a corner shows at least three of its corners
     assert np.all((xy[seen] >= 0) & (xy[seen] <= [view.w, view.h]))
+
+
+def test_seams_that_name_no_piece_are_a_named_error(tmp_path):
+    import json
+
+    from filletfold.errors import MeshReadError
+    from filletfold.export.fold_read import read_fold
+
+    folder = tmp_path / "cube"
+    filletfold.round_mesh("cube").export(folder)
+    doc = json.loads((folder / "annotations.json").read_text())
+    doc["seams"]["joins"][0] = [0, len(doc["seams"]["pieces"])]
+    (folder / "annotations.json").write_text(json.dumps(doc))
+    with pytest.raises(MeshReadError, match=r"annotations\.json is malformed.*not named"):
+        read_fold(folder / "design.fold")

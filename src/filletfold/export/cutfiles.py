@@ -241,6 +241,7 @@ def scaled_pattern(pattern: CreasePattern, scale: float) -> CreasePattern:
                 labels.kind,
             ),
             sheets=np.asarray(ann.sheets, dtype=np.float64) * scale,
+            seams=ann.seams,
         ),
     )
 

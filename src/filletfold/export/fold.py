@@ -426,7 +426,9 @@ def annotations_json(pattern: CreasePattern) -> str:
         A JSON object: ``"file_creator"``, ``"design"`` (:func:`design_counts`, which
         :func:`~filletfold.export.fold_read.read_fold` compares with ``design.fold``), then
         ``"tabs"``, ``"tab_hinges"``, ``"labels"`` and ``"sheets"`` (empty lists when there
-        are none).
+        are none), and with glue tabs ``"seams"``: ``"pieces"`` (the pieces' names),
+        ``"joins"`` (per label, the two pieces it joins, by index) and ``"tab_on"`` (per
+        label, 0 or 1: the one that carries its tab; -1: no tab).
 
     Raises
     ------
@@ -438,6 +440,13 @@ def annotations_json(pattern: CreasePattern) -> str:
         "design": design_counts(pattern),
         **_annotations_data(pattern.annotations),
     }
+    seams = pattern.annotations.seams
+    if seams is not None and len(seams):  # what the assembly guide needs, from the files
+        doc["seams"] = {
+            "pieces": seams.names,
+            "joins": seams.pieces.tolist(),
+            "tab_on": seams.tab_on.tolist(),
+        }
     return fold_json(doc, root="annotations")
 
 

@@ -221,9 +221,29 @@ def _annotations(data, where: str = NAMESPACE + "annotations") -> Annotations:
         hinges = _hinges(data.get("tab_hinges", []), tabs)
         labels = _labels(data.get("labels", []))
         sheets = np.asarray(data.get("sheets", []), dtype=np.float64).reshape(-1, 4)
+        seams = _seams(data.get("seams"))
     except (TypeError, ValueError, KeyError, AttributeError) as exc:
         raise MeshReadError(f"{where} is malformed ({exc!r})") from None
-    return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets)
+    return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets, seams=seams)
+
+
+def _seams(data):
+    """The :class:`~filletfold.layout.tabs.Seams` of an annotations file's ``"seams"`` (None
+    when it has none)."""
+    if data is None:
+        return None
+    from ..layout.tabs import Seams
+
+    names = [str(n) for n in data["pieces"]]
+    joins = np.asarray(data["joins"], dtype=np.int64).reshape(-1, 2)
+    tab_on = np.asarray(data["tab_on"], dtype=np.int64).reshape(-1)
+    if len(tab_on) != len(joins):
+        raise ValueError(f"{len(joins)} seams but {len(tab_on)} tab sides")
+    if len(joins) and (joins.min() < 0 or joins.max() >= len(names)):
+        raise ValueError("a seam joins a piece that is not named")
+    if len(tab_on) and (tab_on.min() < -1 or tab_on.max() > 1):
+        raise ValueError("a seam's tab side is not -1, 0 or 1")
+    return Seams(names, joins, tab_on)
 
 
 def _hinges(items, tabs: list) -> list[np.ndarray]:

@@ -779,6 +779,7 @@ def _tabs_and_labels(p, tab_height, part_names):
         ann.labels = LabelRows(pos.reshape(-1, 2), text, angle.ravel(), label_h, "tab")
     ann.labels = LabelRows.of(ann.labels) + _part_labels(p, faces, names, label_h)
     ann.labels = label_digits(ann.labels, p.vertices_2d)
+    ann.seams = seams
     p.annotations = ann
     stats["seams"] = seams
     return stats

@@ -321,12 +321,16 @@ class Annotations:
     sheets : (n_sheets, 4) float
         ``(xmin, ymin, xmax, ymax)`` of each sheet of material, in pattern coordinates (empty
         when the pieces were not placed on sheets).
+    seams : Seams or None
+        The numbered cut borders the labels name: the two pieces each joins and which one
+        carries its tab (:class:`~filletfold.layout.tabs.Seams`; None without glue tabs).
     """
 
     tabs: list = field(default_factory=list)
     tab_hinges: list = field(default_factory=list)
     labels: list = field(default_factory=list)
     sheets: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    seams: object = None
 
 
 @dataclass
