@@ -80,3 +80,13 @@ def test_a_gltf_of_many_instances_is_refused_before_they_are_expanded(tmp_path, 
     monkeypatch.setattr(io, "MAX_READ_TRIANGLES", 2400)
     _, faces = io.read_mesh(path)  # at the limit: read, every instance placed
     assert len(faces) == 2400
+
+
+def test_an_apex_deeper_than_ten_thousand_edges_is_refused():
+    """Issue 30: a depth of 1e308 raised ZeroDivisionError, then overflowed the solver into a
+    design of sharp vertices only."""
+    with pytest.raises(ParameterError, match=r"depth 1e\+308 is more than 10000 times"):
+        filletfold.round_mesh("cube", depth=1e308)
+    with pytest.raises(ParameterError, match="at vertex 3"):
+        filletfold.round_mesh("cube", depth={"default": "30%", 3: 2e4})
+    assert filletfold.round_mesh("cube", depth=50.0, certify=False).pattern.n_pieces > 0

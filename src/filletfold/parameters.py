@@ -582,9 +582,33 @@ def resolve_depth(depth, reference: float, n: int):
                     f"depth given for vertex {k}, which does not exist", name="depth"
                 )
             out[int(k)] = float(parse_length(val, reference, "depth"))
-        return out
+        return _bounded_depth(out, reference)
     d = parse_length(depth, reference, "depth", count=n)
-    return np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy()
+    return _bounded_depth(np.broadcast_to(np.asarray(d, dtype=float), (n,)).copy(), reference)
+
+
+#: The deepest apex, in mean edge lengths: farther, a cone is a cylinder to round-off and its
+#: solve overflows (a depth of 1e308 once raised ZeroDivisionError, then left every vertex
+#: sharp).
+MAX_DEPTH_EDGES = 1e4
+
+
+def _bounded_depth(out, reference: float):
+    """``out`` (the depths), or a :class:`ParameterError` naming the first deeper than
+    :data:`MAX_DEPTH_EDGES` mean edge lengths ``reference``."""
+    import numpy as np
+
+    if reference > 0 and len(out):
+        far = np.flatnonzero(np.abs(out) > MAX_DEPTH_EDGES * reference)
+        if len(far):
+            at = "" if np.all(out == out[0]) else f" at vertex {int(far[0])}"
+            raise ParameterError(
+                f"depth {out[far[0]]:.4g}{at} is more than {MAX_DEPTH_EDGES:g} times the mean "
+                f"edge length ({reference:.4g}): an apex that far makes the cone a cylinder "
+                "to round-off",
+                name="depth",
+            )
+    return out
 
 
 def sized(params: Parameters, extent: float, ref: float = 0.0) -> Parameters:
