@@ -251,6 +251,7 @@ def test_no_tabs(tmp_path):
     assert fab["tabs"] == 0 and fab["cut_borders"] == 0
 
 
+@pytest.mark.slow  # pictures drawn: the fast tier under 3 minutes
 def test_view_turns_the_preview_only(tmp_path):
     """--view back draws preview.png from the other side; the other files keep their bytes."""
     for view in ("front", "back"):

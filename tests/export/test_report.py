@@ -202,6 +202,7 @@ def _annotated(tabs, hinges, labels, sheets) -> CreasePattern:
     return p
 
 
+@pytest.mark.slow  # every example: the fast tier under 3 minutes
 def test_fold_annotations_in_bulk_are_the_plain_documents_text():
     from filletfold.surface.pattern import Label
 

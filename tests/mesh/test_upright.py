@@ -65,6 +65,7 @@ def test_a_mesh_that_stands_on_no_side_takes_its_formats_convention():
     assert FOOT < 0.1
 
 
+@pytest.mark.slow  # pictures drawn: the fast tier under 3 minutes
 def test_a_design_knows_its_up_says_so_and_draws_it(tmp_path):
     from filletfold.app.view import scene_arrays
     from filletfold.cli import main
