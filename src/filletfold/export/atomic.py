@@ -129,6 +129,16 @@ def _write_synced(path: Path, data: str | bytes | Iterator[str]) -> None:
         os.fsync(fh.fileno())
 
 
+def _write_staged(folder: Path, files: Mapping, names: list) -> None:
+    """Write the files ``names`` of ``files`` (contents, or functions giving them) into the
+    staging folder ``folder``, each fsynced, one file's contents in memory at a time."""
+    for n in names:
+        data = files[n]
+        data = _encode(n, data() if callable(data) else data)
+        _write_synced(folder / n, data)
+        del data
+
+
 def _fsync_dir(folder: Path) -> None:
     """Flush a directory entry change to disk where the platform allows it."""
     try:
@@ -243,14 +253,8 @@ def write_outputs(folder, files: Mapping[str, str | bytes]) -> list[Path]:
     try:
         new_dir.mkdir()
         old_dir.mkdir()
-        staged = []
+        _write_staged(new_dir, files, names)
         for n in names:
-            data = files[n]
-            data = _encode(n, data() if callable(data) else data)
-            _write_synced(new_dir / n, data)
-            del data
-            staged.append(n)
-        for n in staged:
             target = folder / n
             backup = old_dir / n
             had_old = _keep_old(target, backup)

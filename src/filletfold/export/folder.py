@@ -32,14 +32,13 @@ from .atomic import (
     STAGING_MARK,
     _check_name,
     _clean_stale,
-    _encode,
     _fsync_dir,
     _make_dirs,
     _os_message,
     _prefix,
     _raise_as_export_error,
     _remove_dirs,
-    _write_synced,
+    _write_staged,
     write_outputs,
 )
 from .cutfiles import FORMAT_FILES
@@ -171,11 +170,7 @@ def _swap(folder: Path, files, names: list) -> list[Path]:
         _remove_dirs(created)
         raise ExportError(_os_message(exc, f"a staging folder beside {folder}")) from exc
     try:
-        for n in names:
-            data = files[n]
-            data = _encode(n, data() if callable(data) else data)
-            _write_synced(stage / n, data)
-            del data
+        _write_staged(stage, files, names)
         _fsync_dir(stage)
         if not folder.exists():
             os.rename(stage, folder)
