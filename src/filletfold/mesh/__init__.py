@@ -22,7 +22,7 @@ from .clean import CleanLog, clean_mesh
 from .examples import EXAMPLES, Example, example_mesh, example_names, find_example
 from .examples import unknown_example_message as _unknown_example_message
 from .io import SUPPORTED_EXTENSIONS, read_mesh, write_obj, write_off
-from .polymesh import PolyMesh, VertexRing
+from .polymesh import PolyMesh, VertexRing, too_many_corners
 from .repair import Repair
 
 __all__ = [
@@ -125,11 +125,9 @@ def _check_raw_corners(faces, limit: int, path) -> None:
     """A :class:`MeshError` naming the first face of ``faces`` (as read) with more distinct
     corners than ``limit`` (a face that repeats its corners is the cleaning's to repair)."""
     for f, face in enumerate(faces):
-        if len(face) > limit and len(set(np.asarray(face).tolist())) > limit:
+        if len(face) <= limit:
+            continue
+        distinct = len(set(np.asarray(face).tolist()))
+        if distinct > limit:
             where = f"{path}: " if path is not None else ""
-            raise MeshError(
-                f"{where}face {f} has {len(set(np.asarray(face).tolist()))} corners, more than "
-                f"{limit} (--max-corners: each face's corners cost time about quadratic in "
-                "their number); raise it, or --faces N to triangulate and coarsen the mesh",
-                face=f,
-            )
+            raise too_many_corners(f"{where}face {f} has {distinct} corners", limit, face=f)
