@@ -821,9 +821,7 @@ def app_cmd(
     """
     from .app.server import run_app
 
-    if not 0 <= port <= 65535:
-        raise _error(f"port must be in 0..65535, got {port}")
-    try:
+    try:  # the port, as the host, checked by run_app (app/bind.py)
         server = run_app(
             mesh, host=host, port=port, open_browser=open_browser, allow_remote=allow_remote
         )

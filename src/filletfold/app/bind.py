@@ -61,7 +61,7 @@ def check_bind(host: str, port: int, *, allow_remote: bool = False) -> Bind:
             "--host is empty; give an address (127.0.0.1: this machine only)", name="host"
         )
     addresses = _resolve(host)
-    remote = not all(_local(a) for a in addresses)
+    remote = _remote(addresses)
     if remote and not allow_remote:
         raise ParameterError(
             f"--host {host} lets other machines reach the app (whoever reaches it can drive "
@@ -97,6 +97,11 @@ def _resolve(host: str) -> tuple:
         why = getattr(found[0], "strerror", None) or str(found[0]) or "no address"
         raise ParameterError(f"--host {host} is not an address of this machine: {why}", name="host")
     return found[0]
+
+
+def _remote(addresses) -> bool:
+    """Whether other machines reach any of ``addresses`` (a host's, resolved)."""
+    return not all(_local(a) for a in addresses)
 
 
 def _local(address: str) -> bool:
@@ -147,8 +152,11 @@ def check_origins() -> None:
     @functools.wraps(serve)
     def checked(handler, host=None, port=None, *args, **kwargs):
         if kwargs.get("origins") is None and host is not None:
-            addresses = [host] if _local(str(host)) or host == "localhost" else []
-            if addresses:
+            try:  # local as check_bind decides it; an address that fails it: checked too
+                local = not _remote(_resolve(str(host)))
+            except ParameterError:
+                local = True
+            if local:
                 kwargs["origins"] = [LOCAL_ORIGIN, None]
         return serve(handler, host, port, *args, **kwargs)
 
