@@ -27,32 +27,26 @@ def on_refused(gui_api, listener) -> None:
     _LISTENERS[gui_api] = listener
 
 
-def _refuse(api, transfer_uuid: str, filename: str, size: int) -> None:
-    api._current_file_upload_states.pop(transfer_uuid, None)  # its parts freed
+def _tell(api, filename: str, size: int) -> None:
     listener = _LISTENERS.get(api)
     if listener is not None:
         listener(filename, size)
 
 
-def bound_uploads(limit: int = UPLOAD_LIMIT_BYTES) -> None:
-    """Bound every viser server's uploads to ``limit`` bytes, while they stream (installed
-    once per process, on viser's ``GuiApi``: its handlers are looked up when a server is
-    made)."""
+def bound_uploads() -> None:
+    """Bound every viser server's uploads to :data:`UPLOAD_LIMIT_BYTES`, while they stream
+    (installed once per process, on viser's ``GuiApi``: its handlers are looked up when a
+    server is made)."""
     from viser._gui_api import GuiApi
 
-    if getattr(GuiApi._handle_file_transfer_start, "_filletfold_limit", None) == limit:
+    start, part = GuiApi._handle_file_transfer_start, GuiApi._handle_file_transfer_part
+    if getattr(start, "_filletfold", False):
         return
-    start = getattr(GuiApi._handle_file_transfer_start, "_filletfold_original", None)
-    part = getattr(GuiApi._handle_file_transfer_part, "_filletfold_original", None)
-    start = start or GuiApi._handle_file_transfer_start
-    part = part or GuiApi._handle_file_transfer_part
 
     @functools.wraps(start)
     def checked_start(self, client_id, message):
-        if message.size_bytes > limit:  # announced too large: nothing of it is kept
-            listener = _LISTENERS.get(self)
-            if listener is not None:
-                listener(message.filename, int(message.size_bytes))
+        if message.size_bytes > UPLOAD_LIMIT_BYTES:  # announced too large: nothing is kept
+            _tell(self, message.filename, int(message.size_bytes))
             return None
         return start(self, client_id, message)
 
@@ -61,13 +55,12 @@ def bound_uploads(limit: int = UPLOAD_LIMIT_BYTES) -> None:
         state = self._current_file_upload_states.get(message.transfer_uuid)
         if state is not None:
             after = state["transferred_bytes"] + len(message.content)
-            if after > min(limit, state["total_bytes"]):  # more than it announced, or allowed
-                _refuse(self, message.transfer_uuid, state["filename"], after)
+            if after > min(UPLOAD_LIMIT_BYTES, state["total_bytes"]):  # more than announced
+                self._current_file_upload_states.pop(message.transfer_uuid, None)  # parts freed
+                _tell(self, state["filename"], after)
                 return None
         return part(self, client_id, message)
 
-    for wrapped, original in ((checked_start, start), (checked_part, part)):
-        wrapped._filletfold_limit = limit
-        wrapped._filletfold_original = original
+    checked_start._filletfold = checked_part._filletfold = True
     GuiApi._handle_file_transfer_start = checked_start
     GuiApi._handle_file_transfer_part = checked_part
