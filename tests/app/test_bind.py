@@ -77,22 +77,30 @@ def test_an_upload_over_the_limit_is_dropped_while_it_streams():
     from filletfold.app import run_app
     from filletfold.app.session import UPLOAD_LIMIT_BYTES
 
+    from .page import Page
+
     app = run_app("tetrahedron", host="127.0.0.1", port=0)
+    page = Page(app.url)
     try:
-        api = app.server.gui
-        button = app._upload_button._impl.uuid
-        big = m.FileTransferStartUpload(button, "t1", "huge.obj", "", 20_000, 1 << 30)
-        api._handle_file_transfer_start("c", big)
-        assert "t1" not in api._current_file_upload_states
-        assert "huge.obj" in app.status and "up to 50 MB" in app.status
-        liar = m.FileTransferStartUpload(button, "t2", "small.obj", "", 3, 1000)
-        api._handle_file_transfer_start("c", liar)
-        assert "t2" in api._current_file_upload_states
-        api._handle_file_transfer_part("c", m.FileTransferPart(button, "t2", 0, b"v" * 600))
-        assert "t2" in api._current_file_upload_states
-        api._handle_file_transfer_part("c", m.FileTransferPart(button, "t2", 1, b"v" * 600))
-        assert "t2" not in api._current_file_upload_states  # 1200 bytes of 1000: dropped
-        assert "small.obj" in app.status
+        view = app.wait_view()
+        api = view.client.gui  # the page's own panel
+        button = view._upload_button._impl.uuid
+
+        def held():  # the transfers the page's panel keeps, once the server has read them
+            time.sleep(0.3)
+            return api._current_file_upload_states
+
+        page.send(m.FileTransferStartUpload(button, "t1", "huge.obj", "", 20_000, 1 << 30))
+        assert "t1" not in held()
+        assert "huge.obj" in view.status and "up to 50 MB" in view.status
+        page.send(m.FileTransferStartUpload(button, "t2", "small.obj", "", 3, 1000))
+        assert "t2" in held()
+        page.send(m.FileTransferPart(button, "t2", 0, b"v" * 600))
+        assert "t2" in held()
+        page.send(m.FileTransferPart(button, "t2", 1, b"v" * 600))
+        assert "t2" not in held()  # 1200 bytes of 1000: dropped
+        assert "small.obj" in view.status
         assert UPLOAD_LIMIT_BYTES == 50 * 1024 * 1024
     finally:
+        page.close()
         app.stop()

@@ -246,13 +246,12 @@ def browser(tmp_path):
 
 @pytest.fixture
 def app():
-    """The app on a free port, its first design drawn."""
+    """The app on a free port, its first design made (a page draws it when it connects)."""
     pytest.importorskip("viser")
     from filletfold.app import run_app
 
     app = run_app("icosahedron", host="127.0.0.1", port=_free_port())
     try:
-        assert app.wait_drawn(1, timeout=60), "the app did not draw its first design"
         yield app
     finally:
         app.stop()
@@ -262,6 +261,7 @@ def app():
 def test_page_draws_slider_changes_design_and_bad_upload_shows_error(app, browser, tmp_path):
     ARTIFACTS.mkdir(exist_ok=True)
     browser.get(app.url + "/")
+    view = app.wait_view(timeout=60)  # the page's own view: its session, panel and scene
 
     # 1. the canvas draws the design: many colours, not blank, the cones' orange present
     shot = ARTIFACTS / "app-icosahedron.png"
@@ -278,15 +278,15 @@ def test_page_draws_slider_changes_design_and_bad_upload_shows_error(app, browse
     assert "icosahedron" in browser.text()
 
     # 2. move the radius slider in the page (keyboard on its thumb): 10 % -> 15 %
-    before = app.session.design_id
+    before = view.session.design_id
     thumb = browser.find_by_label("Radius (% edge)", '[role="slider"]')
     browser.send_keys(thumb, ARROW_RIGHT * 10)  # step 0.5
-    _wait(lambda: app.session.params.radius == "15.0%", 20, "the slider's value at the server")
+    _wait(lambda: view.session.params.radius == "15.0%", 20, "the slider's value at the server")
     _wait(
         lambda: (
-            app.session.design_id > before
-            and app.drawn_id == app.session.latest_id
-            and app.session.design.params.radius == "15.0%"
+            view.session.design_id > before
+            and view.drawn_id == view.session.latest_id
+            and view.session.design.params.radius == "15.0%"
         ),
         60,
         "the design of radius 15 % drawn",
@@ -306,7 +306,7 @@ def test_page_draws_slider_changes_design_and_bad_upload_shows_error(app, browse
     )
 
     # 3. upload a bad file through the page's upload control: the reader's error appears
-    design = app.session.design
+    design = view.session.design
     bad = tmp_path / "bad.obj"
     bad.write_bytes(BAD_OBJ)
     upload = browser.find_by_label("Upload mesh (OBJ/OFF/PLY/STL, ≤ 50 MB)", 'input[type="file"]')
@@ -318,5 +318,5 @@ def test_page_draws_slider_changes_design_and_bad_upload_shows_error(app, browse
 
     text = _wait(error_shown, 30, "the reader's error in the page")
     assert "error: bad.obj: line 1: vertex needs 3 coordinates" in text
-    assert app.session.design is design  # the design stays
+    assert view.session.design is design  # the design stays
     browser.screenshot(ARTIFACTS / "app-bad-upload.png")

@@ -392,44 +392,51 @@ def test_server_answers_and_stops():
     pytest.importorskip("viser")
     from filletfold.app import run_app
 
+    from .page import Page
+
     port = _free_port()
     app = run_app("cube", host="127.0.0.1", port=port)
+    page = None
     try:
         assert app.url == f"http://127.0.0.1:{port}"
 
-        def page():
+        def index():
             try:
                 with urllib.request.urlopen(app.url + "/", timeout=2) as r:
                     return r.status, r.headers.get("content-type", ""), r.read()
             except OSError:
                 return None
 
-        assert _wait_for(lambda: page() is not None)
-        status, ctype, body = page()
+        assert _wait_for(lambda: index() is not None)
+        status, ctype, body = index()
         assert status == 200 and "text/html" in ctype and b"<html" in body.lower()
 
+        page = Page(app.url)  # a page of the app, without a browser
+        view = app.wait_view()
         # a slider change recomputes in the worker; the status says when it is done
-        first = app.session.design_id
-        app.session.set_params(radius="5%")
-        app.request_update()
-        assert _wait_for(lambda: app.session.design_id > first and "computing" not in app.status)
-        assert app.status.startswith("**cube**")
+        first = view.session.design_id
+        view.session.set_params(radius="5%")
+        view.request_update()
+        assert _wait_for(lambda: view.session.design_id > first and "computing" not in view.status)
+        assert view.status.startswith("**cube**")
 
         # a bad upload shows the reader's error and keeps the design
-        design = app.session.design
-        app.request_load("bad.obj", b"v 1 2\nf 1 2 3\n")
-        assert _wait_for(lambda: "error" in app.status)
-        assert "bad.obj: line 1" in app.status and app.session.design is design
+        design = view.session.design
+        view.request_load("bad.obj", b"v 1 2\nf 1 2 3\n")
+        assert _wait_for(lambda: "error" in view.status)
+        assert "bad.obj: line 1" in view.status and view.session.design is design
 
         # coarsening in the worker: the status says what it did
-        app.request_load("blob")
-        assert _wait_for(lambda: app.status.startswith("**blob**"))
-        app.request_coarsen(120)
-        assert _wait_for(lambda: "coarsened: 320 -> " in app.status)
-        assert app.session.mesh.n_faces <= 120
-        app.request_coarsen(None)
-        assert _wait_for(lambda: "coarsened" not in app.status and "blob**" in app.status)
+        view.request_load("blob")
+        assert _wait_for(lambda: view.status.startswith("**blob**"))
+        view.request_coarsen(120)
+        assert _wait_for(lambda: "coarsened: 320 -> " in view.status)
+        assert view.session.mesh.n_faces <= 120
+        view.request_coarsen(None)
+        assert _wait_for(lambda: "coarsened" not in view.status and "blob**" in view.status)
     finally:
+        if page is not None:
+            page.close()
         app.stop()
     with pytest.raises(OSError):
         urllib.request.urlopen(app.url + "/", timeout=2)
@@ -440,6 +447,8 @@ def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(mo
     answers and takes GUI changes, and a newer change stops the older computation."""
     pytest.importorskip("viser")
     from filletfold.app import run_app
+
+    from .page import Page
 
     real = session_mod.round_mesh
     armed, reached, release = threading.Event(), threading.Event(), threading.Event()
@@ -460,36 +469,41 @@ def test_server_shows_progress_stays_responsive_and_a_newer_change_supersedes(mo
 
     monkeypatch.setattr(session_mod, "round_mesh", gated_round_mesh)
     app = run_app("cube", host="127.0.0.1", port=_free_port())
+    page = None
     try:
-        assert app.wait_drawn(1)
-        assert app.progress is None and not app._progress_bar.visible
+        page = Page(app.url)  # a page of the app, without a browser
+        view = app.wait_view()
+        assert view.wait_drawn(1)
+        assert view.progress is None and not view._progress_bar.visible
         armed.set()
-        app._radius.value = 15.0  # what the slider's on_update does, from the server side
+        view._radius.value = 15.0  # what the slider's on_update does, from the server side
         assert reached.wait(30), "the worker did not start computing"
         # mid-computation: the stage and the bar are shown
         ((stage, done, total),) = first_call
-        assert app.progress == (stage, done, total) and total == 8
-        assert app.status == f"computing… {stage} {done}/{total}"
-        assert app._progress_bar.visible
-        assert app._progress_bar.value == pytest.approx(100 * done / total)
+        assert view.progress == (stage, done, total) and total == 8
+        assert view.status == f"computing… {stage} {done}/{total}"
+        assert view._progress_bar.visible
+        assert view._progress_bar.value == pytest.approx(100 * done / total)
         # ...and the page is not frozen: the server answers and takes a newer change at once
         with urllib.request.urlopen(app.url + "/", timeout=5) as r:
             assert r.status == 200
         # setting the slider returns while the worker is still held (not released below)
-        setter = threading.Thread(target=setattr, args=(app._radius, "value", 20.0))
+        setter = threading.Thread(target=setattr, args=(view._radius, "value", 20.0))
         setter.start()
         setter.join(30)
         assert not setter.is_alive(), "the slider waited for the computation in progress"
-        assert app.session.params.radius == "20.0%"
+        assert view.session.params.radius == "20.0%"
         release.set()
-        assert _wait_for(lambda: app.session.design.params.radius == "20.0%", 30)
-        assert app.wait_drawn(app.session.design_id)
+        assert _wait_for(lambda: view.session.design.params.radius == "20.0%", 30)
+        assert view.wait_drawn(view.session.design_id)
         assert "15.0%" not in finished  # the superseded computation was stopped
-        assert _wait_for(lambda: app.progress is None and not app._progress_bar.visible)
-        assert app.status.startswith("**cube**")
-        assert set(app.timings) == {"compute", "draw"}
+        assert _wait_for(lambda: view.progress is None and not view._progress_bar.visible)
+        assert view.status.startswith("**cube**")
+        assert set(view.timings) == {"compute", "draw"}
     finally:
         release.set()
+        if page is not None:
+            page.close()
         app.stop()
 
 
@@ -500,39 +514,46 @@ def test_a_redraw_updates_the_scene_nodes_it_made_first():
     pytest.importorskip("viser")
     from filletfold.app import run_app
 
+    from .page import Page
+
     app = run_app("cube", host="127.0.0.1", port=_free_port())
+    page = None
     try:
-        assert app.wait_drawn(1)
-        nodes = dict(app._nodes)
-        app._radius.value = 15.0
-        assert app.wait_idle(60) and app.session.design.params.radius == "15.0%"
-        assert app._nodes == nodes and all(app._nodes[k] is v for k, v in nodes.items())
-        arrays = scene_arrays(app.session.design)
+        page = Page(app.url)  # a page of the app, without a browser
+        view = app.wait_view()
+        assert view.wait_drawn(1)
+        nodes = dict(view._nodes)
+        view._radius.value = 15.0
+        assert view.wait_idle(60) and view.session.design.params.radius == "15.0%"
+        assert view._nodes == nodes and all(view._nodes[k] is v for k, v in nodes.items())
+        arrays = scene_arrays(view.session.design)
         for root, parts in (("/folded", arrays.folded), ("/pattern", arrays.flat)):
             for kind, (v, f) in parts.items():
-                node = app._nodes[f"{root}/{kind}"]
+                node = view._nodes[f"{root}/{kind}"]
                 assert np.array_equal(node.vertices, v.astype(np.float32))
                 assert np.array_equal(node.faces, f) and node.visible
         for a, points in arrays.flat_creases.items():  # the cube has no valley creases
-            node = app._nodes[f"/pattern/crease_{a}"]
+            node = view._nodes[f"/pattern/crease_{a}"]
             assert node.visible == (len(points) > 0)
             if len(points):
                 assert np.array_equal(node.points, points.astype(np.float32))
-        assert np.array_equal(app._nodes["/folded/vertices"].colors, arrays.vertex_colors)
-        assert "radius 15.0%" in app.status
+        assert np.array_equal(view._nodes["/folded/vertices"].colors, arrays.vertex_colors)
+        assert "radius 15.0%" in view.status
 
-        app.request_load("saddle-patch")  # no cones, no mountain or valley creases
-        assert app.wait_idle(60) and app.session.name == "saddle-patch"
-        assert app._nodes == nodes
-        arrays = scene_arrays(app.session.design)
-        visible = {name for name, node in app._nodes.items() if node.visible}
+        view.request_load("saddle-patch")  # no cones, no mountain or valley creases
+        assert view.wait_idle(60) and view.session.name == "saddle-patch"
+        assert view._nodes == nodes
+        arrays = scene_arrays(view.session.design)
+        visible = {name for name, node in view._nodes.items() if node.visible}
         want = {f"{root}/{kind}" for root in ("/folded", "/pattern") for kind in arrays.folded}
         want |= {f"/pattern/crease_{a}" for a, p in arrays.flat_creases.items() if len(p)}
         want |= {f"/folded/crease_{a}" for a, p in arrays.folded_creases.items() if len(p)}
         assert visible == want | {"/folded/vertices"} and "/folded/cone" not in visible
-        app._show_pattern.value = False
-        assert not any(app._nodes[name].visible for name in want if name.startswith("/pattern"))
+        view._show_pattern.value = False
+        assert not any(view._nodes[name].visible for name in want if name.startswith("/pattern"))
     finally:
+        if page is not None:
+            page.close()
         app.stop()
 
 

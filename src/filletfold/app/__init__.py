@@ -6,7 +6,7 @@
 
 from __future__ import annotations
 
-from .server import AppServer, run_app
+from .server import AppServer, AppView, run_app
 from .session import UPLOAD_LIMIT_BYTES, AppSession
 
-__all__ = ["UPLOAD_LIMIT_BYTES", "AppServer", "AppSession", "run_app"]
+__all__ = ["UPLOAD_LIMIT_BYTES", "AppServer", "AppSession", "AppView", "run_app"]

@@ -5,9 +5,14 @@ crease pattern laid flat beside it, vertex status markers and a legend; the pane
 example list, an upload button, sliders for radius, depth and samples, the material-loss
 switch, a vertex inspector with its own depth, and the download button.
 
-Every change is handed to one worker thread; changes that arrive while it computes are merged
-into the next computation, a computation that a newer change makes useless is stopped at its
-next progress report, and a result older than the one shown is dropped. While the worker
+Every page (browser tab) is an :class:`AppView` with its own session, panel, scene and worker:
+one page's upload or slider never changes what another page shows. A new page starts from the
+design computed when the app started; at most :data:`MAX_PAGES` pages are served at once and
+:data:`MAX_COMPUTING` designs computed at once (the others wait, and say so).
+
+A page's changes are handed to its worker thread; changes that arrive while it computes are
+merged into the next computation, a computation that a newer change makes useless is stopped at
+its next progress report, and a result older than the one shown is dropped. While the worker
 computes, the panel shows the stage and a progress bar.
 """
 
@@ -43,6 +48,10 @@ DEFAULT_RADIUS_PERCENT = 10.0
 DEFAULT_DEPTH_PERCENT = 30.0
 #: Shortest time between two progress updates sent to the page, in seconds.
 PROGRESS_INTERVAL = 0.1
+#: Most pages (browser tabs) served at once; each holds a design of its own.
+MAX_PAGES = 8
+#: Most designs computed at once over all pages (each may take a core and its memory).
+MAX_COMPUTING = 1
 
 
 class _Superseded(Exception):
@@ -58,25 +67,23 @@ def _import_viser():
 
 
 class AppServer:
-    """A running app: the viser server, its session and its worker thread.
+    """A running app: the viser server and one :class:`AppView` per connected page.
 
     Attributes
     ----------
     session : AppSession
+        The design the app started with: every new page starts from a fork of it
+        (:meth:`AppSession.fork`).
     host : str
     port : int
     url : str
         ``http://HOST:PORT``.
     remote : bool
         Whether other machines reach it (``--allow-remote``).
-    status : str
-        The status line shown in the page (Markdown).
-    progress : tuple or None
-        ``(stage, done, total)`` of the computation in progress, None when idle.
-    drawn_id : int
-        Design id (:attr:`AppSession.design_id`) of the scene last drawn.
-    timings : dict
-        Seconds of the last computation (``compute``) and drawing (``draw``).
+    views : dict of int to AppView
+        The pages connected now, by viser client id.
+    refused : int
+        Pages turned away because :data:`MAX_PAGES` were open.
     """
 
     def __init__(self, server, session: AppSession, host: str):
@@ -86,36 +93,87 @@ class AppServer:
         self.port = int(server.get_port())
         self.url = f"http://{host}:{self.port}"
         self.remote = False
-        self.status = "starting"
-        self._wake = threading.Condition()
-        self._dirty = False
-        self._upload = None
+        self.views: dict[int, AppView] = {}
+        self.refused = 0
+        self._pages = threading.Condition()
+        self._opening = 0  # pages being built (counted against MAX_PAGES)
         self._stopping = False
-        self._busy = False
         self._stopped = threading.Event()
-        self._selected = 0
-        self._phase = ""
-        self._last_progress = 0.0
-        self.progress = None
-        self.drawn_id = 0
-        self._drawn = threading.Condition()
-        self.timings: dict[str, float] = {}
-        self._nodes: dict = {}  # scene nodes by name, made by the first draw
-        self._clickable: set = set()  # folded nodes that select a vertex on a click
-        self._vertex_points = None  # the drawn vertex markers, for clicks
-        self._build_gui()
-        self._worker = threading.Thread(target=self._work, name="filletfold-app", daemon=True)
-        self._worker.start()
+        self._computing = threading.BoundedSemaphore(MAX_COMPUTING)
+        server.on_client_connect(self._connected)
+        server.on_client_disconnect(self._disconnected)
+
+    # -- pages ----------------------------------------------------------------------------
+    def _connected(self, client) -> None:
+        """A page connected: give it a view of its own, or say why not."""
+        with self._pages:
+            full = len(self.views) + self._opening >= MAX_PAGES
+            if self._stopping:
+                return
+            if full:
+                self.refused += 1
+            else:
+                self._opening += 1
+        if full:
+            client.gui.add_markdown(
+                f"**error:** the app serves at most {MAX_PAGES} pages at once: close another "
+                "page of it, then reload this one"
+            )
+            log.info("app: page %s refused, %d pages open", client.client_id, MAX_PAGES)
+            return
+        view = None
+        try:
+            view = AppView(client, self.session.fork(), self._computing)
+            view.draw()
+        finally:
+            with self._pages:
+                self._opening -= 1
+                if view is not None:
+                    self.views[client.client_id] = view
+                self._pages.notify_all()
+        log.info("app: page %s opened", client.client_id)
+
+    def _disconnected(self, client) -> None:
+        """A page closed: stop its worker and let its design go."""
+        with self._pages:
+            view = self.views.pop(client.client_id, None)
+            self._pages.notify_all()
+        if view is not None:
+            view.stop(wait=False)
+            log.info("app: page %s closed", client.client_id)
+
+    def wait_view(self, client_id: int | None = None, timeout: float = 30.0) -> AppView:
+        """The view of page ``client_id`` (None: the first page connected), once it is built.
+
+        Raises
+        ------
+        TimeoutError
+            No such page within ``timeout`` seconds.
+        """
+
+        def find():
+            if client_id is not None:
+                return self.views.get(client_id)
+            return self.views[min(self.views)] if self.views else None
+
+        with self._pages:
+            if not self._pages.wait_for(lambda: find() is not None, timeout):
+                which = "no page" if client_id is None else f"no page {client_id}"
+                raise TimeoutError(f"{which} in {timeout:g} s")
+            return find()
 
     # -- lifecycle ------------------------------------------------------------------------
     def stop(self) -> None:
-        """Stop the worker and the viser server (idempotent)."""
-        with self._wake:
+        """Stop every page's worker and the viser server (idempotent)."""
+        with self._pages:
             if self._stopping:
                 return
             self._stopping = True
-            self._wake.notify_all()
-        self._worker.join(timeout=30)
+            views = list(self.views.values())
+        for view in views:
+            view.stop(wait=False)
+        for view in views:
+            view.join(timeout=30)
         with _quiet_stdout():
             self.server.stop()
         self._stopped.set()
@@ -128,6 +186,75 @@ class AppServer:
                 pass
         except KeyboardInterrupt:
             self.stop()
+
+
+class AppView:
+    """One page of the app: its panel, its scene, its session and its worker thread.
+
+    Parameters
+    ----------
+    client : viser.ClientHandle
+        The page; the panel and scene are made on its ``gui`` and ``scene`` (seen by it only).
+    session : AppSession
+        This page's own state.
+    computing : threading.Semaphore
+        Held while a design is computed (shared by the pages: :data:`MAX_COMPUTING`).
+
+    Attributes
+    ----------
+    session : AppSession
+    status : str
+        The status line shown in the page (Markdown).
+    progress : tuple or None
+        ``(stage, done, total)`` of the computation in progress, None when idle.
+    drawn_id : int
+        Design id (:attr:`AppSession.design_id`) of the scene last drawn.
+    timings : dict
+        Seconds of the last computation (``compute``) and drawing (``draw``).
+    """
+
+    def __init__(self, client, session: AppSession, computing):
+        self.client = client
+        self.session = session
+        self.status = "starting"
+        self._computing = computing
+        self._wake = threading.Condition()
+        self._dirty = False
+        self._upload = None
+        self._stopping = False
+        self._busy = False
+        self._selected = 0
+        self._phase = ""
+        self._last_progress = 0.0
+        self.progress = None
+        self.drawn_id = 0
+        self._drawn = threading.Condition()
+        self.timings: dict[str, float] = {}
+        self._nodes: dict = {}  # scene nodes by name, made by the first draw
+        self._clickable: set = set()  # folded nodes that select a vertex on a click
+        self._vertex_points = None  # the drawn vertex markers, for clicks
+        self._build_gui()
+        self._worker = threading.Thread(
+            target=self._work, name=f"filletfold-page-{client.client_id}", daemon=True
+        )
+        self._worker.start()
+
+    # -- lifecycle ------------------------------------------------------------------------
+    def stop(self, wait: bool = True) -> None:
+        """Stop the worker (a computation in progress stops at its next progress report)."""
+        with self._wake:
+            self._stopping = True
+            self._wake.notify_all()
+        if wait:
+            self.join()
+
+    def join(self, timeout: float = 30.0) -> None:
+        """Wait for the worker to end (after :meth:`stop`)."""
+        self._worker.join(timeout=timeout)
+
+    def draw(self) -> None:
+        """Draw the session's current design in the page."""
+        self._draw()
 
     # -- worker ---------------------------------------------------------------------------
     def request_update(self) -> None:
@@ -186,6 +313,9 @@ class AppServer:
                     self._wake.wait()
                 if self._stopping:
                     return
+            if not self._take_turn():
+                return
+            with self._wake:
                 upload, self._upload = self._upload, None
                 dirty, self._dirty = self._dirty, False
                 self._busy = True
@@ -211,8 +341,21 @@ class AppServer:
                 log.exception("app: unexpected error")
                 self._set_status(f"**unexpected error:** {type(exc).__name__}: {exc}")
             finally:
+                self._computing.release()
                 self._phase = ""
                 self._end_progress()
+
+    def _take_turn(self) -> bool:
+        """Wait until no more than :data:`MAX_COMPUTING` designs are computed (saying so in
+        the page meanwhile); False when the page stops while it waits."""
+        if self._computing.acquire(blocking=False):
+            return True
+        self._set_status("waiting: another page of this app is computing…")
+        while not self._computing.acquire(timeout=0.2):
+            with self._wake:
+                if self._stopping:
+                    return False
+        return True
 
     def _report_progress(self, stage: str, done: int, total: int) -> None:
         """``round_mesh``'s progress callback (worker thread): show the stage in the page, at
@@ -239,6 +382,8 @@ class AppServer:
 
     def _end_progress(self) -> None:
         self.progress = None
+        if self._stopping:  # a closed page is sent nothing
+            return
         self._progress_bar.visible = False
         self._progress_bar.value = 0.0
 
@@ -254,11 +399,11 @@ class AppServer:
     def _set_status(self, text: str) -> None:
         self.status = text
         handle = getattr(self, "_status_md", None)
-        if handle is not None:
+        if handle is not None and not self._stopping:  # a closed page is sent nothing
             handle.content = text
 
     def _build_gui(self) -> None:
-        gui = self.server.gui
+        gui = self.client.gui
         self._status_md = gui.add_markdown("starting…")
         self._progress_bar = gui.add_progress_bar(0.0, visible=False, animated=True)
         with gui.add_folder("Mesh"):
@@ -347,8 +492,7 @@ class AppServer:
                 self._set_status(f"**error:** {exc}")
                 return
             stem = (self.session.name or "design").rsplit(".", 1)[0].replace(":", "_")
-            target = event.client if event.client is not None else self.server
-            target.send_file_download(f"{stem}-filletfold.zip", data)
+            self.client.send_file_download(f"{stem}-filletfold.zip", data)
 
     def _params_changed(self) -> None:
         self.session.set_params(
@@ -416,7 +560,7 @@ class AppServer:
     def _update_scene(self, arrays) -> None:
         """Give the scene nodes the arrays of a design (:func:`~.view.scene_arrays`)."""
         self._vertex_points = arrays.vertex_points
-        scene = self.server.scene
+        scene = self.client.scene
         show_pattern = bool(self._show_pattern.value)
         flat_nodes = []
         for kind, rgb in PATCH_RGB.items():
@@ -487,7 +631,7 @@ class AppServer:
             return
         arrays = scene_arrays(design)
         # one window of messages: the page applies the scene and the status line together
-        with self.server.atomic():
+        with self.client.atomic():
             self._update_scene(arrays)
             counts = ", ".join(f"{n} {s}" for s, n in design.status_counts().items() if n)
             shown = (
@@ -626,7 +770,6 @@ def run_app(
             )
         app = AppServer(server, session, host)
         app.remote = bind.remote
-        app._draw()
     except BaseException:
         server.stop()
         raise

@@ -189,6 +189,17 @@ class AppSession:
         self._next_id = 0
         self._lock = threading.RLock()
 
+    def fork(self) -> AppSession:
+        """A session of its own that starts where this one is (same mesh, parameters, per-vertex
+        depths and design; the design is shared, never changed in place): one per page of
+        the app, so one page's changes never reach another's."""
+        with self._lock:
+            other = AppSession.__new__(AppSession)
+            other.__dict__.update(self.__dict__)
+            other.vertex_depth = dict(self.vertex_depth)
+            other._lock = threading.RLock()
+            return other
+
     # -- requests -------------------------------------------------------------------------
     def begin(self, *, mesh: PolyMesh | None = None, name: str | None = None) -> Request:
         """Number a new request and snapshot the state it is computed from.

@@ -22,8 +22,8 @@ _LISTENERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def on_refused(gui_api, listener) -> None:
-    """Call ``listener(filename, size_bytes)`` when an upload to ``gui_api`` (a viser server's
-    GUI API) is refused for its size."""
+    """Call ``listener(filename, size_bytes)`` when an upload to ``gui_api`` (the GUI API of a
+    viser server or of one of its clients) is refused for its size."""
     _LISTENERS[gui_api] = listener
 
 
@@ -45,7 +45,8 @@ def bound_uploads() -> None:
 
     @functools.wraps(start)
     def checked_start(self, client_id, message):
-        if message.size_bytes > UPLOAD_LIMIT_BYTES:  # announced too large: nothing is kept
+        mine = message.source_component_uuid in self._gui_input_handle_from_uuid
+        if mine and message.size_bytes > UPLOAD_LIMIT_BYTES:  # announced too large: nothing is kept
             _tell(self, message.filename, int(message.size_bytes))
             return None
         return start(self, client_id, message)
