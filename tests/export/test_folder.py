@@ -102,6 +102,8 @@ g = 0
 while True:
     g += 1
     ff.write_design_folder(sys.argv[1], {n: (f"{g} " * 200_000) + str(g) for n in names})
+    if g == 1:
+        print("written", flush=True)  # the kill comes at a random moment after this
 """
 
 
@@ -121,10 +123,14 @@ def test_a_run_killed_at_any_moment_leaves_the_old_design_or_the_new(tmp_path, m
     out = tmp_path / "out"
     seen = set()
     for _ in range(kills):
-        child = subprocess.Popen([sys.executable, "-c", _CHILD, str(out), mode], env=env)
-        time.sleep(0.6 + rng.random() * 0.6)
+        child = subprocess.Popen(
+            [sys.executable, "-c", _CHILD, str(out), mode], env=env, stdout=subprocess.PIPE
+        )
+        assert child.stdout.readline() == b"written\n"  # one whole design, however loaded
+        time.sleep(rng.random() * 0.6)  # then killed at a random moment of the next writes
         child.send_signal(signal.SIGKILL)
         child.wait()
+        child.stdout.close()
         ff._clean_stale(out)
         if not out.exists():
             continue
