@@ -14,6 +14,7 @@ import filletfold
 from filletfold.defaults import DEFAULT_MAX_CORNERS, MAX_SAMPLES
 from filletfold.errors import MeshError, ParameterError
 from filletfold.mesh import load_mesh
+from filletfold.mesh.polymesh import estimate_pattern_points
 
 
 def _ngon_cone(n: int):
@@ -90,3 +91,70 @@ def test_an_apex_deeper_than_ten_thousand_edges_is_refused():
     with pytest.raises(ParameterError, match="at vertex 3"):
         filletfold.round_mesh("cube", depth={"default": "30%", 3: 2e4})
     assert filletfold.round_mesh("cube", depth=50.0, certify=False).pattern.n_pieces > 0
+
+
+# -- the pattern's size, estimated before anything is solved ---------------------------------
+@pytest.mark.parametrize(
+    ("name", "samples", "arc_step"),
+    [
+        ("tetrahedron", 3, 10.0),  # the most points per edge over the examples (0.77)
+        ("cube", 3, 0.0),
+        ("house", 24, 10.0),
+        ("torus", 24, 0.0),
+        ("geodesic-sphere", 8, 10.0),
+        ("blob", 24, 10.0),
+    ],
+)
+def test_the_estimate_bounds_the_pattern_it_is_made_for(name, samples, arc_step):
+    design = filletfold.round_mesh(name, samples=samples, arc_step=arc_step)
+    points = len(design.pattern.vertices_2d)
+    estimate = estimate_pattern_points(design.mesh, samples)
+    assert points <= estimate < 20 * points  # an upper estimate, not a vague one
+
+
+@pytest.mark.slow
+def test_the_estimate_bounds_every_examples_pattern():
+    for name in filletfold.example_names():
+        for samples in (3, 24, 96):
+            design = filletfold.round_mesh(name, samples=samples, arc_step=0.0)
+            assert len(design.pattern.vertices_2d) <= estimate_pattern_points(
+                design.mesh, samples
+            ), (name, samples)
+
+
+def test_a_pattern_estimated_over_the_limit_is_refused_before_anything_is_solved(monkeypatch):
+    import filletfold.design as design_mod
+
+    def no_solving(*args, **kw):
+        raise AssertionError("the refused design was solved")
+
+    monkeypatch.setattr(design_mod, "edge_stage", no_solving)
+    mesh, _ = load_mesh("geodesic-sphere")
+    estimate = estimate_pattern_points(mesh, 64)
+    with pytest.raises(MeshError, match=r"estimated at up to [\d,]+ pattern points.*--max-points"):
+        filletfold.round_mesh(mesh, samples=64, max_points=estimate - 1)
+    with pytest.raises(ParameterError, match="max points"):
+        filletfold.round_mesh(mesh, max_points=0)
+
+
+def test_the_command_names_the_limit_and_writes_nothing(tmp_path, capsys):
+    from filletfold.cli import main
+
+    out = tmp_path / "out"
+    assert main(["round", "cube", "-n", "256", "--max-points", "10000", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--max-points" in err and "--faces" in err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_mesh_of_200k_triangles_is_refused_at_the_default_limit():
+    n = 330  # a wavy grid of 217,800 triangles: no coplanar faces to merge
+    x, y = np.meshgrid(np.arange(n + 1.0), np.arange(n + 1.0))
+    vertices = np.c_[x.ravel(), y.ravel(), (0.3 * np.sin(x / 7) * np.cos(y / 5)).ravel()]
+    i = (np.arange(n)[:, None] * (n + 1) + np.arange(n)[None, :]).ravel()
+    faces = np.r_[np.c_[i, i + 1, i + n + 2], np.c_[i, i + n + 2, i + n + 1]]
+    t = time.perf_counter()
+    with pytest.raises(MeshError, match=r"327,291 edges at 24 samples.* more than 50,000,000"):
+        filletfold.round_mesh((vertices, faces))
+    assert time.perf_counter() - t < 60  # reading and cleaning only (9 s here)

@@ -43,6 +43,7 @@ from .defaults import (
     DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
     DEFAULT_MAX_CORNERS,
+    DEFAULT_MAX_POINTS,
     DEFAULT_RADIUS,
     DEFAULT_SAMPLES,
     DEFAULT_SHARP,
@@ -226,6 +227,7 @@ ROUND_PARAMETERS = {
     "size": "size",
     "up": "up",
     "max_corners": "max_corners",
+    "max_points": "max_points",
 }
 
 
@@ -422,6 +424,15 @@ def round_cmd(
             "is solved (time grows about with the square of a face's corners).",
         ),
     ] = DEFAULT_MAX_CORNERS,
+    max_points: Annotated[
+        int,
+        typer.Option(
+            "--max-points",
+            metavar="<int>",
+            help="The most crease-pattern points the design may be estimated at (64 + 4 per "
+            "sample, per edge); more is refused before anything is solved.",
+        ),
+    ] = DEFAULT_MAX_POINTS,
     faces: Annotated[
         int | None,
         typer.Option(

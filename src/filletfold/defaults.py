@@ -12,6 +12,11 @@ MAX_SAMPLES = 256
 #: time about quadratic in their number (a prism of two 256-gons: 7 s; of two 400-gons: 38 s;
 #: one 10,000-gon filled 24 GB).
 DEFAULT_MAX_CORNERS = 256
+#: The most crease-pattern points a design may be estimated at before it is solved (see
+#: round_mesh(max_points=...) and mesh.polymesh.estimate_pattern_points): about what a
+#: 200,000-triangle mesh at the default samples is estimated at; such a run takes about half
+#: an hour and 6 GB here (a 100,000-triangle scan: 640 s, 2.9 GB).
+DEFAULT_MAX_POINTS = 50_000_000
 #: Largest turn (degrees) between two samples of an arc (0: no limit): the chord tolerance
 #: decides, this bounds the turn of a chord on a small fillet (see round_mesh(arc_step=...)).
 DEFAULT_ARC_STEP = 10.0

@@ -21,6 +21,7 @@ from .defaults import (
     DEFAULT_CHORD_TOL,
     DEFAULT_DEPTH,
     DEFAULT_MAX_CORNERS,
+    DEFAULT_MAX_POINTS,
     DEFAULT_RADIUS,
     DEFAULT_SAMPLES,
     DEFAULT_SHARP,
@@ -65,6 +66,7 @@ _JSON_TYPES = {
     "size": ("number", "string", "null"),
     "up": ("string",),
     "max_corners": ("integer",),
+    "max_points": ("integer",),
 }
 
 
@@ -183,6 +185,10 @@ class Parameters:
         face is refused with its index before anything is solved (a face's corners cost
         time about quadratic in their number: a prism of two 256-gons takes 7 s, one
         10,000-gon filled 24 GB). ``faces`` triangulates and coarsens a mesh instead.
+    max_points : int
+        The most crease-pattern points the design (of the mesh as cleaned and coarsened) may
+        be estimated at before it is solved (``64 + 4 * samples`` per edge, an upper
+        estimate); more is refused at once, naming ``--faces`` and ``--samples``.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -208,6 +214,7 @@ class Parameters:
     size: object = "auto"
     up: str = "auto"
     max_corners: int = DEFAULT_MAX_CORNERS
+    max_points: int = DEFAULT_MAX_POINTS
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:
@@ -313,6 +320,11 @@ class Parameters:
         if isinstance(corners, bool) or not isinstance(corners, int | np.integer) or corners < 3:
             raise ParameterError(
                 f"max corners must be an integer >= 3, got {corners!r}", name="max_corners"
+            )
+        points = self.max_points
+        if isinstance(points, bool) or not isinstance(points, int | np.integer) or points < 1:
+            raise ParameterError(
+                f"max points must be an integer >= 1, got {points!r}", name="max_points"
             )
         if isinstance(arc_step, bool) or not isinstance(arc_step, int | float | np.number):
             raise ParameterError(

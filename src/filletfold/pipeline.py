@@ -41,7 +41,7 @@ from .layout.fabrication import cut_first, recut_solved
 from .layout.net import cut_edges_for_nets
 from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
-from .mesh.polymesh import PolyMesh, check_corners, mesh_size
+from .mesh.polymesh import PolyMesh, check_corners, check_pattern_size, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth, sized
 from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
@@ -275,6 +275,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         shift = far_offset(pm.vertices)
         if shift is not None:  # far from the origin: compute about the centre, shift back later
             pm = PolyMesh(pm.vertices - shift, pm.faces)
+    check_pattern_size(pm, params.samples, params.max_points)  # before anything is solved
     size, strict = mesh_size(pm), params.strict
     params = sized(params, float(np.ptp(pm.vertices, axis=0).max(initial=0.0)), pm.mean_edge_length)
     return Job(

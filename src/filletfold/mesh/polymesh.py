@@ -322,6 +322,33 @@ def check_corners(mesh: PolyMesh, limit: int) -> None:
         raise too_many_corners(f"vertex {v} meets {int(valence[v])} edges", limit, vertex=v)
 
 
+#: Points of the crease pattern per edge, fixed and per sample of an arc, in
+#: :func:`estimate_pattern_points` (over the built-in examples, 3 to 96 samples, arc step 0
+#: and 10 degrees, the pattern had at most 0.77 of the estimate; a 2,904-vertex scan 0.08).
+PATTERN_POINTS_PER_EDGE = (64, 4)
+
+
+def estimate_pattern_points(mesh: PolyMesh, samples: int) -> int:
+    """An upper estimate of the crease pattern's points before anything is solved: each edge's
+    cylinder, the cones at its ends and the face pieces beside it give at most
+    ``64 + 4 * samples`` points (:data:`PATTERN_POINTS_PER_EDGE`)."""
+    fixed, per_sample = PATTERN_POINTS_PER_EDGE
+    return int(mesh.n_edges) * (fixed + per_sample * int(samples))
+
+
+def check_pattern_size(mesh: PolyMesh, samples: int, limit: int) -> None:
+    """A :class:`~filletfold.errors.MeshError` when the pattern of ``mesh`` at ``samples``
+    points per arc is estimated (:func:`estimate_pattern_points`) at more than ``limit``
+    points (``max_points``): refused before its time and memory are spent."""
+    points = estimate_pattern_points(mesh, samples)
+    if points > limit:
+        raise MeshError(
+            f"the design of {mesh.n_edges:,} edges at {samples} samples is estimated at up to "
+            f"{points:,} pattern points, more than {limit:,} (--max-points: time and memory grow "
+            "with them); coarsen with --faces N, lower --samples, or raise --max-points"
+        )
+
+
 def too_many_corners(what: str, limit: int, **element) -> MeshError:
     """The error of an element beyond ``max_corners``: ``what`` it has, the limit, why, and
     the options that change it."""
