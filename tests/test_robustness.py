@@ -24,6 +24,9 @@ TIMEOUT = 60.0
 #: The first cases, which `make test` runs (garbage files among them); the slow tier runs all
 #: N_CASES.
 N_FAST = 25
+#: Cases of the long suite (``make test-long``), in parts of LONG_PART run by separate workers.
+N_LONG = 5000
+LONG_PART = 500
 
 
 @pytest.fixture(
@@ -31,13 +34,28 @@ N_FAST = 25
     params=[
         pytest.param(N_FAST, id="first"),
         pytest.param(N_CASES, id="all", marks=pytest.mark.slow),
+        *(
+            pytest.param(
+                (start, start + LONG_PART),
+                id=f"long-{start}",
+                # the four tests of a part on one worker: its cases run once (--dist loadgroup)
+                marks=[pytest.mark.long, pytest.mark.xdist_group(f"long-{start}")],
+            )
+            for start in range(0, N_LONG, LONG_PART)
+        ),
     ],
 )
 def outcomes(request, tmp_path_factory):
-    """The outcomes of the first cases of seed 0, run once for this file (with the solver
-    users get: the numba kernel when it is installed)."""
+    """The outcomes of the first cases of seed 0 (or of the cases ``[start, stop)`` of the
+    long suite), run once for this file (with the solver users get: the numba kernel when it
+    is installed)."""
     folder = tmp_path_factory.mktemp("fuzz")
-    return [run_case(case, folder, timeout=TIMEOUT) for case in fuzz_cases(request.param)]
+    if isinstance(request.param, tuple):
+        start, stop = request.param
+        cases = fuzz_cases(stop)[start:]
+    else:
+        cases = fuzz_cases(request.param)
+    return [run_case(case, folder, timeout=TIMEOUT) for case in cases]
 
 
 def listing(items, line) -> str:
