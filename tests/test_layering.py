@@ -189,6 +189,7 @@ PIPELINE = ["design.py", "pipeline.py", "parameters.py", "vertex/state.py", "ver
 #: the numba kernel's compiled functions, which take arrays one by one.
 MANY_PARAMETERS = {
     "cli.py:round_cmd": "the command's options",
+    "check.py:certify": "public: the certificate's inputs and limits",
     "export/render.py:render": "public: the picture's options",
     "export/cutfiles.py:cut_files": "public: the cut files' options",
     "export/outputs.py:export_design": "public: Design.export's options",

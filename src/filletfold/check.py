@@ -462,6 +462,7 @@ def certify(
     coord_quantum: float = 0.0,
     quantum_source: str = f"coordinates rounded to {FOLD_DIGITS} digits",
     arc_step: float = DEFAULT_ARC_STEP,
+    bend_floor: float = 0.0,
 ) -> Certificate:
     """Measure the invariants of a crease pattern against the mesh it rounds.
 
@@ -489,6 +490,10 @@ def certify(
     arc_step : float
         The design's arc step (degrees; 0: none), which sets its facet limit
         (:func:`~filletfold.surface.sampling.facet_limit`): ``facet folds`` and ``edge lengths``.
+    bend_floor : float
+        The least radius a cylinder may have (mesh units): a sheet material's bend floor at
+        the design's size (:meth:`~filletfold.materials.Material.bend_floor_mm`); 0 (no
+        material) leaves the ``bend floor`` check out.
 
     Returns
     -------
@@ -517,6 +522,8 @@ def certify(
         _smallest_face_angle(data),
         _holes(data),
     ]
+    if bend_floor > 0:
+        checks.append(_bend_floor(data, float(bend_floor)))
     return Certificate(checks=checks, size=data.size, coord_quantum=data.q)
 
 
@@ -629,6 +636,29 @@ def _on_cylinders(g: _Data) -> Check:
     worst = {"pattern_vertex": v, "mesh_edge": me}
     ok = bool(err[k] <= CYLINDER_TOL)
     return Check(name, ok, float(err[k]), CYLINDER_TOL, detail, "<=", worst)
+
+
+def _bend_floor(g: _Data, floor: float) -> Check:
+    """Every cylinder of the pattern at least the material's bend floor: its radius (that of
+    the mesh edge, which ``on cylinders`` measures its points against) over the floor.
+    Tapering fillets narrow to their sharp corner and are not held to it (counted)."""
+    name = "bend floor"
+    c = np.flatnonzero(g.kind[g.face_of] == _CYLINDER)
+    e = np.unique(g.index[g.face_of[c]])
+    e = e[g.rounded[e]]
+    tapering = _distinct(g.index[g.face_of[np.flatnonzero(g.kind[g.face_of] == _FILLET)]])
+    note = f"; {tapering} tapering fillet(s) not held to it" if tapering else ""
+    if not len(e):
+        return Check(name, True, float("nan"), 1.0, "no cylinder in the design" + note, ">=")
+    ratio = g.radius[e] / floor
+    k = int(np.argmin(ratio))
+    below = int((ratio < 1 - 1e-9).sum())
+    detail = (
+        f"{len(e)} cylinders, radius / floor {floor:.6g} (mesh units): least "
+        f"{_fmt(float(ratio[k]))} at cylinder {int(e[k])}; {below} below" + note
+    )
+    ok = below == 0
+    return Check(name, ok, float(ratio[k]), 1.0, detail, ">=", {"mesh_edge": int(e[k])})
 
 
 def _off_cylinder(g: _Data, points: np.ndarray, e: np.ndarray) -> np.ndarray:
@@ -1260,7 +1290,17 @@ def certify_design(design) -> Certificate:
         coord_quantum=memory_quantum(design.pattern),
         quantum_source=f"round-off: {ROUNDOFF_ULPS} ulp of the largest coordinate",
         arc_step=float(design.params.arc_step),
+        bend_floor=design_bend_floor(design.params),
     )
+
+
+def design_bend_floor(params) -> float:
+    """The bend floor (mesh units) a design made with ``params`` (its size settled) is held
+    to: its sheet material's, at its size; 0 without a material or a size."""
+    material = params.sheet_material()
+    if material is None or params.size is None or params.scale is None:
+        return 0.0
+    return material.bend_floor_mm() / params.mm_per_unit
 
 
 def memory_quantum(pattern: CreasePattern) -> float:
@@ -1324,9 +1364,22 @@ def check_folder(path) -> Certificate:
             apex,
             coord_quantum=file_quantum(pattern),
             arc_step=arc_step,
+            bend_floor=_report_bend_floor(report),
         )
     except ParameterError as exc:
         raise MeshReadError(f"{fold} does not match {report.name}: {exc}") from None
+
+
+def _report_bend_floor(path: Path) -> float:
+    """:func:`design_bend_floor` of the parameters a design's report names."""
+    from .parameters import Parameters
+
+    doc = load_json(path, "a report")
+    try:
+        params = Parameters.from_dict(doc.get("parameters"), where=f"{path}: parameters")
+        return design_bend_floor(params)
+    except ParameterError as exc:
+        raise MeshReadError(f"{path}: {exc}") from None
 
 
 #: The prefix of the mesh's keys in ``design.fold`` (see ``mesh_fold_keys`` in

@@ -97,6 +97,24 @@ def examples():
     console.print(table)
 
 
+@app.command()
+def materials():
+    """List the sheet materials of --material: thickness t, least inner bend radius min r, the
+    bend floor of the fillets (min r + t/2), k-factor, how creases are made (docs/materials.md
+    gives where each figure comes from)."""
+    from rich.table import Table
+
+    from .materials import material_table
+
+    table = Table("name", "t mm", "min r mm", "floor mm", "k", "made by", "description")
+    for m in material_table():
+        table.add_row(
+            m["name"], f"{m['thickness_mm']:g}", f"{m['min_bend_radius_mm']:g}",
+            f"{m['bend_floor_mm']:g}", f"{m['k_factor']:.2f}", m["making"], m["description"],
+        )  # fmt: skip
+    console.print(table)
+
+
 #: Formats ``filletfold export`` can write from a ``design.fold``.
 EXPORT_FORMATS = ("simulator", "obj", "svg", "dxf", "pdf", "png", "3dm", "glb", "ply", "stl")
 
@@ -228,6 +246,10 @@ ROUND_PARAMETERS = {
     "up": "up",
     "max_corners": "max_corners",
     "max_points": "max_points",
+    "material": "material",
+    "thickness": "thickness",
+    "min_bend_radius": "min_bend_radius",
+    "k_factor": "k_factor",
 }
 
 
@@ -472,6 +494,43 @@ def round_cmd(
             "least size at which every label is 2 mm high and every piece spans 3 mm (at "
             "least 100 mm), printed in the summary; with --units or --scale, none (the mesh "
             "is in those units); 'none': a unitless drawing.",
+            show_default=False,
+        ),
+    ] = None,
+    material: Annotated[
+        str | None,
+        typer.Option(
+            "--material",
+            help="The sheet material ('filletfold materials' lists them: card-300gsm, "
+            "aluminium-1mm, plywood-3mm...): no fillet is made tighter than it bends (its "
+            "least inner bend radius plus half its thickness) at the design's size; with "
+            "--size, tighter fillets are widened or the least size is named; by default the "
+            "size grows until they hold.",
+            show_default=False,
+        ),
+    ] = None,
+    thickness: Annotated[
+        float | None,
+        typer.Option(
+            "--thickness",
+            help="The sheet's thickness in mm (overrides the material's).",
+            show_default=False,
+        ),
+    ] = None,
+    min_bend_radius: Annotated[
+        float | None,
+        typer.Option(
+            "--min-bend-radius",
+            help="The least inner bend radius in mm (overrides the material's).",
+            show_default=False,
+        ),
+    ] = None,
+    k_factor: Annotated[
+        float | None,
+        typer.Option(
+            "--k-factor",
+            help="The neutral axis's distance from the inner surface over the thickness, 0-1 "
+            "(overrides the material's).",
             show_default=False,
         ),
     ] = None,

@@ -67,6 +67,10 @@ _JSON_TYPES = {
     "up": ("string",),
     "max_corners": ("integer",),
     "max_points": ("integer",),
+    "material": ("string", "null"),
+    "thickness": ("number", "null"),
+    "min_bend_radius": ("number", "null"),
+    "k_factor": ("number", "null"),
 }
 
 
@@ -189,6 +193,17 @@ class Parameters:
         The most crease-pattern points the design (of the mesh as cleaned and coarsened) may
         be estimated at before it is solved (``64 + 4 * samples`` per edge, an upper
         estimate); more is refused at once, naming ``--faces`` and ``--samples``.
+    material : str or None
+        The sheet material (:data:`~filletfold.materials.MATERIALS`: ``"card-300gsm"``,
+        ``"aluminium-1mm"``...; None: paper of no thickness that bends to any radius). Every
+        fillet is then at least the material's bend floor (its least inner bend radius plus
+        half its thickness) at the design's size: with ``size`` given, fillets below it are
+        raised (an edge whose limit is below it is refused, naming the least size that
+        holds it); with the default size, the size grows until every fillet holds it.
+    thickness, min_bend_radius, k_factor : float or None
+        Overrides of the material's figures (millimetres; the k-factor is the neutral axis's
+        distance from the inner surface over the thickness); without ``material`` they
+        describe a sheet of their own.
     """
 
     radius: object = DEFAULT_RADIUS
@@ -215,6 +230,10 @@ class Parameters:
     up: str = "auto"
     max_corners: int = DEFAULT_MAX_CORNERS
     max_points: int = DEFAULT_MAX_POINTS
+    material: str | None = None
+    thickness: float | None = None
+    min_bend_radius: float | None = None
+    k_factor: float | None = None
 
     # -- building ---------------------------------------------------------------------------
     def replace(self, **changes) -> Parameters:
@@ -354,6 +373,7 @@ class Parameters:
         if self.sheet is not None:  # a bad sheet, before the solve
             sheet_in_pattern_units(self.sheet, self.sheet_units, self.sheet_scale)
         resolve_chord_tol(self.chord_tol, 1.0)
+        self.sheet_material()  # an unknown material or a bad figure, before the solve
         choose_nester(self.nest, self.sheet)  # a bad nester, or a missing one
         if self.sharp != "auto":
             parse_sharp(self.sharp)
@@ -375,6 +395,13 @@ class Parameters:
         from .units import MM_PER_UNIT
 
         return self.sheet_scale * MM_PER_UNIT[self.sheet_units]
+
+    def sheet_material(self):
+        """The :class:`~filletfold.materials.Material` of ``material`` and its overrides, or
+        None (see :func:`~filletfold.materials.resolve_material`)."""
+        from .materials import resolve_material
+
+        return resolve_material(self.material, self.thickness, self.min_bend_radius, self.k_factor)
 
     def sharp_kinds(self) -> frozenset:
         """The kinds of cone-less vertices kept sharp (``"auto"`` resolved)."""

@@ -34,7 +34,14 @@ from typing import Any
 
 import numpy as np
 
-from .errors import FilletfoldError, InternalError, SolverError, is_callers, one_line
+from .errors import (
+    FilletfoldError,
+    InternalError,
+    ParameterError,
+    SolverError,
+    is_callers,
+    one_line,
+)
 from .errors import stage as _stage
 from .layout.arrange import arrange
 from .layout.fabrication import cut_first, recut_solved
@@ -43,6 +50,7 @@ from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
 from .mesh.polymesh import PolyMesh, check_corners, check_pattern_size, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth, sized
+from .rounding.bend import FLOOR_RTOL, hold_floor, least_size_factor
 from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
@@ -52,6 +60,7 @@ from .surface.module import Modules, build_modules
 from .surface.pattern import CreasePattern
 from .surface.sampling import cone_sample_counts, unsampled_cones
 from .tolerances import tol
+from .units import AUTO_SIZE, ceil_digits
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
     kept_sharp,
@@ -128,6 +137,9 @@ class Job:
         ``progress(stage, done, total)``.
     coarsening : Coarsening or None
         What coarsening the mesh did (``params.faces`` or ``params.edge_length``), else None.
+    bend : float
+        The sheet material's bend floor in mesh units at the size given (:func:`bend_floor`);
+        0 without a material or at the default size.
     """
 
     params: Parameters
@@ -146,6 +158,7 @@ class Job:
     chord: float
     progress: Any
     coarsening: Coarsening | None = None
+    bend: float = 0.0
 
 
 @dataclass
@@ -278,6 +291,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
     check_pattern_size(pm, params.samples, params.max_points)  # before anything is solved
     size, strict = mesh_size(pm), params.strict
     params = sized(params, float(np.ptp(pm.vertices, axis=0).max(initial=0.0)), pm.mean_edge_length)
+    bend = bend_units(params)
     return Job(
         params=params,
         mesh=pm,
@@ -286,7 +300,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         shift=shift,
         input_key=input_key,
         coarsening=coarsening,
-        key=_stage_key(pm, *(getattr(params, name) for name in STAGE_KEY)),
+        key=_stage_key(pm, *(getattr(params, name) for name in STAGE_KEY), bend),
         depths=resolve_depth(params.depth, pm.mean_edge_length, pm.n_vertices),
         kinds=params.sharp_kinds(),
         size=size,
@@ -295,7 +309,18 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         min_chord=0.0 if strict else 2 * tol.ruling * size,
         chord=resolve_chord_tol(params.chord_tol, pm.mean_edge_length),
         progress=progress,
+        bend=bend,
     )
+
+
+def bend_units(params: Parameters) -> float:
+    """The sheet material's bend floor (:meth:`~filletfold.materials.Material.bend_floor_mm`)
+    in mesh units at the size of ``params`` (sized: :func:`~filletfold.parameters.sized`); 0
+    without a material, and at the default size (which grows to it instead)."""
+    material = params.sheet_material()
+    if material is None or params.size == AUTO_SIZE:
+        return 0.0
+    return material.bend_floor_mm() / params.mm_per_unit
 
 
 def reusable_stages(job: Job, earlier: Stages | None) -> Stages | None:
@@ -342,9 +367,41 @@ def edge_stage(job: Job, st: Stages | None) -> Edges:
         r = given
         if p.clamp:
             r = clamp_radii(pm, r, flat_deg=p.coplanar_deg)
+    r = bend_floor(job, r)
     rounding = round_edges(pm, r, flat_deg=p.coplanar_deg, floor=floor, min_width=min_width)
     centres = face_piece_centres(pm, rounding)
     return Edges(loss, rounding, conical, requested, centres, rounding.radius.copy())
+
+
+def bend_floor(job: Job, radius: np.ndarray) -> np.ndarray:
+    """The fitted radii with the sheet material's bend floor held
+    (:mod:`~filletfold.rounding.bend`), at a size that was given: every fillet below it is
+    raised to it; an edge whose limit is below it is refused, naming the least size that
+    holds it. Unchanged without a material, and at the default size (which grows until the
+    fillets hold it: :func:`~filletfold.layout.arrange.default_size`). Radii of the
+    material-loss programme are never raised (they are consistent only as they are)."""
+    p, pm, floor = job.params, job.mesh, job.bend
+    if floor <= 0:
+        return radius
+    material, mm = p.sheet_material(), p.mm_per_unit
+    if p.material_loss:
+        held, short = radius, (radius > 0) & (radius < floor * (1 - FLOOR_RTOL))
+        factor = float(floor / radius[short].min()) if short.any() else 1.0
+    else:
+        held, short = hold_floor(pm, radius, floor)
+        factor = least_size_factor(pm, radius, floor) if short.any() else 1.0
+    if short.any():
+        size = float(np.ptp(pm.vertices, axis=0).max()) * mm
+        edges = np.flatnonzero(short)
+        listed = ", ".join(map(str, edges[:6])) + (", ..." if len(edges) > 6 else "")
+        least = f"{ceil_digits(size * factor):g}mm" if np.isfinite(factor) else "none"
+        raise ParameterError(
+            f"{material.name} bends no tighter than {material.bend_floor_mm():g} mm (its least "
+            f"inner radius plus half its thickness), but {len(edges)} edge(s) ({listed}) cannot "
+            f"hold a fillet that wide at --size {size:.4g}mm; the least size that can: {least}",
+            name="size",
+        )
+    return held
 
 
 def normal_stage(job: Job, edges: Edges, st: Stages | None) -> VertexState:
@@ -362,7 +419,7 @@ def normal_stage(job: Job, edges: Edges, st: Stages | None) -> VertexState:
         mesh=pm, rounding=edges.rounding, centres=edges.centres, frames=[],
         res=VertexResult.empty(pm.n_vertices), depths=job.depths, face_centres=face_piece_centres,
         flat_deg=p.coplanar_deg, floor=job.floor, min_width=job.min_width, size=job.size,
-        progress=job.progress,
+        progress=job.progress, bend_floor=job.bend,
     )  # fmt: skip
     if st is not None:
         # the earlier design's stages stay as they were: the apex stage replaces the frames

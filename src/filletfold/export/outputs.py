@@ -115,6 +115,37 @@ def report_records(design) -> dict:
         "up": {"axis": design.up, "why": design.up_why},
         "fabrication": _fabrication_report(design),
         "material_loss": _loss_report(design.material_loss),
+        "material": material_report(design),
+    }
+
+
+def material_report(design) -> dict | None:
+    """The sheet material and what it did (None without one): its figures
+    (:meth:`~filletfold.materials.Material.as_dict`), the size (mm) and the fillets against
+    its bend floor: how many, the least radius (mm), how many below the floor (0 in a valid
+    design) and the tapering fillets, which narrow to their sharp corner and are not held to
+    it."""
+    p = design.params
+    material = p.sheet_material()
+    if material is None:
+        return None
+    r = np.asarray(design.rounding.radius, dtype=float)
+    mm = p.mm_per_unit if p.scale is not None else None
+    rounded = r[r > 0]
+    patches = {str(x) for x in design.pattern.face_patch}
+    floor = material.bend_floor_mm()
+    least = float(rounded.min()) * mm if (mm is not None and len(rounded)) else None
+    return {
+        **material.as_dict(),
+        "size": p.size,
+        "fillets": len(rounded),
+        "least_fillet_radius_mm": least,
+        "fillets_below_floor": (
+            int((rounded * mm < floor * (1 - 1e-9)).sum()) if mm is not None else None
+        ),
+        "tapering_fillets": sum(x.startswith("fillet ") for x in patches),
+        "cones": sum(x.startswith("cone ") for x in patches),
+        "not_held": "cones and tapering fillets are not yet held to the bend floor",
     }
 
 
@@ -456,7 +487,29 @@ _DEFAULT_SIZE_WHY = {
     "least": "a model held in the hand",
     "labels": f"the least with labels {MIN_LABEL_MM:g} mm high",
     "pieces": f"the least with every piece {MIN_PIECE_MM:g} mm across",
+    "material": "the least at which every fillet is as wide as the material bends",
 }
+
+
+def _material_lines(design) -> list[str]:
+    """The summary's line for the sheet material (none without one)."""
+    m = material_report(design)
+    if m is None:
+        return []
+    line = (
+        f"material: {m['name']}, {m['thickness_mm']:g} mm thick, fillets no tighter than "
+        f"{m['bend_floor_mm']:g} mm (least inner radius {m['min_bend_radius_mm']:g} mm + half "
+        f"the thickness)"
+    )
+    if m["least_fillet_radius_mm"] is not None:
+        line += f": {m['fillets']} fillets, the least {m['least_fillet_radius_mm']:.4g} mm"
+    lines = [line]
+    if m["tapering_fillets"] or m["cones"]:
+        lines.append(
+            f"  note: {m['cones']} cones and {m['tapering_fillets']} tapering fillets are not "
+            "yet held to the bend floor"
+        )
+    return lines
 
 
 def _size_lines(design) -> list[str]:
@@ -554,6 +607,7 @@ def design_summary(design, max_listed: int = 8) -> str:
         f"(relative {relative.max(initial=0.0):.2e})"
     )
     lines += _size_lines(design)
+    lines += _material_lines(design)
     if design.up_why != "given":
         lines.append(f"up: +{design.up} ({design.up_why}; in the pictures; --up to choose)")
     thin = thickness_ratio(mesh.vertices)

@@ -12,6 +12,7 @@ import time
 import numpy as np
 
 from ..errors import ParameterError, SolverError
+from ..rounding.bend import floor_size
 from ..surface.assemble import assemble_pattern
 from ..surface.module import Modules
 from ..surface.pattern import face_arrays
@@ -45,17 +46,21 @@ def tab_height(params, ref: float) -> float:
     return min(TAB_MM / params.mm_per_unit, TAB_MAX * ref)
 
 
-def default_size(extent: float, ref: float, smallest: float | None = None) -> tuple[float, str]:
+def default_size(
+    extent: float, ref: float, smallest: float | None = None, bend: float | None = None
+) -> tuple[float, str]:
     """The default size of an object whose mesh's largest side is ``extent`` and mean edge
     length ``ref``: the least largest side (mm) at which it can be built, rounded up to two
     significant digits, and what sets it.
 
-    Three lower bounds, the largest of which sets it (``"least"``, ``"labels"``,
-    ``"pieces"``): :data:`~filletfold.units.LEAST_SIZE_MM`; the size at which the labels
-    are :data:`~filletfold.units.MIN_LABEL_MM` high, tabs being at most :data:`TAB_MAX` of
-    the mean edge length and labels :data:`~filletfold.layout.tabs.LABEL_SHARE` of a tab;
-    and, given the ``smallest`` piece's span (pattern units), the size at which it spans
-    :data:`~filletfold.units.MIN_PIECE_MM`.
+    Four lower bounds, the largest of which sets it (``"least"``, ``"labels"``,
+    ``"pieces"``, ``"material"``): :data:`~filletfold.units.LEAST_SIZE_MM`; the size at which
+    the labels are :data:`~filletfold.units.MIN_LABEL_MM` high, tabs being at most
+    :data:`TAB_MAX` of the mean edge length and labels
+    :data:`~filletfold.layout.tabs.LABEL_SHARE` of a tab; given the ``smallest`` piece's span
+    (pattern units), the size at which it spans :data:`~filletfold.units.MIN_PIECE_MM`; and
+    ``bend``, the size (mm) at which every fillet holds the sheet material's bend floor
+    (:func:`~filletfold.rounding.bend.floor_size`).
 
     Returns
     -------
@@ -68,6 +73,8 @@ def default_size(extent: float, ref: float, smallest: float | None = None) -> tu
     }
     if smallest is not None and smallest > 0:
         bounds["pieces"] = extent * MIN_PIECE_MM / smallest
+    if bend is not None:
+        bounds["material"] = bend
     binding = max(bounds, key=bounds.__getitem__)
     return ceil_digits(bounds[binding]), binding
 
@@ -84,18 +91,24 @@ def smallest_span(pieces: list) -> float | None:
     return min(spans) if spans else None
 
 
-def settle_size(params, extent: float, ref: float, pieces: list | None):
+def settle_size(params, extent: float, ref: float, pieces: list | None, radius=None):
     """``params`` with the default size settled (unchanged unless ``size`` is
     :data:`~filletfold.units.AUTO_SIZE`): :func:`default_size` with the smallest of the laid
     out ``pieces`` (None: the labels and the least size only, the size pieces are first fitted
-    to sheets at), written as the size in millimetres it is (``"620mm"``), with
+    to sheets at) and, with a sheet material, the fillets' ``radius`` (mesh units: the size
+    at which they hold its bend floor), written as the size in millimetres it is (``"620mm"``), with
     the units (mm) and scale it gives, and the report's account of it (``{"size",
     "binding"}``; None when the size was given). A mesh of no extent gets no size."""
     if params.size != AUTO_SIZE:
         return params, None
     if not (extent > 0 and ref > 0):
         return params.replace(size=None), None
-    mm, binding = default_size(extent, ref, None if pieces is None else smallest_span(pieces))
+    material = params.sheet_material()
+    bend = None
+    if material is not None and radius is not None:  # the fillets hold the bend floor
+        bend = floor_size(extent, material.bend_floor_mm(), radius)
+    smallest = None if pieces is None else smallest_span(pieces)
+    mm, binding = default_size(extent, ref, smallest, bend)
     size = f"{mm:g}mm"
     return params.replace(size=size, units="mm", scale=mm / extent), {
         "size": size,
@@ -192,7 +205,8 @@ def arrange(
     ref = pm.mean_edge_length
     asked = params  # the size settles once the pieces are known (on sheets, before)
     extent = float(np.ptp(pm.vertices, axis=0).max(initial=0.0))
-    params, _ = settle_size(params, extent, ref, None)
+    radius = sol.rounding.radius  # the fillets as the vertices left them
+    params, _ = settle_size(params, extent, ref, None, radius)
     given = pieces  # the caller's list (``pieces`` may be rebound to laid-out copies)
     layout_used, layout_note = "modules", ""
     eps = tol.relative * ref
@@ -221,7 +235,7 @@ def arrange(
         pieces = net_pieces(pm, sol, mods.modules, mods.points, eps, sheet=room)
         layout_used = "net"
     labels_size = params.scale
-    params, default = settle_size(asked, extent, ref, pieces)
+    params, default = settle_size(asked, extent, ref, pieces, radius)
     if default is not None and sheet is not None and params.scale != labels_size:
         # the pieces ask for a larger size: fitted to the sheets again at it, if every
         # module fits one (else the labels' size stays, and the summary warns of them)
@@ -236,7 +250,7 @@ def arrange(
             if net:
                 pieces = net_pieces(pm, sol, mods.modules, mods.points, eps, sheet=room)
         else:
-            params, default = settle_size(asked, extent, ref, None)
+            params, default = settle_size(asked, extent, ref, None, radius)
     elif sheet is None:  # the tabs at the size settled
         tab_h, gap, _, _ = spacing(params, ref)
     if net and release_pieces:  # the nets hold copies: the modules, and what built them, go

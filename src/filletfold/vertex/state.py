@@ -60,6 +60,9 @@ class VertexState:
         ``progress(stage, done, total)``.
     work : ApexWork
         The apex solver's work over every solve of this state (counts).
+    bend_floor : float
+        The sheet material's bend floor (mesh units; 0: none): the rescue makes a fillet it
+        would shrink below it a crease instead (:func:`~filletfold.vertex.rescue.rescue_vertices`).
     """
 
     mesh: PolyMesh
@@ -78,6 +81,7 @@ class VertexState:
     cuts: dict = field(default_factory=dict)
     progress: Any = None
     work: ApexWork = field(default_factory=ApexWork)
+    bend_floor: float = 0.0
 
     def sharp_frames(self) -> np.ndarray:
         """(n_vertices,) bool: the vertices whose frames are built sharp."""
@@ -100,6 +104,8 @@ class VertexState:
         """
         mesh = self.mesh
         radius = shrink_broken(mesh, radius, self.rounding.half_angle)
+        if self.bend_floor > 0:  # a fillet the sheet cannot bend is a crease
+            radius = np.where(radius < self.bend_floor * (1 - 1e-9), 0.0, radius)
         rounding = round_edges(
             mesh, radius, flat_deg=self.flat_deg, floor=self.floor, min_width=self.min_width
         )

@@ -1,0 +1,154 @@
+"""Sheet materials (issue 31, first part): presets, overrides, the bend floor on the fillets,
+the least size, and the certificate's ``bend floor`` check."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+
+import numpy as np
+import pytest
+
+import filletfold
+from filletfold.check import certify, check_folder, design_bend_floor
+from filletfold.cli import main
+from filletfold.errors import ParameterError
+from filletfold.materials import MATERIALS, din6935_k_factor, resolve_material
+
+
+def _least_fillet_mm(design) -> float:
+    r = np.asarray(design.rounding.radius)
+    return float(r[r > 0].min()) * design.params.mm_per_unit
+
+
+def test_presets_and_their_bend_floor():
+    for name in ("card-300gsm", "aluminium-1mm", "plywood-3mm"):  # the issue's names
+        assert name in MATERIALS
+    for m in MATERIALS.values():
+        assert m.thickness_mm > 0 and m.min_bend_radius_mm >= 0 and 0 < m.k_factor <= 0.5
+        assert m.bend_floor_mm() == pytest.approx(m.min_bend_radius_mm + m.thickness_mm / 2)
+        assert m.making in ("score", "relief", "kerf")
+
+
+def test_din6935_k_factor():
+    assert din6935_k_factor(1.0, 1.0) == pytest.approx(0.325)  # k = 0.65 at r = t
+    assert din6935_k_factor(5.0, 1.0) == pytest.approx((0.65 + 0.5 * math.log10(5)) / 2)
+    assert din6935_k_factor(6.0, 1.0) == 0.5  # wide bends: the middle
+    assert din6935_k_factor(0.01, 1.0) == 0.25  # floored
+    ks = [din6935_k_factor(r, 1.0) for r in np.linspace(0.1, 8, 50)]
+    assert all(a <= b for a, b in itertools.pairwise(ks))
+
+
+def test_overrides_and_bad_values():
+    m = resolve_material("aluminium-1mm", thickness=2.0, k_factor=0.4)
+    assert (m.thickness_mm, m.min_bend_radius_mm, m.k_factor) == (2.0, 1.0, 0.4)
+    assert resolve_material(None) is None
+    custom = resolve_material(None, thickness=0.3, min_bend_radius=2.0)
+    assert custom.name == "custom" and custom.bend_floor_mm() == pytest.approx(2.15)
+    for kwargs, match in (
+        ({"name": "cardboard"}, "unknown material 'cardboard': choose from paper-120gsm"),
+        ({"name": None, "thickness": -1.0}, "thickness must be more than 0"),
+        ({"name": None, "thickness": math.nan}, "thickness"),
+        ({"name": None, "min_bend_radius": -0.1}, "min_bend_radius must be at least 0"),
+        ({"name": "card-300gsm", "k_factor": 1.5}, r"k-factor must be in \[0, 1\]"),
+    ):
+        with pytest.raises(ParameterError, match=match):
+            resolve_material(**kwargs)
+
+
+def test_a_given_size_widens_the_fillets_to_the_floor():
+    plain = filletfold.round_mesh("cube", size="5mm")
+    assert _least_fillet_mm(plain) == pytest.approx(0.5)  # 10 % of a 5 mm edge
+    card = filletfold.round_mesh("cube", size="5mm", material="card-300gsm")
+    assert _least_fillet_mm(card) == pytest.approx(1.2)  # 1 mm + 0.4 / 2
+    assert card.certificate.ok
+    (check,) = [c for c in card.certificate.checks if c.name == "bend floor"]
+    assert check.ok and check.value == pytest.approx(1.0)
+    assert "bend floor" not in {c.name for c in plain.certificate.checks}
+
+
+def test_a_size_too_small_names_the_least_size_that_holds():
+    with pytest.raises(
+        ParameterError, match=r"cannot hold .* --size 2mm; the least size .*: 2\.5mm"
+    ):
+        filletfold.round_mesh("cube", size="2mm", material="card-300gsm")
+    design = filletfold.round_mesh("cube", size="2.5mm", material="card-300gsm")
+    r = np.asarray(design.rounding.radius) * design.params.mm_per_unit
+    assert design.certificate.ok and (r[r > 0] >= 1.2 * (1 - 1e-9)).all()
+
+
+def test_the_default_size_grows_until_the_fillets_hold():
+    plain = filletfold.round_mesh("torus")
+    ply = filletfold.round_mesh("torus", material="plywood-3mm")
+    assert ply.fabrication["default_size"]["binding"] == "material"
+    grown = float(ply.params.size.removesuffix("mm"))
+    assert grown > float(plain.params.size.removesuffix("mm"))
+    assert _least_fillet_mm(ply) >= MATERIALS["plywood-3mm"].bend_floor_mm()
+    assert ply.certificate.ok
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "blob",  # the rescue halves fillets of blob under the floor (without it: 0.21 mm)
+        *(
+            pytest.param(n, marks=pytest.mark.slow)
+            for n in ("dimpled-cube", "house", "shell", "yoshimura")
+        ),
+    ],
+)
+def test_no_fillet_under_the_floor_after_the_vertices_changed_them(name):
+    """The rescue halves fillets of vertices it cannot solve: one it would halve under the
+    floor becomes a crease (radius 0), never a fillet tighter than the material bends."""
+    try:
+        design = filletfold.round_mesh(name, size="60mm", material="card-300gsm")
+    except ParameterError as exc:
+        assert "the least size that can" in str(exc) and "\n" not in str(exc)
+        return
+    r = np.asarray(design.rounding.radius) * design.params.mm_per_unit
+    assert (r[r > 0] >= 1.2 * (1 - 1e-9)).all()
+    assert design.certificate.ok
+
+
+def test_the_check_fails_a_fillet_under_the_floor():
+    design = filletfold.round_mesh("cube", size="50mm", material="card-300gsm")
+    floor = design_bend_floor(design.params)
+    rd, mesh = design.rounding, design.mesh
+    edges = {
+        "vertices": mesh.edges,
+        "faces": mesh.edge_faces,
+        "radius": rd.radius,
+        "half_angle": rd.half_angle,
+        "kappa": rd.kappa,
+    }
+    args = (design.pattern, mesh.vertices, mesh.faces, edges, design.vertices.apex)
+    held = certify(*args, bend_floor=floor)
+    assert held.ok
+    least = float(rd.radius[rd.radius > 0].min())
+    broken = certify(*args, bend_floor=least * 1.01)  # a material that bends less
+    (check,) = [c for c in broken.checks if c.name == "bend floor"]
+    assert not broken.ok and not check.ok and "12 below" in check.detail
+
+
+def test_the_command_writes_a_design_whose_check_measures_the_floor(tmp_path, capsys):
+    out = tmp_path / "cube"
+    assert (
+        main(["round", "cube", "--size", "50mm", "--material", "card-300gsm", "-o", str(out)]) == 0
+    )
+    summary = capsys.readouterr().out
+    assert "material: card-300gsm, 0.4 mm thick, fillets no tighter than 1.2 mm" in summary
+    report = json.loads((out / "report.json").read_text())
+    assert report["material"]["fillets_below_floor"] == 0
+    assert report["material"]["least_fillet_radius_mm"] == pytest.approx(5.0)
+    cert = check_folder(out)
+    assert cert.ok and "bend floor" in {c.name for c in cert.checks}
+    # a thicker sheet written into the report: the files no longer hold it
+    report["parameters"]["min_bend_radius"] = 6.0
+    (out / "report.json").write_text(json.dumps(report))
+    assert not check_folder(out).ok
+    assert main(["round", "cube", "--material", "cardboard", "-o", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown material 'cardboard'" in err
+    assert main(["materials"]) == 0
+    assert "plywood-3mm" in capsys.readouterr().out
