@@ -152,3 +152,48 @@ def test_the_command_writes_a_design_whose_check_measures_the_floor(tmp_path, ca
     assert err.count("\n") == 1 and "unknown material 'cardboard'" in err
     assert main(["materials"]) == 0
     assert "plywood-3mm" in capsys.readouterr().out
+
+
+def _cone(alpha: float, s0: float, s1: float, n: int = 60, triangles: bool = False):
+    """A faceted half cone of half-angle ``alpha``, apex at the origin, from ``s0`` to ``s1``
+    along its rulings (``s0 = 0``: it reaches its apex)."""
+    phi = np.linspace(0, np.pi, n)
+    d = np.c_[np.sin(alpha) * np.cos(phi), np.sin(alpha) * np.sin(phi), -np.cos(alpha) + 0 * phi]
+    points = np.r_[s0 * d, s1 * d]
+    if triangles:
+        faces = [f for i in range(n - 1) for f in ([i, i + 1, n + i + 1], [i, n + i + 1, n + i])]
+    else:
+        faces = [[i, i + 1, n + i + 1, n + i] for i in range(n - 1)]
+    flat = np.array(faces).ravel()
+    start = np.r_[0, np.cumsum([len(f) for f in faces])]
+    return points, flat, start, np.zeros(len(faces), dtype=np.int64)
+
+
+@pytest.mark.parametrize("triangles", [False, True])
+def test_a_cone_bends_at_s_tan_alpha(triangles):
+    from filletfold.surface.bend import cone_bend_radii
+
+    alpha = np.radians(35)
+    points, flat, start, cone = _cone(alpha, 2.0, 5.0, triangles=triangles)
+    radius, u, rate = cone_bend_radii(points, flat, start, cone, np.zeros((1, 3)))
+    assert len(radius) == 58 and (u == 0).all()  # the rulings, not the flat diagonals
+    assert radius.min() == pytest.approx(2.0 * np.tan(alpha), rel=1e-3)
+    assert rate == pytest.approx(np.tan(alpha), rel=1e-3)
+    # a fan of triangles from its apex: it bends tighter than a floor f within f / tan(alpha)
+    points, flat, start, cone = _cone(alpha, 0.0, 5.0)
+    points = np.r_[np.zeros((1, 3)), points[60:]]
+    flat = np.array([[0, 1 + i, 2 + i] for i in range(59)]).ravel()
+    start = np.arange(0, len(flat) + 1, 3)
+    radius, _, rate = cone_bend_radii(points, flat, start, cone, np.zeros((1, 3)))
+    assert radius.min() == 0 and rate == pytest.approx(np.tan(alpha), rel=1e-3)
+
+
+def test_the_report_gives_the_cones_tip_zones(tmp_path, capsys):
+    out = tmp_path / "blob"
+    assert (
+        main(["round", "blob", "--size", "100mm", "--material", "aluminium-1mm", "-o", str(out)])
+        == 0
+    )
+    assert "the cones bend tighter than that within" in capsys.readouterr().out
+    tips = json.loads((out / "report.json").read_text())["material"]["cone_tip_zones"]
+    assert tips["cones"] > 100 and 0 < tips["median_mm"] <= tips["max_mm"] < 100

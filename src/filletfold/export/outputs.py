@@ -13,6 +13,7 @@ from ..errors import named_stages
 from ..layout.tabs import assembly_text
 from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
+from ..surface.bend import cone_tip_zones
 from ..surface.pattern import LabelRows, face_arrays
 from ..surface.validate import face_signed_area_2d
 from ..tolerances import tol
@@ -123,8 +124,10 @@ def material_report(design) -> dict | None:
     """The sheet material and what it did (None without one): its figures
     (:meth:`~filletfold.materials.Material.as_dict`), the size (mm) and the fillets against
     its bend floor: how many, the least radius (mm), how many below the floor (0 in a valid
-    design) and the tapering fillets, which narrow to their sharp corner and are not held to
-    it."""
+    design); the tapering fillets, which narrow to their sharp corner and are not held to
+    it; and the cones' tip zones (:func:`~filletfold.surface.bend.cone_tip_zones`: within
+    what distance of its apex a cone bends tighter than the floor; median, largest and
+    where), in mm."""
     p = design.params
     material = p.sheet_material()
     if material is None:
@@ -135,6 +138,18 @@ def material_report(design) -> dict | None:
     patches = {str(x) for x in design.pattern.face_patch}
     floor = material.bend_floor_mm()
     least = float(rounded.min()) * mm if (mm is not None and len(rounded)) else None
+    tips = None
+    if mm is not None and floor > 0:
+        zone = cone_tip_zones(design.pattern, design.vertices.apex, floor / mm) * mm
+        held = np.flatnonzero(np.isfinite(zone))
+        if len(held):
+            worst = int(held[np.argmax(zone[held])])
+            tips = {
+                "cones": len(held),
+                "median_mm": float(np.median(zone[held])),
+                "max_mm": float(zone[worst]),
+                "max_at_vertex": worst,
+            }
     return {
         **material.as_dict(),
         "size": p.size,
@@ -145,7 +160,12 @@ def material_report(design) -> dict | None:
         ),
         "tapering_fillets": sum(x.startswith("fillet ") for x in patches),
         "cones": sum(x.startswith("cone ") for x in patches),
-        "not_held": "cones and tapering fillets are not yet held to the bend floor",
+        "cone_tip_zones": tips,
+        "not_held": (
+            "a cone bends tighter than the floor near its tip (cone_tip_zones: within that "
+            "distance of its apex) and a tapering fillet near its sharp corner: relieve or "
+            "crease the sheet there"
+        ),
     }
 
 
@@ -504,10 +524,17 @@ def _material_lines(design) -> list[str]:
     if m["least_fillet_radius_mm"] is not None:
         line += f": {m['fillets']} fillets, the least {m['least_fillet_radius_mm']:.4g} mm"
     lines = [line]
-    if m["tapering_fillets"] or m["cones"]:
+    tips = m["cone_tip_zones"]
+    if tips is not None and tips["max_mm"] > 0:
         lines.append(
-            f"  note: {m['cones']} cones and {m['tapering_fillets']} tapering fillets are not "
-            "yet held to the bend floor"
+            f"  note: the cones bend tighter than that within {tips['median_mm']:.3g} mm of "
+            f"their tips (median of {tips['cones']}; {tips['max_mm']:.3g} mm at vertex "
+            f"{tips['max_at_vertex']}): relieve or crease the sheet there"
+        )
+    if m["tapering_fillets"]:
+        lines.append(
+            f"  note: {m['tapering_fillets']} tapering fillets narrow to their sharp corner: "
+            "crease the sheet there"
         )
     return lines
 

@@ -5,5 +5,5 @@ folded positions, built for all vertices at once (:mod:`.module`; the fans of sh
 that no cone's facets fold by more than the arc step (:mod:`.sampling`), the crease
 pattern they assemble into (:mod:`.assemble`, :mod:`.pattern`; each face on a patch of
 :mod:`.patch`), its validation
-(:mod:`.validate`), the triangles of its faces (:mod:`.triangulate`) and its coarse copy for
-Origami Simulator (:mod:`.coarse`)."""
+(:mod:`.validate`), the triangles of its faces (:mod:`.triangulate`), its coarse copy for
+Origami Simulator (:mod:`.coarse`), and how tightly its cones bend (:mod:`.bend`)."""
