@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..arrays import round_significant, run_owners, run_starts
+from ..arrays import round_significant, run_next, run_owners, run_starts, split_runs
 from ..errors import ParameterError
 from .patch import RULED_KINDS, patch_ids, patch_kinds
 from .pattern import Annotations, CreasePattern, edge_dihedrals, face_arrays
@@ -234,6 +234,16 @@ def _split_faces(pattern: CreasePattern) -> list[np.ndarray]:
     return [flat[a:b].astype(np.int64) for a, b in itertools.pairwise(start)]
 
 
+def _loop_sides(loops: list) -> np.ndarray:
+    """(k, 2) int: every side of the polygons ``loops`` (each a sequence of points), from
+    each corner to the next, the last back to the first; the polygons one after another."""
+    if not loops:
+        return np.zeros((0, 2), dtype=np.int64)
+    flat = np.concatenate([np.asarray(f, dtype=np.int64).reshape(-1) for f in loops])
+    start = run_starts([len(f) for f in loops])
+    return np.stack([flat, flat[run_next(start)]], axis=1)
+
+
 def _ruled_strips(pattern: CreasePattern, faces: list[np.ndarray], edge_faces: np.ndarray):
     """Each connected cylinder or conical fillet strip, as a tuple: its faces, its points, each
     point's place along the rulings (flat), its rulings (k, 2) (sides of its faces along the
@@ -249,9 +259,12 @@ def _ruled_strips(pattern: CreasePattern, faces: list[np.ndarray], edge_faces: n
     label = _components(len(faces), edge_faces[same])
     v2 = pattern.vertices_2d
     key = pattern.edges[:, 0] * len(v2) + pattern.edges[:, 1]  # sorted
-    for comp in np.unique(label[ruled]).tolist():
-        members = np.nonzero(label == comp)[0]
-        sides = np.concatenate([np.c_[faces[f], np.roll(faces[f], -1)] for f in members.tolist()])
+    order = np.argsort(label, kind="stable")  # each component's faces, ascending
+    cut = np.nonzero(np.diff(label[order]))[0] + 1
+    for members in split_runs(order, cut):
+        if not len(members) or not ruled[members[0]]:  # a strip's faces are all ruled
+            continue
+        sides = _loop_sides([faces[f] for f in members.tolist()])
         sides = np.unique(np.sort(sides, axis=1), axis=0)
         pos = np.clip(np.searchsorted(key, sides[:, 0] * len(v2) + sides[:, 1]), 0, len(key) - 1)
         side_inner = same[pos]
@@ -354,6 +367,8 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
         elif length < scale * bound:
             proposals.append(np.asarray(rulings, dtype=np.int64).reshape(-1, 2))
     active = np.ones(len(proposals), dtype=bool)
+    proposed = np.concatenate([np.zeros((0, 2), dtype=np.int64), *proposals])
+    proposer = run_owners([len(p) for p in proposals])  # (k,) the strip of each pair
     verdicts: dict[tuple, bool] = {}  # a merged polygon's place -> broken
     shift = _shift_bound(pattern)
     while True:
@@ -367,7 +382,8 @@ def _collapse_narrow(pattern: CreasePattern, min_angle: float) -> CreasePattern:
             if broken is None:
                 break
         # the strips that merged a point of a broken face go back
-        hit = np.array([np.isin(rep[p], broken).any() for p in proposals]) & active
+        touched = np.isin(rep[proposed], broken).any(axis=1)
+        hit = (np.bincount(proposer[touched], minlength=len(proposals)) > 0) & active
         if not hit.any():  # cannot happen: a broken face has a merged point
             break
         active &= ~hit
@@ -397,8 +413,7 @@ def _crossed(v2: np.ndarray, loops: list, moved: np.ndarray):
 
     if not loops:
         return None
-    sides = np.concatenate([np.c_[f, np.roll(f, -1)] for f in map(np.asarray, loops)])
-    sides = np.unique(np.sort(sides, axis=1), axis=0)
+    sides = np.unique(np.sort(_loop_sides(loops), axis=1), axis=0)
     mine = np.nonzero(moved[sides].any(axis=1))[0]
     if not len(mine):
         return None
@@ -617,10 +632,10 @@ def _dropped_crease_points(
     fdeg = np.bincount(pairs.ravel(), minlength=n)
     candidate = on_cone & ~on_ruled & (fdeg == 2)
     # the apex of each cone patch: the corner its faces share most
-    apex: dict[str, int] = {}
-    for name in {names[f] for f in np.nonzero(cone)[0].tolist()}:
-        members = [faces[f] for f in range(len(faces)) if names[f] == name]
-        apex[name] = int(np.bincount(np.concatenate(members)).argmax())
+    members: dict[str, list[np.ndarray]] = {}
+    for f in np.nonzero(cone)[0].tolist():
+        members.setdefault(names[f], []).append(faces[f])
+    apex = {name: int(np.bincount(np.concatenate(m)).argmax()) for name, m in members.items()}
     link = pairs[candidate[pairs].any(axis=1)]
     neighbours: dict[int, list[int]] = {}
     for a, b in link.tolist():
@@ -707,7 +722,7 @@ def _clean_slivers(
                 continue
             moves += 1
             _apply_move(live, move)
-            sides.add(_new_sides(tri, move), tri[alive])
+            sides.add(_new_sides(tri, move), tri, alive)
         tri, patch = tri[alive], [p for p, a in zip(patch, alive, strict=True) if a]
         piece = piece[alive]
         if not moves:
@@ -829,25 +844,41 @@ class _FlatSides:
         self.v2 = v2
         self.on_border = np.zeros(len(v2), dtype=bool)
         self.on_border[np.asarray(border, dtype=np.int64).ravel()] = True
+        self.key = np.zeros(0, dtype=np.int64)
+        self.lines = np.zeros(0, dtype=object)
+        self.drawn = v2.copy()  # the points as the tree's lines have them
         self.rebuild(tri)
 
     def rebuild(self, tri: np.ndarray) -> None:
-        """Start again from the triangles ``tri`` (k, 3)."""
+        """Start again from the triangles ``tri`` (k, 3). The lines of the sides the last
+        tree had, neither of whose ends has moved since, are taken over (the same lines:
+        the same tree); only the others are made."""
         import shapely
 
         n = len(self.v2)
         ends = _triangle_sides(tri)
         key = np.unique(ends[:, 0] * n + ends[:, 1])
-        self.sides = np.stack([key // n, key % n], axis=1)
-        self.tree = shapely.STRtree(shapely.linestrings(self.v2[self.sides]))
+        sides = np.stack([key // n, key % n], axis=1)
+        lines = np.empty(len(key), dtype=object)
+        old = np.zeros(len(key), dtype=bool)
+        if len(self.key):
+            at = np.minimum(np.searchsorted(self.key, key), len(self.key) - 1)
+            still = ~(self.v2 != self.drawn).any(axis=1)  # points not moved since
+            old = (self.key[at] == key) & still[sides].all(axis=1)
+            lines[old] = self.lines[at[old]]
+        if not old.all():
+            lines[~old] = shapely.linestrings(self.v2[sides[~old]])
+        self.key, self.sides, self.lines = key, sides, lines
+        self.drawn[:] = self.v2
+        self.tree = shapely.STRtree(lines)
         self.added = np.zeros((0, 2), dtype=np.int64)
 
-    def add(self, sides: np.ndarray, tri: np.ndarray) -> None:
-        """Sides (k, 2) just made; ``tri`` the live triangles, to start again from when the
-        list is long."""
+    def add(self, sides: np.ndarray, tri: np.ndarray, alive: np.ndarray) -> None:
+        """Sides (k, 2) just made; ``tri`` (m, 3) the triangles and ``alive`` (m,) bool which
+        of them are live, to start again from when the list is long."""
         self.added = np.concatenate([self.added, np.asarray(sides, dtype=np.int64)])
         if len(self.added) > SIDES_REBUILD:
-            self.rebuild(tri)
+            self.rebuild(tri[alive])
 
     def crossed(self, new: np.ndarray, gone: int, moved=None) -> bool:
         """Whether a side of ``new`` (k, 2) crosses or touches, flat, a side it shares no
@@ -1137,7 +1168,7 @@ def _merged_patches(
         touch = gone[pattern.edges].any(axis=1)
         label = _components(len(faces), edge_faces[same & touch])
         order = np.argsort(label, kind="stable")
-        groups = np.split(order, np.nonzero(np.diff(label[order]))[0] + 1)
+        groups = split_runs(order, np.nonzero(np.diff(label[order]))[0] + 1)
         out, back = [], []
         for group in groups:
             points = np.unique(np.concatenate([faces[f] for f in group.tolist()]))
