@@ -20,6 +20,7 @@ from scipy.spatial import cKDTree
 import filletfold
 from filletfold.errors import ParameterError
 from filletfold.export import cut_files
+from filletfold.surface import coarse
 from filletfold.surface.coarse import (
     SIM_MAX_STRETCH,
     SIM_MIN_ANGLE,
@@ -510,3 +511,63 @@ def test_move_qualities_are_each_moves_own_quality(seed, n_moves):
         moves.append((k, moved))
     one_by_one = [_move_quality(k, v2, v3, moved, shift) for k, moved in moves]
     np.testing.assert_array_equal(_move_qualities(moves, v2, v3, shift), one_by_one)
+
+
+class _OneTree:
+    """The sides of :class:`~filletfold.surface.coarse._FlatSides` as one search tree of the
+    sides taken last, made again whole each time (what the two trees stand for)."""
+
+    def __init__(self, tri, v2, border, at):
+        self.v2 = v2
+        self.on_border = np.zeros(len(v2), dtype=bool)
+        self.on_border[np.asarray(border, dtype=np.int64).ravel()] = True
+        self.rebuild(tri)
+
+    def rebuild(self, tri):
+        import shapely
+
+        n = len(self.v2)
+        ends = coarse._triangle_sides(tri)
+        key = np.unique(ends[:, 0] * n + ends[:, 1])
+        self.sides = np.stack([key // n, key % n], axis=1)
+        self.tree = shapely.STRtree(shapely.linestrings(self.v2[self.sides]))
+        self.added = np.zeros((0, 2), dtype=np.int64)
+
+    def add(self, gone, sides, tri, alive):
+        self.added = np.concatenate([self.added, np.asarray(sides, dtype=np.int64)])
+        if len(self.added) > coarse.SIDES_REBUILD:
+            self.rebuild(tri[alive])
+
+    def _taken_pairs(self, new, lines):
+        i, j = self.tree.query(lines, predicate="intersects")
+        return [(new[i], self.sides[j])]
+
+    crossed = coarse._FlatSides.crossed
+
+
+@pytest.mark.parametrize("name", CORPUS_DESIGNS[:2])
+def test_flat_sides_find_what_one_tree_of_the_sides_taken_last_finds(name, monkeypatch):
+    """The sliver moves' search trees of the sides (the sides taken again one by one where
+    they changed, a tree of those since the large one was made) cross the same sides as one
+    tree made whole each time: the same coarse pattern, with the sides taken after every
+    few made so that both trees, and the large one made again, are used many times."""
+    pattern = _design(name).pattern
+    monkeypatch.setattr(coarse, "SIDES_REBUILD", 2)
+    calls = dict.fromkeys(("__init__", "_retake", "rebuild"), 0)
+    for method in calls:
+        real = getattr(coarse._FlatSides, method)
+
+        def counted(self, *args, _real=real, _method=method):
+            calls[_method] += 1
+            return _real(self, *args)
+
+        monkeypatch.setattr(coarse._FlatSides, method, counted)
+    fast = simulator_pattern(pattern)
+    # sides taken again many times, and the large tree made again besides once per round
+    assert calls["_retake"] > 100 and calls["rebuild"] > calls["__init__"]
+    monkeypatch.setattr(coarse, "_FlatSides", _OneTree)
+    slow = simulator_pattern(pattern)
+    np.testing.assert_array_equal(fast.vertices_2d, slow.vertices_2d)
+    np.testing.assert_array_equal(fast.vertices_3d, slow.vertices_3d)
+    np.testing.assert_array_equal(np.asarray(fast.faces), np.asarray(slow.faces))
+    assert list(fast.face_patch) == list(slow.face_patch)

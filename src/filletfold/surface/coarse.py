@@ -712,7 +712,7 @@ def _clean_slivers(
             for v in corners:
                 at[v].add(f)
         moves = 0
-        sides = _FlatSides(tri, v2, current.edges[current.edge_assignment == "B"])
+        sides = _FlatSides(tri, v2, current.edges[current.edge_assignment == "B"], at)
         live = _Triangles(tri, alive, at, v2, v3, is_feature, fdeg, patch, shift, sides)
         for t in bad[np.argsort(quality[bad], kind="stable")].tolist():
             if not alive[t]:
@@ -721,8 +721,9 @@ def _clean_slivers(
             if move is None:
                 continue
             moves += 1
+            gone = _triangle_sides(tri[move[0]])  # the changed triangles' sides before
             _apply_move(live, move)
-            sides.add(_new_sides(tri, move), tri, alive)
+            sides.add(gone, _new_sides(tri, move), tri, alive)
         tri, patch = tri[alive], [p for p, a in zip(patch, alive, strict=True) if a]
         piece = piece[alive]
         if not moves:
@@ -837,48 +838,103 @@ def _apart(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 class _FlatSides:
     """The sides of a triangulation's flat layout, to look up which sides a new one crosses
     (a collapse along a border moves the border, which can then cut across a thin notch of
-    its piece): a search tree of the sides as they were when it was last made, and a list
-    of the sides made since, made into the tree again every ``SIDES_REBUILD`` of them."""
+    its piece): the sides as they were when they were last taken (at the start and after
+    every ``SIDES_REBUILD`` sides made), each where its ends were then, and a list of the
+    sides made since.
 
-    def __init__(self, tri: np.ndarray, v2: np.ndarray, border: np.ndarray):
+    The sides taken are kept in two search trees: one of all the sides taken at some time,
+    each with a flag saying whether it is still one of the sides taken last (a side no
+    triangle has any more, or one whose end has moved since, is not: a side whose end moved
+    is taken again where it is now), and a smaller one of the sides taken since the large
+    tree was made, made again each time; the large one is made again, of the sides taken
+    last alone, when the small one holds a quarter of its sides. Both give the sides that a
+    single tree of the sides taken last gives, at a cost that grows with the sides made
+    since instead of with all of them."""
+
+    def __init__(self, tri: np.ndarray, v2: np.ndarray, border: np.ndarray, at: list):
         self.v2 = v2
+        self.at = at  # each point's live triangles, as the moves keep them
         self.on_border = np.zeros(len(v2), dtype=bool)
         self.on_border[np.asarray(border, dtype=np.int64).ravel()] = True
-        self.key = np.zeros(0, dtype=np.int64)
-        self.lines = np.zeros(0, dtype=object)
-        self.drawn = v2.copy()  # the points as the tree's lines have them
         self.rebuild(tri)
 
     def rebuild(self, tri: np.ndarray) -> None:
-        """Start again from the triangles ``tri`` (k, 3). The lines of the sides the last
-        tree had, neither of whose ends has moved since, are taken over (the same lines:
-        the same tree); only the others are made."""
+        """Start again from the triangles ``tri`` (k, 3): every side in the large tree."""
         import shapely
 
         n = len(self.v2)
         ends = _triangle_sides(tri)
         key = np.unique(ends[:, 0] * n + ends[:, 1])
-        sides = np.stack([key // n, key % n], axis=1)
-        lines = np.empty(len(key), dtype=object)
-        old = np.zeros(len(key), dtype=bool)
-        if len(self.key):
-            at = np.minimum(np.searchsorted(self.key, key), len(self.key) - 1)
-            still = ~(self.v2 != self.drawn).any(axis=1)  # points not moved since
-            old = (self.key[at] == key) & still[sides].all(axis=1)
-            lines[old] = self.lines[at[old]]
-        if not old.all():
-            lines[~old] = shapely.linestrings(self.v2[sides[~old]])
-        self.key, self.sides, self.lines = key, sides, lines
-        self.drawn[:] = self.v2
-        self.tree = shapely.STRtree(lines)
+        self.sides = np.stack([key // n, key % n], axis=1)
+        self.tree = shapely.STRtree(shapely.linestrings(self.v2[self.sides]))
+        self.taken = np.ones(len(key), dtype=bool)  # per side of both trees: taken last
+        self.entry = dict(zip(key.tolist(), range(len(key)), strict=True))  # key -> side
+        self.recent = np.zeros((0, 2), dtype=np.int64)  # the small tree's sides
+        self.recent_lines = np.zeros(0, dtype=object)
+        self.recent_tree = None
+        self.drawn = self.v2.copy()  # the points where the sides taken last have them
+        self.touched: set[int] = set()  # keys of the sides made or unmade since
         self.added = np.zeros((0, 2), dtype=np.int64)
 
-    def add(self, sides: np.ndarray, tri: np.ndarray, alive: np.ndarray) -> None:
-        """Sides (k, 2) just made; ``tri`` (m, 3) the triangles and ``alive`` (m,) bool which
-        of them are live, to start again from when the list is long."""
-        self.added = np.concatenate([self.added, np.asarray(sides, dtype=np.int64)])
+    def add(self, gone: np.ndarray, sides: np.ndarray, tri: np.ndarray, alive: np.ndarray):
+        """The sides (k, 2) of the triangles a move changed, ``gone`` as they were and
+        ``sides`` as they are now; ``tri`` (m, 3) the triangles and ``alive`` (m,) bool
+        which of them are live, whose sides are taken again when the list is long."""
+        sides = np.asarray(sides, dtype=np.int64).reshape(-1, 2)
+        n = len(self.v2)
+        self.touched.update((np.r_[gone.reshape(-1, 2), sides] @ [n, 1]).tolist())
+        self.added = np.concatenate([self.added, sides])
         if len(self.added) > SIDES_REBUILD:
+            self._retake(tri, alive)
+
+    def _retake(self, tri: np.ndarray, alive: np.ndarray) -> None:
+        """Take the sides of the live triangles again (the sides made or unmade since, and
+        those at a point moved since, looked at one by one)."""
+        import shapely
+
+        n, at = len(self.v2), self.at
+        moved = np.flatnonzero((self.v2 != self.drawn).any(axis=1))
+        self.drawn[moved] = self.v2[moved]
+        keys = self.touched
+        for v in moved.tolist():  # every side at a moved point: taken where it is now
+            keys.update(min(v, x) * n + max(v, x) for f in at[v] for x in tri[f].tolist())
+        moved = set(moved.tolist())
+        new = []
+        for k in sorted(keys):
+            a, b = divmod(k, n)
+            live = a != b and bool(at[a] & at[b])  # a live triangle has both ends
+            e = self.entry.get(k)
+            if e is not None and (not live or a in moved or b in moved):
+                self.taken[e] = False
+                del self.entry[k]
+                e = None
+            if live and e is None:
+                self.entry[k] = len(self.taken) + len(new)
+                new.append(k)
+        self.touched = set()
+        self.added = np.zeros((0, 2), dtype=np.int64)
+        if len(self.recent) + len(new) > max(16 * SIDES_REBUILD, len(self.sides) // 4):
             self.rebuild(tri[alive])
+            return
+        if not new:
+            return
+        key = np.array(new, dtype=np.int64)
+        sides = np.stack([key // n, key % n], axis=1)
+        self.taken = np.concatenate([self.taken, np.ones(len(new), dtype=bool)])
+        self.recent = np.concatenate([self.recent, sides])
+        self.recent_lines = np.concatenate([self.recent_lines, shapely.linestrings(self.v2[sides])])
+        self.recent_tree = shapely.STRtree(self.recent_lines)
+
+    def _taken_pairs(self, new: np.ndarray, lines) -> list:
+        """(new side, side taken last) pairs whose lines meet, from both trees."""
+        i, j = self.tree.query(lines, predicate="intersects")
+        ok = self.taken[j]
+        out = [(new[i[ok]], self.sides[j[ok]])]
+        if self.recent_tree is not None:
+            i, j = self.recent_tree.query(lines, predicate="intersects")
+            ok = self.taken[len(self.sides) + j]
+            out.append((new[i[ok]], self.recent[j[ok]]))
+        return out
 
     def crossed(self, new: np.ndarray, gone: int, moved=None) -> bool:
         """Whether a side of ``new`` (k, 2) crosses or touches, flat, a side it shares no
@@ -891,8 +947,7 @@ class _FlatSides:
         if moved is not None:
             p = np.where((new == moved[0])[:, :, None], moved[1], p)
         lines = shapely.linestrings(p)
-        i, j = self.tree.query(lines, predicate="intersects")
-        others = [(new[i], self.sides[j])]
+        others = self._taken_pairs(new, lines)
         if len(self.added):  # boxes first, then the segments whose boxes meet
             q = self.v2[self.added]  # (m, 2, 2)
             lo, hi, lo2, hi2 = p.min(axis=1), p.max(axis=1), q.min(axis=1), q.max(axis=1)
