@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..arrays import run_starts
 from ..errors import ParameterError
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
@@ -261,7 +262,9 @@ def _pages(pattern, tiles, page, units, scale, margin_mm):
 
 
 def _drawing_mm(pattern: CreasePattern, k: float) -> dict:
-    """Polylines (in drawing mm) of every layer, and the labels."""
+    """Polylines (in drawing mm) of every layer, and the labels; ``BOXES`` the polylines'
+    boxes per layer (:func:`_line_boxes`), ``LABEL_AT`` (k, 2) and ``LABEL_HEIGHT`` (k,) the
+    labels' anchors and heights, to find what a page shows."""
     v = pattern.vertices_2d * k
     out = {}
     for layer, mask in edge_layer_masks(pattern).items():
@@ -289,18 +292,28 @@ def _drawing_mm(pattern: CreasePattern, k: float) -> dict:
         )
         for lb in ann.labels
     ]
+    out["BOXES"] = {layer: _line_boxes(out[layer]) for layer in out if layer != "LABEL"}
+    out["LABEL_AT"] = np.array([pos for pos, _, _, _ in out["LABEL"]]).reshape(-1, 2)
+    out["LABEL_HEIGHT"] = np.array([h for _, _, _, h in out["LABEL"]], dtype=np.float64)
     return out
 
 
-def _in_box(lines: list, box) -> list:
-    """The polylines whose bounding box meets ``box``."""
+def _line_boxes(lines: list) -> np.ndarray:
+    """(k, 4) ``(xmin, ymin, xmax, ymax)`` of each of the polylines ``lines`` (each (m, 2),
+    m >= 1)."""
+    if not lines:
+        return np.zeros((0, 4))
+    points = np.concatenate(lines)
+    start = run_starts([len(p) for p in lines])[:-1]
+    return np.c_[np.minimum.reduceat(points, start), np.maximum.reduceat(points, start)]
+
+
+def _in_box(lines: list, boxes: np.ndarray, box) -> list:
+    """The polylines whose bounding box (a row of ``boxes``, :func:`_line_boxes`) meets
+    ``box``."""
     x0, y0, x1, y1 = box
-    keep = []
-    for p in lines:
-        lo, hi = p.min(axis=0), p.max(axis=0)
-        if hi[0] >= x0 and lo[0] <= x1 and hi[1] >= y0 and lo[1] <= y1:
-            keep.append(p)
-    return keep
+    meets = (boxes[:, 2] >= x0) & (boxes[:, 0] <= x1) & (boxes[:, 3] >= y0) & (boxes[:, 1] <= y1)
+    return [lines[i] for i in np.flatnonzero(meets).tolist()]
 
 
 def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: float):
@@ -327,7 +340,9 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
         ("TAB", TAB_HINGE_COLOR, lw, (0, (4, 3))),
     ]
     for layer, color, width_pt, style in styles:
-        lines = _in_box(layers.get(layer, []), tile.box)
+        if layer not in layers:
+            continue
+        lines = _in_box(layers[layer], layers["BOXES"][layer], tile.box)
         if not lines:
             continue
         lc = LineCollection(
@@ -337,9 +352,11 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
         lc.set_joinstyle("round")
         ax.add_collection(lc)
         lc.set_clip_path(clip)
-    for pos, text, angle, h in layers["LABEL"]:
-        if not (x0 - 5 * h <= pos[0] <= x1 + 5 * h and y0 - 5 * h <= pos[1] <= y1 + 5 * h):
-            continue
+    at, reach = layers["LABEL_AT"], 5 * layers["LABEL_HEIGHT"]
+    near = (x0 - reach <= at[:, 0]) & (at[:, 0] <= x1 + reach)
+    near &= (y0 - reach <= at[:, 1]) & (at[:, 1] <= y1 + reach)
+    for i in np.flatnonzero(near).tolist():
+        pos, text, angle, h = layers["LABEL"][i]
         t = ax.text(
             *(pos + shift),
             text,
