@@ -176,6 +176,7 @@ class _View:
         seen = self.owner[self.owner >= 0]
         self.pixels = np.bincount(seen, minlength=n)  # samples seen per piece
         self.by_piece = None  # the pixels of each piece, made on the first repaint
+        self.faces_of = None  # the faces of each piece, likewise
         self.rgb = np.ones((n_faces + 1, 3), dtype=np.float32)
         self.img = np.ones((self.h * self.w, 3), dtype=np.float32)
 
@@ -210,8 +211,9 @@ class _View:
         """:meth:`paint` after only the faces of ``pieces`` changed."""
         if self.by_piece is None:
             self.by_piece = self._pixels_by_piece()
+            self.faces_of = _faces_by_piece(self.piece, len(self.pixels))
         for k in pieces:
-            faces = np.flatnonzero(self.piece == k)
+            faces = self.faces_of[k]
             self.rgb[faces] = self._lit(face_rgb, faint, faces)
             at = self.by_piece[k]
             self.img[at] = self.rgb[self.samples[at]].mean(axis=1)
@@ -238,6 +240,14 @@ class _View:
         at = sums / np.where(total > 0, total, 1.0)[:, None]
         xy = project(at, p.vertices_3d, self.w, self.h, self.azim, self.elev, self.up)
         return xy, (facing @ self.eye > 0) & (total > 0) & (self.pixels > 0)
+
+
+def _faces_by_piece(face_piece: np.ndarray, n: int) -> list[np.ndarray]:
+    """The faces of each of the ``n`` pieces, ascending: ``face_piece`` (n_faces,) int the
+    piece of each face (one outside ``0 .. n - 1`` is in none)."""
+    order = np.argsort(face_piece, kind="stable")
+    bounds = np.searchsorted(face_piece[order], np.arange(n + 1))
+    return [order[a:b] for a, b in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True)]
 
 
 def _place(fig, image: np.ndarray, x: float, y: float):
@@ -303,14 +313,18 @@ def assembly_pages(
     rgb = np.where(inside[:, None], palette[state[np.clip(piece, 0, None)]], _DONE)
     for view in views:
         view.paint(rgb, inside)
+    face_state = np.where(inside, state[np.clip(piece, 0, None)], 1)
+    rgb, faint = palette[face_state], face_state == 0
+    faces_of = _faces_by_piece(piece, n)
     for first in range(0, len(steps), STEPS_PER_PAGE):
         fig = Figure(figsize=size_in, dpi=dpi)
         for slot, step in enumerate(steps[first : first + STEPS_PER_PAGE]):
             changed = [*np.flatnonzero(state == 2).tolist(), step.piece]
             state[state == 2] = 1
             state[step.piece] = 2
-            face_state = np.where(inside, state[np.clip(piece, 0, None)], 1)
-            rgb, faint = palette[face_state], face_state == 0
+            for k in changed:  # the faces of the pieces whose state changed
+                rgb[faces_of[k]] = palette[state[k]]
+                faint[faces_of[k]] = state[k] == 0
             images = [view.repaint(changed, rgb, faint) for view in views]
             best = max(range(len(views)), key=lambda v: views[v].pixels[step.piece])
             row, col = divmod(slot, 2)
