@@ -147,13 +147,14 @@ class _Model:
         """One run: a degree-3 curve through ``points`` with ``spline``, else a line (two
         points) or a polyline (closed: back to its first point)."""
         r = self.r
-        pts = [r.Point3d(*map(float, p)) for p in points]
         if spline:
             curve = _interpolating_curve(r, np.asarray(points, dtype=np.float64))
-        elif len(pts) == 2 and not closed:
-            curve = r.LineCurve(pts[0], pts[1])
         else:
-            curve = r.PolylineCurve([*pts, pts[0]] if closed else pts)
+            pts = [r.Point3d(x, y, z) for x, y, z in np.asarray(points, dtype=float).tolist()]
+            if len(pts) == 2 and not closed:
+                curve = r.LineCurve(pts[0], pts[1])
+            else:
+                curve = r.PolylineCurve([*pts, pts[0]] if closed else pts)
         self.file.Objects.AddCurve(curve, self.attributes(layer))
 
     def encode(self) -> bytes:
