@@ -563,10 +563,11 @@ def _dropped_rulings(
     gone = np.zeros(len(v2), dtype=bool)
     bound = math.tan(math.radians(min_angle))
     strips = _ruled_strips(pattern, faces, edge_faces)
+    key = pattern.edges[:, 0] * len(v2) + pattern.edges[:, 1]  # sorted
     for _, _, _, rulings, is_inner, at, width, length in strips:
         if not is_inner.any():
             continue
-        turn = _strip_turn(pattern, rulings[is_inner], at[is_inner], dihedral)
+        turn = _strip_turn(key, len(v2), rulings[is_inner], at[is_inner], dihedral)
         by_turn = math.ceil(turn / max_turn - 1e-9) if turn > 0 else 1
         by_width = math.floor(width / (1.5 * length * bound)) if bound > 0 else len(rulings) + 1
         cells = max(1, min(by_turn, by_width))
@@ -574,28 +575,31 @@ def _dropped_rulings(
         chosen = {float(inner_at[np.argmin(np.abs(inner_at - k / cells))]) for k in range(1, cells)}
         near = np.abs(at[:, None] - np.array(sorted(chosen) or [np.inf])[None, :]) < 1e-6
         kept = ~is_inner | near.any(axis=1)
-        drop = np.zeros(len(v2), dtype=bool)
-        drop[rulings[~kept].ravel()] = True
-        drop[rulings[kept].ravel()] = False
+        # the strip's points: ``ends`` its rulings' ends among them
+        points, ends = np.unique(rulings, return_inverse=True)
+        ends = ends.reshape(rulings.shape)
+        drop = np.zeros(len(points), dtype=bool)
+        drop[ends[~kept].ravel()] = True
+        drop[ends[kept].ravel()] = False
         # a ruling goes only when both its ends may go (a fillet's apex, on many rulings,
         # stays and does not count)
-        hub = np.bincount(rulings.ravel(), minlength=len(v2)) >= 3
+        hub = np.bincount(ends.ravel(), minlength=len(points)) >= 3
         drop[hub] = False
-        free = droppable | hub
-        drop[rulings[~free[rulings].all(axis=1)].ravel()] = False
-        half = (drop | hub)[rulings].all(axis=1)
-        drop[rulings[drop[rulings].any(axis=1) & ~half].ravel()] = False
-        gone |= drop
+        free = droppable[points] | hub
+        drop[ends[~free[ends].all(axis=1)].ravel()] = False
+        half = (drop | hub)[ends].all(axis=1)
+        drop[ends[drop[ends].any(axis=1) & ~half].ravel()] = False
+        gone[points[drop]] = True
     return gone
 
 
 def _strip_turn(
-    pattern: CreasePattern, rulings: np.ndarray, at: np.ndarray, dihedral: np.ndarray
+    key: np.ndarray, n: int, rulings: np.ndarray, at: np.ndarray, dihedral: np.ndarray
 ) -> float:
     """The total bend (degrees) of a strip across its inner ``rulings`` (at places ``at``
-    across it): the sum of their dihedrals, one ruling per place (a strip may have rows)."""
-    n = len(pattern.vertices_2d)
-    key = pattern.edges[:, 0] * n + pattern.edges[:, 1]
+    across it): the sum of their dihedrals, one ruling per place (a strip may have rows).
+    ``key`` (n_edges,) the pattern's edges as ``lo * n + hi`` (``n`` its points), ascending,
+    and ``dihedral`` (n_edges,) theirs."""
     lo, hi = rulings.min(axis=1), rulings.max(axis=1)
     bends = np.abs(dihedral[np.searchsorted(key, lo * n + hi)])  # pattern edges are sorted
     order = np.argsort(at, kind="stable")
