@@ -1234,7 +1234,9 @@ def _merged_patches(
             going = points[gone[points]]
             key = (tuple(group.tolist()), tuple(going.tolist()))
             if key not in made:
-                if not len(going):  # one face of the pattern as it is
+                if not len(going) and len(faces[group[0]]) == 3:  # a triangle as it is
+                    made[key] = [faces[group[0]].tolist()]  # what the line below gives it
+                elif not len(going):  # one face of the pattern as it is
                     made[key] = _triangles(faces[group[0]].tolist(), v2, v3) or _triangulate(
                         faces[group[0]].tolist(), v2
                     )
