@@ -108,7 +108,16 @@ def test_mismatch_converges_as_the_arc_step_shrinks(name):
     assert 3.5 < rel[0] / rel[1] < 4.5 and 3.5 < rel[1] / rel[2] < 4.5
 
 
-@pytest.mark.parametrize("step", [0.0, 0.7, 1.5, 5.0, 45.0])
+@pytest.mark.parametrize(
+    "step",
+    [
+        pytest.param(0.0, marks=pytest.mark.slow),
+        pytest.param(0.7, marks=pytest.mark.slow),
+        1.5,
+        5.0,
+        45.0,
+    ],
+)
 def test_arc_points_bound_the_turn_between_samples(step):
     """Every arc gets at most ``samples`` points, at least 2, and fewer only when the turn
     between two samples stays within the arc step; the built modules use those counts, or
@@ -327,6 +336,7 @@ def test_infeasible_vertices_are_rescued_with_smaller_radii():
     assert "would be feasible" in hint.summary()
 
 
+@pytest.mark.slow
 @settings(max_examples=8, deadline=None)
 @given(seed=st.integers(0, 10_000))
 def test_a_convex_solid_has_no_infeasible_vertex(seed):

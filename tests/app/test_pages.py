@@ -74,6 +74,7 @@ def test_two_pages_each_keep_their_own_design(app):
         _until(lambda: b.session.design.params.radius == "20.0%", 60, "B's radius")
 
 
+@pytest.mark.slow
 def test_pages_over_the_limit_are_told_and_one_design_computed_at_a_time(app, monkeypatch):
     monkeypatch.setattr(server_mod, "MAX_PAGES", 2)
     real = session_mod.round_mesh
