@@ -48,6 +48,7 @@ def test_relative_radius_and_depth(tmp_path):
     assert report["vertices"][0]["depth_requested"] == pytest.approx(0.6)
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 def test_arc_step_sets_the_points_per_arc(tmp_path):
     """--arc-step is recorded in the report; a finer step (or 0) gives more pattern faces."""
     faces = {}

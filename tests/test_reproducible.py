@@ -77,6 +77,7 @@ def test_timings_are_kept_apart(tmp_path):
     assert timings["tabs"] <= timings["surface"]
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 def test_a_design_is_the_same_first_or_after_a_large_one(tmp_path):
     """In one process, a small design built before and after a large one (which loads the
     numba kernel) writes the same bytes: the solver's path does not depend on the past."""

@@ -56,6 +56,7 @@ def test_load_example_and_recompute():
     assert again.params.radius == "5%" and again.params.samples == 8
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 def test_arc_step_reaches_the_design_and_its_download():
     """The arc step is a session parameter; the download (rebuilt with tabs by reuse) keeps
     the shown design's sampling."""

@@ -218,6 +218,7 @@ def tab_outlines(draw):
     return np.array(pts).reshape(-1, 2), hinge
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 @settings(max_examples=300, deadline=None)
 @given(st.lists(tab_outlines(), max_size=12), st.integers(0, 12))
 def test_tab_cut_paths_all_at_once_are_the_tab_by_tab_paths(outlines, n_hinges):

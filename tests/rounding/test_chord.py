@@ -105,6 +105,7 @@ def test_a_smaller_fillet_gets_fewer_points():
     assert (nb[0] - 1) / (ns[0] - 1) == pytest.approx(np.sqrt(2), rel=0.04)
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 def test_the_isometry_figures_stay_at_round_off():
     """The certificate's ruling isometry and contraction are the construction's, not the
     sampling's: with the chord tolerance as with the old arc step, at round-off (1e-11: the

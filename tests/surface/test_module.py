@@ -88,6 +88,7 @@ SAMPLINGS = [(24, 1.5)] + [
 ]
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 @pytest.mark.parametrize(("samples", "arc_step"), SAMPLINGS)
 def test_geodesic_sphere_and_random_convex(samples, arc_step):
     designs = [

@@ -4,6 +4,7 @@ sharp by the design rather than drawn with sliver edges or facets folded past th
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import filletfold
 import filletfold.pipeline as pipeline
@@ -46,6 +47,7 @@ def test_which_cones_cannot_be_sampled():
     assert set(fine) == set(vertex.tolist())
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 def test_a_cone_that_cannot_be_sampled_is_made_sharp(monkeypatch):
     """The design makes such a vertex sharp (its corner kept, its fillets tapering into it),
     solves its neighbours again, and stays valid: a blob vertex stands in for the sliver cone

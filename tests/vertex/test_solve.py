@@ -164,6 +164,7 @@ def test_max_min_direction_matches_brute_force():
         assert_allclose(np.linalg.norm(d), 1.0)
 
 
+@pytest.mark.slow  # fast tier near its budget: in make test-slow (CI runs both)
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 10_000), share=st.floats(0.2, 0.6), depth=st.floats(0.1, 0.8))
 def test_random_convex_polyhedra_every_solved_apex_is_valid(seed, share, depth):
