@@ -20,6 +20,7 @@ from filletfold.check import (
     certify,
     certify_design,
     check_folder,
+    design_edges,
     file_quantum,
     memory_quantum,
 )
@@ -64,21 +65,10 @@ def tmp_root(tmp_path_factory) -> str:
     return str(tmp_path_factory.mktemp("check"))
 
 
-def _edges(design) -> dict:
-    rd = design.rounding
-    return {
-        "vertices": design.mesh.edges,
-        "faces": design.mesh.edge_faces,
-        "radius": rd.radius,
-        "half_angle": rd.half_angle,
-        "kappa": rd.kappa,
-    }
-
-
 def _certify(design, pattern: CreasePattern | None = None, apex=None) -> Certificate:
     apex = design.vertices.apex if apex is None else apex
     pattern = design.pattern if pattern is None else pattern
-    return certify(pattern, design.mesh.vertices, design.mesh.faces, _edges(design), apex)
+    return certify(pattern, design.mesh.vertices, design.mesh.faces, design_edges(design), apex)
 
 
 def _failed(cert: Certificate) -> set[str]:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import filletfold
-from filletfold.check import certify, check_folder, design_bend_floor
+from filletfold.check import certify, check_folder, design_edges
 from filletfold.cli import main
 from filletfold.errors import ParameterError
 from filletfold.materials import MATERIALS, din6935_k_factor, resolve_material
@@ -114,16 +114,9 @@ def test_no_fillet_under_the_floor_after_the_vertices_changed_them(name):
 
 def test_the_check_fails_a_fillet_under_the_floor():
     design = filletfold.round_mesh("cube", size="50mm", material="card-300gsm")
-    floor = design_bend_floor(design.params)
+    floor = design.params.bend_floor()
     rd, mesh = design.rounding, design.mesh
-    edges = {
-        "vertices": mesh.edges,
-        "faces": mesh.edge_faces,
-        "radius": rd.radius,
-        "half_angle": rd.half_angle,
-        "kappa": rd.kappa,
-    }
-    args = (design.pattern, mesh.vertices, mesh.faces, edges, design.vertices.apex)
+    args = (design.pattern, mesh.vertices, mesh.faces, design_edges(design), design.vertices.apex)
     held = certify(*args, bend_floor=floor)
     assert held.ok
     least = float(rd.radius[rd.radius > 0].min())

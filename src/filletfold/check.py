@@ -1273,34 +1273,31 @@ def certify_design(design) -> Certificate:
     -------
     Certificate
     """
-    mesh, rd = design.mesh, design.rounding
-    edges = {
-        "vertices": mesh.edges,
-        "faces": mesh.edge_faces,
-        "radius": rd.radius,
-        "half_angle": rd.half_angle,
-        "kappa": rd.kappa,
-    }
+    mesh = design.mesh
     return certify(
         design.pattern,
         mesh.vertices,
         mesh.faces,
-        edges,
+        design_edges(design),
         design.vertices.apex,
         coord_quantum=memory_quantum(design.pattern),
         quantum_source=f"round-off: {ROUNDOFF_ULPS} ulp of the largest coordinate",
         arc_step=float(design.params.arc_step),
-        bend_floor=design_bend_floor(design.params),
+        bend_floor=design.params.bend_floor(),
     )
 
 
-def design_bend_floor(params) -> float:
-    """The bend floor (mesh units) a design made with ``params`` (its size settled) is held
-    to: its sheet material's, at its size; 0 without a material or a size."""
-    material = params.sheet_material()
-    if material is None or params.size is None or params.scale is None:
-        return 0.0
-    return material.bend_floor_mm() / params.mm_per_unit
+def design_edges(design) -> dict:
+    """The ``edges`` of :func:`certify` for an in-memory design: its mesh's edges and their
+    faces, and its rounding's radius, half angle and mountain/valley sign."""
+    rd = design.rounding
+    return {
+        "vertices": design.mesh.edges,
+        "faces": design.mesh.edge_faces,
+        "radius": rd.radius,
+        "half_angle": rd.half_angle,
+        "kappa": rd.kappa,
+    }
 
 
 def memory_quantum(pattern: CreasePattern) -> float:
@@ -1354,7 +1351,7 @@ def check_folder(path) -> Certificate:
         if not f.is_file():
             raise MeshReadError(f"{f}: no such file (write the design with 'filletfold round')")
     pattern, doc = read_fold_document(fold)
-    mesh_vertices, mesh_faces, edges, apex, arc_step = _read_report(report, doc, fold)
+    mesh_vertices, mesh_faces, edges, apex, arc_step, bend = _read_report(report, doc, fold)
     try:
         return certify(
             pattern,
@@ -1364,22 +1361,10 @@ def check_folder(path) -> Certificate:
             apex,
             coord_quantum=file_quantum(pattern),
             arc_step=arc_step,
-            bend_floor=_report_bend_floor(report),
+            bend_floor=bend,
         )
     except ParameterError as exc:
         raise MeshReadError(f"{fold} does not match {report.name}: {exc}") from None
-
-
-def _report_bend_floor(path: Path) -> float:
-    """:func:`design_bend_floor` of the parameters a design's report names."""
-    from .parameters import Parameters
-
-    doc = load_json(path, "a report")
-    try:
-        params = Parameters.from_dict(doc.get("parameters"), where=f"{path}: parameters")
-        return design_bend_floor(params)
-    except ParameterError as exc:
-        raise MeshReadError(f"{path}: {exc}") from None
 
 
 #: The prefix of the mesh's keys in ``design.fold`` (see ``mesh_fold_keys`` in
@@ -1388,7 +1373,8 @@ MESH_KEY = "filletfold:mesh_"
 
 
 def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | None = None):
-    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step) of a design: the mesh
+    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step, bend floor) of a
+    design: the mesh
     and its edges and apices from the ``filletfold:mesh_*`` keys of its FOLD document when it
     has them, else from the tables of its ``report.json`` (written with ``--report-tables``,
     or by filletfold before 0.2); the arc step the report's parameters name, else the
@@ -1432,7 +1418,18 @@ def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | Non
     edges = {"vertices": ev, "faces": ef, "radius": radius, "half_angle": gamma, "kappa": kappa}
     if not (math.isfinite(arc_step) and 0 <= arc_step <= 180):
         raise MeshReadError(f"{path}: arc_step {arc_step} is not in [0, 180] degrees")
-    return vertices, faces, edges, apex, arc_step
+    return vertices, faces, edges, apex, arc_step, _report_bend_floor(doc, path)
+
+
+def _report_bend_floor(doc: dict, path: Path) -> float:
+    """The bend floor (mesh units) of the parameters a design's report names
+    (:meth:`~filletfold.parameters.Parameters.bend_floor`); 0 without a material."""
+    from .parameters import Parameters
+
+    try:
+        return Parameters.from_dict(doc.get("parameters"), where=f"{path}: parameters").bend_floor()
+    except ParameterError as exc:
+        raise MeshReadError(f"{path}: {exc}") from None
 
 
 def _fold_columns(doc: dict) -> tuple:

@@ -403,6 +403,17 @@ class Parameters:
 
         return resolve_material(self.material, self.thickness, self.min_bend_radius, self.k_factor)
 
+    def bend_floor(self) -> float:
+        """The sheet material's bend floor
+        (:meth:`~filletfold.materials.Material.bend_floor_mm`) in mesh units at the design's
+        size (``mm_per_unit``: a unitless drawing is read in mm); 0 without a material, and
+        while the size is the default still to settle (it grows to hold the floor instead:
+        :func:`~filletfold.layout.arrange.default_size`)."""
+        material = self.sheet_material()
+        if material is None or self.size == AUTO_SIZE:
+            return 0.0
+        return material.bend_floor_mm() / self.mm_per_unit
+
     def sharp_kinds(self) -> frozenset:
         """The kinds of cone-less vertices kept sharp (``"auto"`` resolved)."""
         from .vertex.sharpen import parse_sharp

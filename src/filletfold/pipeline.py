@@ -60,7 +60,7 @@ from .surface.module import Modules, build_modules
 from .surface.pattern import CreasePattern
 from .surface.sampling import cone_sample_counts, unsampled_cones
 from .tolerances import tol
-from .units import AUTO_SIZE, ceil_digits
+from .units import ceil_digits
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
     kept_sharp,
@@ -138,8 +138,9 @@ class Job:
     coarsening : Coarsening or None
         What coarsening the mesh did (``params.faces`` or ``params.edge_length``), else None.
     bend : float
-        The sheet material's bend floor in mesh units at the size given (:func:`bend_floor`);
-        0 without a material or at the default size.
+        The sheet material's bend floor in mesh units at the size given
+        (:meth:`~filletfold.parameters.Parameters.bend_floor`); 0 without a material or at the
+        default size.
     """
 
     params: Parameters
@@ -291,7 +292,7 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
     check_pattern_size(pm, params.samples, params.max_points)  # before anything is solved
     size, strict = mesh_size(pm), params.strict
     params = sized(params, float(np.ptp(pm.vertices, axis=0).max(initial=0.0)), pm.mean_edge_length)
-    bend = bend_units(params)
+    bend = params.bend_floor()
     return Job(
         params=params,
         mesh=pm,
@@ -311,16 +312,6 @@ def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Jo
         progress=progress,
         bend=bend,
     )
-
-
-def bend_units(params: Parameters) -> float:
-    """The sheet material's bend floor (:meth:`~filletfold.materials.Material.bend_floor_mm`)
-    in mesh units at the size of ``params`` (sized: :func:`~filletfold.parameters.sized`); 0
-    without a material, and at the default size (which grows to it instead)."""
-    material = params.sheet_material()
-    if material is None or params.size == AUTO_SIZE:
-        return 0.0
-    return material.bend_floor_mm() / params.mm_per_unit
 
 
 def reusable_stages(job: Job, earlier: Stages | None) -> Stages | None:

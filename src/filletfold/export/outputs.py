@@ -140,7 +140,7 @@ def material_report(design) -> dict | None:
     least = float(rounded.min()) * mm if (mm is not None and len(rounded)) else None
     tips = None
     if mm is not None and floor > 0:
-        zone = cone_tip_zones(design.pattern, design.vertices.apex, floor / mm) * mm
+        zone = cone_tip_zones(design.pattern, design.vertices.apex, p.bend_floor()) * mm
         held = np.flatnonzero(np.isfinite(zone))
         if len(held):
             worst = int(held[np.argmax(zone[held])])

@@ -114,8 +114,7 @@ def rescue_vertices(state: VertexState, *, apply: bool, vertices=None) -> Rescue
         if not len(edges):
             break
         radius[edges] *= scale[edges]
-        # a fillet the sheet cannot bend that tightly is a crease instead (the last step's)
-        radius[edges] = np.where(radius[edges] < state.bend_floor, 0.0, radius[edges])
+        # (state.reround makes a fillet halved under the sheet's bend floor a crease)
         radius, new_rounding, new_centres = state.reround(radius)
         if apply:
             affected = face_vertices(mesh, edges)

@@ -61,8 +61,8 @@ class VertexState:
     work : ApexWork
         The apex solver's work over every solve of this state (counts).
     bend_floor : float
-        The sheet material's bend floor (mesh units; 0: none): the rescue makes a fillet it
-        would shrink below it a crease instead (:func:`~filletfold.vertex.rescue.rescue_vertices`).
+        The sheet material's bend floor (mesh units; 0: none): :meth:`reround` makes a fillet
+        under it a crease (radius 0), so no change of radii (the rescue's halvings) leaves one.
     """
 
     mesh: PolyMesh
