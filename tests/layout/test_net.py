@@ -122,3 +122,24 @@ def test_a_small_overlap_clashes_unless_it_is_a_sliver_along_a_glued_border():
     assert _clash(placed, corner, nowhere, 1e-9 * 1e5, 1e-9, 1e-12)
     beside = shapely.box(100 - 1e-13, 0, 200, 100)  # round-off of the shared border
     assert not _clash(placed, beside, nowhere, 1e-9, 1e-9, 1e-12)
+
+
+def test_modules_touching_in_space_without_a_face_between_them_share_no_border():
+    """Two triangles back to back (the second a copy of the first, reversed, as a split vertex's
+    copies leave them): their modules' points coincide in 3D, but no face holds both vertices,
+    so without the mesh they share a border and with it they share none."""
+    from filletfold.mesh.polymesh import PolyMesh
+    from filletfold.surface.piece import Piece
+
+    v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    mesh = PolyMesh(np.vstack([v, v]), [[0, 1, 2], [3, 5, 4]])
+    edge = np.array([[0.5, 0.0, 0.0], [0.25, 0.25, 0.0]])  # a border segment, both copies
+
+    def piece(u):
+        return Piece(vertex=u, points_2d=list(edge[:, :2]), points_3d=list(edge))
+
+    pieces = [piece(0), piece(1), piece(3)]
+    assert (0, 2) in shared_points(pieces, 1e-9)  # coincident in space
+    shared = shared_points(pieces, 1e-9, mesh)
+    assert (0, 1) in shared and (1, 0) in shared  # vertices 0 and 1: one face
+    assert (0, 2) not in shared and (1, 2) not in shared  # vertex 3: on the other triangle

@@ -224,7 +224,7 @@ def arrange(
                 ),
             )
         else:
-            glued, _, layout_note = glue_pieces(pieces, eps)
+            glued, _, layout_note = glue_pieces(pieces, eps, pm)
         if glued is not None:
             pieces, layout_used = [glued], "sheet"
         elif layout == "sheet":

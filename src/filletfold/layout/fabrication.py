@@ -102,7 +102,7 @@ def net_pieces(mesh, sol, modules, samples, eps, sheet=None, tries=None):
             built = build_modules(mesh, frames, centres, samples, apices, developed)
             rebuilt = dict(zip(recut, built, strict=True))
         pieces = [piece for u, module in enumerate(modules) for piece in rebuilt.get(u, module)]
-        nets, _ = build_nets(pieces, eps, sheet)
+        nets, _ = build_nets(pieces, eps, sheet, mesh=mesh)
         if best is None or len(nets) < len(best):
             best = nets
         if len(best) == 1:

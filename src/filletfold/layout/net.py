@@ -15,6 +15,7 @@ import heapq
 
 import numpy as np
 import shapely
+from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
 from ..arrays import run_next, run_starts
@@ -38,8 +39,14 @@ def rigid_fit(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
     return m
 
 
-def shared_points(pieces: list[Piece], eps: float) -> dict[tuple[int, int], list]:
+def shared_points(pieces: list[Piece], eps: float, mesh=None) -> dict[tuple[int, int], list]:
     """Points of one piece that are points of another in 3D (their common border).
+
+    With ``mesh``, only pieces of one vertex, or of two vertices of one face, share points:
+    two modules that touch in space without a face between them (the copies of a split
+    vertex, a triangle lying back to back on another part of the surface) have no border to
+    glue, and a net joined there would fold flat (by 180 degrees) along it. Pieces of no
+    vertex (``vertex < 0``) are not filtered.
 
     Returns
     -------
@@ -52,12 +59,32 @@ def shared_points(pieces: list[Piece], eps: float) -> dict[tuple[int, int], list
     p3 = np.vstack([a[1] for a in arrays])
     pairs = cKDTree(p3).query_pairs(eps, output_type="ndarray")
     pairs = pairs[owner[pairs[:, 0]] != owner[pairs[:, 1]]]
+    if mesh is not None and len(pairs):
+        vertex = np.array([p.vertex for p in pieces], dtype=np.int64)
+        u, w = vertex[owner[pairs[:, 0]]], vertex[owner[pairs[:, 1]]]
+        pairs = pairs[share_face(mesh, u, w) | (u < 0) | (w < 0)]
     shared: dict[tuple[int, int], list] = {}
     for a, b in pairs:
         ka, kb = int(owner[a]), int(owner[b])
         shared.setdefault((ka, kb), []).append((int(local[a]), int(local[b])))
         shared.setdefault((kb, ka), []).append((int(local[b]), int(local[a])))
     return shared
+
+
+def share_face(mesh, u: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(k,) bool: whether mesh vertices ``u[i]`` and ``w[i]`` are one vertex or lie on a
+    common face (a negative index: False)."""
+    u, w = np.asarray(u, dtype=np.int64), np.asarray(w, dtype=np.int64)
+    ok = (u >= 0) & (w >= 0)
+    incidence = csr_matrix(
+        (np.ones(len(mesh.halfedge_from)), (mesh.halfedge_from, mesh.halfedge_face)),
+        shape=(mesh.n_vertices, max(mesh.n_faces, 1)),
+    )
+    common = np.zeros(len(u), dtype=bool)
+    if ok.any():
+        a, b = incidence[u[ok]], incidence[w[ok]]
+        common[ok] = np.asarray(a.multiply(b).sum(axis=1)).ravel() > 0
+    return ok & ((u == w) | common)
 
 
 def merge_pieces(
@@ -268,6 +295,7 @@ def build_nets(
     eps: float,
     sheet: tuple[float, float] | None = None,
     overlap_tol: float = tol.relative,
+    mesh=None,
 ) -> tuple[list[Piece], list[list[int]]]:
     """Join pieces into nets that overlap nothing and fit the sheet.
 
@@ -294,6 +322,9 @@ def build_nets(
     overlap_tol : float
         Overlap area allowed between a moved piece and the net it joins, relative to the
         piece's area.
+    mesh : PolyMesh, optional
+        The mesh of the pieces' vertices: borders only between modules of one face
+        (:func:`shared_points`).
 
     Returns
     -------
@@ -302,7 +333,7 @@ def build_nets(
     members : list of list of int
         The input pieces in each net, ascending.
     """
-    shared = shared_points(pieces, eps)
+    shared = shared_points(pieces, eps, mesh)
     arrays = [p.arrays()[0] for p in pieces]
     shapes = np.array([_outline(p) for p in pieces], dtype=object)  # placed: moved with nets
     n = len(pieces)

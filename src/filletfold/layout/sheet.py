@@ -17,7 +17,7 @@ from ..surface.piece import Piece
 from .net import merge_pieces, rigid_fit, shared_points
 
 
-def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, str]:
+def glue_pieces(pieces: list[Piece], eps: float, mesh=None) -> tuple[Piece | None, list, str]:
     """Place all pieces in one frame by matching shared border points, then merge them.
 
     Parameters
@@ -25,6 +25,9 @@ def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, st
     pieces : list of Piece
     eps : float
         Distance under which two points are the same (in 3D, and in 2D after placing).
+    mesh : PolyMesh, optional
+        The mesh of the pieces' vertices: borders only between modules of one face
+        (:func:`~filletfold.layout.net.shared_points`).
 
     Returns
     -------
@@ -36,7 +39,7 @@ def glue_pieces(pieces: list[Piece], eps: float) -> tuple[Piece | None, list, st
         Why gluing failed (empty on success).
     """
     arrays = [p.arrays() for p in pieces]
-    shared = shared_points(pieces, eps)
+    shared = shared_points(pieces, eps, mesh)
     neighbours: dict[int, list] = {}  # per piece, its (other piece, matches) in order
     for (ka, kb), matches in sorted(shared.items()):
         neighbours.setdefault(ka, []).append((kb, matches))
