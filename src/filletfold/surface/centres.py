@@ -12,7 +12,9 @@ from ..rounding.edges import EdgeRounding
 from ..tolerances import tol
 
 
-def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
+def face_piece_centres(
+    mesh: PolyMesh, rounding: EdgeRounding, sharp: np.ndarray | None = None
+) -> np.ndarray:
     """Centre of every flat face piece, from which the whole piece is visible.
 
     The face piece of a face is bounded by the tangent lines of its edges (the edge itself for a
@@ -20,6 +22,20 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
     piece is cut off by straight segments from the edge midpoints to this centre, so the centre
     must see the whole piece: it is the centroid of the piece's kernel (the piece itself when
     convex).
+
+    A rounded edge with one ``sharp`` end is a conical fillet (its radius grows from 0 at the
+    sharp end, through the cylinder's at the midpoint, to twice that at the other end): its
+    line on the face runs from the sharp vertex through the midpoint's tangent point, so
+    beside the other end it reaches twice as far into the face as a cylinder's tangent line
+    (a thin face beside a sharp vertex: a centre taken for the cylinder lay beyond the fillet,
+    and the face share of the vertex at the wide end crossed itself).
+
+    Parameters
+    ----------
+    mesh : PolyMesh
+    rounding : EdgeRounding
+    sharp : (n_vertices,) bool, optional
+        The sharp vertices (none when not given).
 
     Returns
     -------
@@ -40,6 +56,16 @@ def face_piece_centres(mesh: PolyMesh, rounding: EdgeRounding) -> np.ndarray:
     u /= np.linalg.norm(u, axis=1)[:, None]
     n = mesh.face_normal[face_of]
     base = p + half[mesh.halfedge_edge][:, None] * np.cross(n, u)  # a point of each tangent line
+    if sharp is not None:  # conical fillets: the line from the sharp end through the midpoint's
+        e = mesh.halfedge_edge
+        a, b = sharp[mesh.halfedge_from], sharp[mesh.halfedge_to]
+        cone = (a != b) & (rounding.radius[e] > 0) & (half[e] > 0)
+        if cone.any():
+            mid = 0.5 * (p[cone] + p[nxt][cone]) + half[e[cone], None] * np.cross(n[cone], u[cone])
+            tip = np.where(a[cone, None], p[cone], p[nxt][cone])  # the sharp end
+            line = np.where(a[cone, None], mid - tip, tip - mid)  # from the half-edge's start
+            base[cone] = mid
+            u[cone] = line / np.linalg.norm(line, axis=1)[:, None]
     # corner of half-edge h: the tangent lines of the previous half-edge and of h cross at T
     prev = mesh.halfedge_prev
     delta = base - base[prev]

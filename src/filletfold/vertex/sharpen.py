@@ -105,17 +105,24 @@ def unround_between(
 ) -> tuple[EdgeRounding, np.ndarray, np.ndarray]:
     """Leave every rounded edge between two ``sharp`` vertices unrounded (a straight crease).
 
-    Returns the rounding and face piece centres afterwards (``state``'s own when no edge
-    changed; the state itself is not changed) and which edges changed, (n_edges,) bool.
+    Returns the rounding and face piece centres afterwards (the state itself is not changed;
+    the centres with the edges from ``sharp`` vertices to others conical fillets) and which
+    edges changed, (n_edges,) bool: unrounded, or a fillet now conical on a face whose
+    centre moved.
     """
-    ends, rounding = state.mesh.edges, state.rounding
+    mesh, rounding = state.mesh, state.rounding
+    ends = mesh.edges
     both = sharp[ends[:, 0]] & sharp[ends[:, 1]] & (rounding.radius > 0)
-    if not both.any():
-        return rounding, state.centres, both
-    radius = rounding.radius.copy()
-    radius[both] = 0.0
-    _, rounding, centres = state.reround(radius)
-    return rounding, centres, both
+    if both.any():
+        radius = rounding.radius.copy()
+        radius[both] = 0.0
+        _, rounding, centres = state.reround(radius, sharp)
+    else:
+        centres = state.face_centres(mesh, rounding, sharp)
+    moved = np.zeros(mesh.n_faces + 1, dtype=bool)  # the last: no face (a boundary side)
+    moved[:-1] = (centres != state.centres).any(axis=1)
+    one = (sharp[ends[:, 0]] != sharp[ends[:, 1]]) & (rounding.radius > 0)
+    return rounding, centres, both | (one & moved[mesh.edge_faces].any(axis=1))
 
 
 @dataclass
@@ -178,7 +185,7 @@ def sharpen_vertices(state: VertexState, kinds) -> Sharpening:
         rounding, centres, changed = unround_between(state, sharp)
         state.rounding, state.centres = rounding, centres
         # the vertices whose sides changed: neighbours of the new sharp vertices, and every
-        # vertex of a face whose piece (and centre) changed with an unrounded edge
+        # vertex of a face whose piece (and centre) changed with an unrounded or conical edge
         near = np.zeros(n, dtype=bool)
         at_new = np.isin(ends, new).any(axis=1)
         near[ends[at_new].ravel()] = True

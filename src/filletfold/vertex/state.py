@@ -40,7 +40,7 @@ class VertexState:
         The per-vertex results.
     depths : (n_vertices,) float
     face_centres : callable
-        ``face_centres(mesh, rounding) -> (n_faces, 3)``
+        ``face_centres(mesh, rounding, sharp) -> (n_faces, 3)``
         (:func:`~filletfold.surface.centres.face_piece_centres`, given by the pipeline: this
         room comes before the surface's).
     flat_deg, floor, min_width : float
@@ -87,12 +87,17 @@ class VertexState:
         """(n_vertices,) bool: the vertices whose frames are built sharp."""
         return np.array([f.sharp for f in self.frames], dtype=bool)
 
-    def reround(self, radius: np.ndarray) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
+    def reround(
+        self, radius: np.ndarray, sharp: np.ndarray | None = None
+    ) -> tuple[np.ndarray, EdgeRounding, np.ndarray]:
         """The rounding of new radii and its face piece centres (the state unchanged).
 
         Parameters
         ----------
         radius : (n_edges,) float
+        sharp : (n_vertices,) bool, optional
+            The sharp vertices, whose edges to cones are conical fillets (default: the
+            vertices whose frames are built sharp).
 
         Returns
         -------
@@ -109,4 +114,6 @@ class VertexState:
         rounding = round_edges(
             mesh, radius, flat_deg=self.flat_deg, floor=self.floor, min_width=self.min_width
         )
-        return radius, rounding, self.face_centres(mesh, rounding)
+        if sharp is None and self.frames:
+            sharp = self.sharp_frames()
+        return radius, rounding, self.face_centres(mesh, rounding, sharp)
