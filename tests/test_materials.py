@@ -192,3 +192,45 @@ def test_the_report_gives_the_cones_tip_zones(tmp_path, capsys):
     assert "the cones bend tighter than that within" in capsys.readouterr().out
     tips = json.loads((out / "report.json").read_text())["material"]["cone_tip_zones"]
     assert tips["cones"] > 100 and 0 < tips["median_mm"] <= tips["max_mm"] < 100
+
+
+def test_the_default_size_leaves_the_tightest_tenth_of_the_fillets_out():
+    from filletfold.rounding.bend import CREASE_SHARE, floor_size, share_floor_size
+
+    assert CREASE_SHARE == 0.1
+    r = np.array([0.01, 1, 1, 1, 1, 1, 1, 1, 1, 1, 0.0])  # one tight fillet, one edge unrounded
+    length = np.ones(11)
+    assert floor_size(10.0, 1.0, r) == pytest.approx(1000.0)  # every fillet: 100 times larger
+    assert share_floor_size(10.0, 1.0, r, length) == pytest.approx(10.0)  # a tenth left out
+    assert share_floor_size(10.0, 1.0, r, length, share=0.0) == pytest.approx(1000.0)
+    r[1] = 0.02  # two tight fillets are a fifth of the length: the second holds the floor
+    assert share_floor_size(10.0, 1.0, r, length) == pytest.approx(500.0)
+    length[0] = 5.0  # the tightest is now over a tenth of the length: it holds the floor
+    assert share_floor_size(10.0, 1.0, r, length) == pytest.approx(1000.0)
+    assert share_floor_size(10.0, 1.0, np.zeros(3), np.ones(3)) is None
+
+
+@pytest.mark.slow
+def test_a_scan_at_the_default_size_creases_its_tightest_fillets():
+    """The 468-vertex bunny scan in card: every fillet would hold 1.2 mm only at several
+    metres; the default size leaves the tightest tenth of the fillets' length out, makes
+    those that cannot widen creases, and says so."""
+    from filletfold.export.outputs import design_summary
+    from filletfold.rounding.bend import floor_size
+    from tests.test_corpus import CORPUS
+
+    path = str(CORPUS / "meshio-bun_zipper_res4.ply")
+    plain = filletfold.round_mesh(path)
+    card = filletfold.round_mesh(path, material="card-300gsm")
+    extent = float(np.ptp(plain.mesh.vertices, axis=0).max())
+    every = floor_size(extent, 1.2, plain.fitting["fitted_radius"])
+    size = float(card.params.size.removesuffix("mm"))
+    assert card.fabrication["default_size"]["binding"] == "material"
+    assert size < every / 4, (size, every)
+    creased = card.fitting["creased"]
+    assert len(creased) > 0
+    assert (np.asarray(card.rounding.radius)[creased] == 0).all()
+    r = np.asarray(card.rounding.radius) * card.params.mm_per_unit
+    assert (r[r > 0] >= 1.2 * (1 - 1e-9)).all()
+    assert card.certificate.ok
+    assert "\ncreased for the material: " in design_summary(card)

@@ -282,7 +282,7 @@ def _design(job: Job, edges: Edges, sol: VertexSolution, laid: Layout, stages, t
         coarsening=job.coarsening,
         up=up,
         up_why=why,
-        fitting=_fitting(rounding, edges.requested, edges.fitted, sol.rescue, sol.res, sol.work),
+        fitting=_fitting(rounding, edges, sol.rescue, sol.res, sol.work),
     )
 
 
@@ -314,22 +314,27 @@ def _shifted(pm: PolyMesh, rounding: EdgeRounding, res: VertexResult, pieces, sh
     return mesh, rounding, res, moved
 
 
-def _fitting(rounding: EdgeRounding, requested, fitted, rescue: Rescue, res, work) -> dict:
+def _fitting(rounding: EdgeRounding, edges, rescue: Rescue, res, work) -> dict:
     """What :attr:`Design.fitting` holds: the radii asked for, the edges reduced to fit their
-    limits, the edges left sharp, the vertices rescued (:mod:`filletfold.vertex.rescue`), the
+    limits, the edges left sharp, the fillets made creases for the sheet material's bend
+    floor, the vertices rescued (:mod:`filletfold.vertex.rescue`), the
     cones whose apex needed the solver's linear programmes, those each fallback of the
     solver found (:func:`~filletfold.vertex.solve.cones_by_fallback`), and the solver's work
     (:class:`~filletfold.vertex.batch.ApexWork`)."""
+    requested, fitted = edges.requested, edges.fitted
     bent = rounding.half_angle > 0  # rounded or left sharp (not boundary, not flat)
     asked = np.where(bent, requested, 0.0)
     sharp = rounding.sharp if rounding.sharp is not None else np.zeros(len(bent), dtype=bool)
-    reduced = np.flatnonzero(bent & ~sharp & (fitted < asked * (1 - tol.roundoff)))
+    creased = np.zeros(len(bent), dtype=bool) if edges.creased is None else edges.creased
+    reduced = np.flatnonzero(bent & ~sharp & ~creased & (fitted < asked * (1 - tol.roundoff)))
     by_fallback = cones_by_fallback(res)
     return {
         "radius_requested": asked,
         "fitted_radius": fitted,
         "reduced": reduced,
         "sharp": np.flatnonzero(sharp),
+        "creased": np.flatnonzero(creased),
+        "bend_floor": float(edges.bend),
         "rescued": dict(sorted(rescue.rescued.items())),
         "rescue_applied": rescue.applied,
         "sharpened": sorted(rescue.sharpened),

@@ -43,14 +43,14 @@ from .errors import (
     one_line,
 )
 from .errors import stage as _stage
-from .layout.arrange import arrange
+from .layout.arrange import arrange, default_size
 from .layout.fabrication import cut_first, recut_solved
 from .layout.net import cut_edges_for_nets
 from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
 from .mesh.polymesh import PolyMesh, check_corners, check_pattern_size, mesh_size
 from .parameters import Parameters, parse_length, resolve_chord_tol, resolve_depth, sized
-from .rounding.bend import FLOOR_RTOL, hold_floor, least_size_factor
+from .rounding.bend import FLOOR_RTOL, hold_floor, least_size_factor, share_floor_size
 from .rounding.conical import conical_material_loss, is_conical
 from .rounding.edges import EdgeRounding, clamp_radii, round_edges
 from .rounding.material_loss import MaterialLoss, solve_material_loss
@@ -60,7 +60,7 @@ from .surface.module import Modules, build_modules
 from .surface.pattern import CreasePattern
 from .surface.sampling import cone_sample_counts, unsampled_cones
 from .tolerances import tol
-from .units import ceil_digits
+from .units import AUTO_SIZE, ceil_digits
 from .vertex.rescue import Rescue, rescue_vertices
 from .vertex.sharpen import (
     kept_sharp,
@@ -139,8 +139,8 @@ class Job:
         What coarsening the mesh did (``params.faces`` or ``params.edge_length``), else None.
     bend : float
         The sheet material's bend floor in mesh units at the size given
-        (:meth:`~filletfold.parameters.Parameters.bend_floor`); 0 without a material or at the
-        default size.
+        (:meth:`~filletfold.parameters.Parameters.bend_floor`), or at the default size once
+        the edge stage settled it for the fillets (:func:`bend_floor`); 0 without a material.
     """
 
     params: Parameters
@@ -179,6 +179,11 @@ class Edges:
         The face pieces' centres.
     fitted : (n_edges,) float
         The radii after fitting to their limits, before any vertex changed them.
+    creased : (n_edges,) bool
+        Fillets made creases at the default size: too tight for the sheet material
+        (:func:`bend_floor`).
+    bend : float
+        The bend floor the fillets hold (mesh units; 0: none).
     """
 
     loss: MaterialLoss | None
@@ -187,6 +192,8 @@ class Edges:
     requested: np.ndarray
     centres: np.ndarray
     fitted: np.ndarray
+    creased: np.ndarray
+    bend: float = 0.0
 
 
 @dataclass
@@ -244,6 +251,10 @@ class Stages:
         The samples each vertex's solves added where its solution dipped between the samples
         (:func:`~filletfold.vertex.solve.solve_apices`): a kept vertex solved again later
         starts with them, as it would in a fresh design.
+    creased : (n_edges,) bool or None
+        The fillets made creases for the sheet material (:attr:`Edges.creased`).
+    bend : float
+        The bend floor of the rounding (:attr:`Edges.bend`).
     """
 
     key: tuple
@@ -261,6 +272,8 @@ class Stages:
     modules: list
     cleaned: tuple | None = None
     cuts: dict | None = None
+    creased: np.ndarray | None = None
+    bend: float = 0.0
 
 
 def read_stage(mesh, params: Parameters, progress, earlier: Stages | None) -> Job:
@@ -330,9 +343,11 @@ def edge_stage(job: Job, st: Stages | None) -> Edges:
     material-loss programme -- and each edge's cylinder; taken over from ``st`` when given."""
     _stage("rounding the edges")
     if st is not None:
+        job.bend = st.bend  # the floor the default size settled, as the stages were made
         return Edges(
-            st.loss, st.rounding, st.conical, st.requested, st.centres, st.rounding.radius.copy()
-        )
+            st.loss, st.rounding, st.conical, st.requested, st.centres,
+            st.rounding.radius.copy(), st.creased, st.bend,
+        )  # fmt: skip
     p, pm = job.params, job.mesh
     ref = pm.mean_edge_length
     loss, conical, floor, min_width = None, False, job.floor, job.min_width
@@ -358,23 +373,46 @@ def edge_stage(job: Job, st: Stages | None) -> Edges:
         r = given
         if p.clamp:
             r = clamp_radii(pm, r, flat_deg=p.coplanar_deg)
-    r = bend_floor(job, r)
+    r, creased = bend_floor(job, r)
     rounding = round_edges(pm, r, flat_deg=p.coplanar_deg, floor=floor, min_width=min_width)
     centres = face_piece_centres(pm, rounding)
-    return Edges(loss, rounding, conical, requested, centres, rounding.radius.copy())
+    return Edges(
+        loss, rounding, conical, requested, centres, rounding.radius.copy(), creased, job.bend
+    )
 
 
-def bend_floor(job: Job, radius: np.ndarray) -> np.ndarray:
+def bend_floor(job: Job, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The fitted radii with the sheet material's bend floor held
-    (:mod:`~filletfold.rounding.bend`), at a size that was given: every fillet below it is
-    raised to it; an edge whose limit is below it is refused, naming the least size that
-    holds it. Unchanged without a material, and at the default size (which grows until the
-    fillets hold it: :func:`~filletfold.layout.arrange.default_size`). Radii of the
-    material-loss programme are never raised (they are consistent only as they are)."""
+    (:mod:`~filletfold.rounding.bend`), and the edges made creases for it ((n_edges,) bool).
+
+    At a size that was given every fillet below the floor is raised to it; an edge whose limit
+    is below it is refused, naming the least size that holds it. At the default size, the
+    size first grows until all but the tightest
+    :data:`~filletfold.rounding.bend.CREASE_SHARE` of the fillets' length hold the floor
+    (:func:`~filletfold.rounding.bend.share_floor_size`, at least the labels' and the least
+    size: :func:`~filletfold.layout.arrange.default_size`); there the fillets below the floor
+    are raised to it where their limits allow and the others become creases (radius 0, a
+    straight crease folded by the dihedral), and ``job.bend`` is the floor in mesh units at
+    that size. Unchanged without a material. Radii of the material-loss programme are never
+    raised or creased (they are consistent only as they are), and ``strict`` creases none: at
+    the default size, the size grows until they all hold it."""
     p, pm, floor = job.params, job.mesh, job.bend
+    none = np.zeros(pm.n_edges, dtype=bool)
+    material = p.sheet_material()
+    auto = material is not None and p.size == AUTO_SIZE
+    if floor <= 0 and auto and not (p.material_loss or p.strict):
+        radius = np.broadcast_to(np.asarray(radius, dtype=float), (pm.n_edges,))
+        extent = float(np.ptp(pm.vertices, axis=0).max(initial=0.0))
+        need = share_floor_size(extent, material.bend_floor_mm(), radius, pm.edge_length)
+        if need is None:
+            return radius, none
+        mm, _ = default_size(extent, pm.mean_edge_length, None, need)
+        job.bend = floor = material.bend_floor_mm() * extent / mm
+        held, short = hold_floor(pm, radius, floor)
+        return np.where(short, 0.0, held), short
     if floor <= 0:
-        return radius
-    material, mm = p.sheet_material(), p.mm_per_unit
+        return radius, none
+    mm = p.mm_per_unit
     if p.material_loss:
         held, short = radius, (radius > 0) & (radius < floor * (1 - FLOOR_RTOL))
         factor = float(floor / radius[short].min()) if short.any() else 1.0
@@ -389,10 +427,11 @@ def bend_floor(job: Job, radius: np.ndarray) -> np.ndarray:
         raise ParameterError(
             f"{material.name} bends no tighter than {material.bend_floor_mm():g} mm (its least "
             f"inner radius plus half its thickness), but {len(edges)} edge(s) ({listed}) cannot "
-            f"hold a fillet that wide at --size {size:.4g}mm; the least size that can: {least}",
+            f"hold a fillet that wide at --size {size:.4g}mm; the least size that can: {least} "
+            "(without --size, the default size makes the tightest fillets creases)",
             name="size",
         )
-    return held
+    return held, none
 
 
 def normal_stage(job: Job, edges: Edges, st: Stages | None) -> VertexState:
@@ -638,6 +677,8 @@ def stages_of(job: Job, edges: Edges, sol: VertexSolution, mods: Modules) -> Sta
         if job.input_key is None
         else (job.input_key, job.mesh, job.clean_log, job.shift, job.coarsening),
         cuts=sol.cuts,
+        creased=edges.creased,
+        bend=edges.bend,
     )
 
 

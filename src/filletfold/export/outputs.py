@@ -177,7 +177,7 @@ REPORT_TABLES = ("mesh", "edges", "vertices")
 #: The per-element lists of the report's ``fitting``, with the tables only: the summary keeps
 #: their counts (``radii_reduced``, ``edges_sharp``, ``vertices_rescued``,
 #: ``vertices_sharpened``). On a 100k-face scan ``sharp`` alone was 458 KB of a 1.0 MB file.
-FITTING_TABLES = ("reduced", "sharp", "rescued", "sharpened")
+FITTING_TABLES = ("reduced", "sharp", "creased", "rescued", "sharpened")
 
 
 def _treatment_counts(treatment) -> dict:
@@ -274,12 +274,15 @@ def _fitting_report(design) -> dict:
         "radii_reduced": len(reduced),
         "smallest_factor": float(factor.min()) if len(reduced) else None,
         "edges_sharp": len(fit["sharp"]),
+        "edges_creased": len(fit.get("creased", ())),
+        "bend_floor": float(fit.get("bend_floor", 0.0)),
         "vertices_sharpened": len(sharpened),
         "reduced": [
             {"edge": int(e), "requested": float(asked[e]), "radius": float(fitted[e])}
             for e in reduced.tolist()
         ],
         "sharp": fit["sharp"].tolist(),
+        "creased": np.asarray(fit.get("creased", []), dtype=np.int64).tolist(),
         "vertices_rescued": len(fit["rescued"]),
         "rescue_applied": bool(fit["rescue_applied"]),
         "rescued": [{"vertex": int(u), "factor": float(f)} for u, f in fit["rescued"].items()],
@@ -507,7 +510,10 @@ _DEFAULT_SIZE_WHY = {
     "least": "a model held in the hand",
     "labels": f"the least with labels {MIN_LABEL_MM:g} mm high",
     "pieces": f"the least with every piece {MIN_PIECE_MM:g} mm across",
-    "material": "the least at which every fillet is as wide as the material bends",
+    "material": (
+        "the least at which the fillets are as wide as the material bends, but for the "
+        "tightest tenth of their length (creases)"
+    ),
 }
 
 
@@ -738,6 +744,19 @@ def _fitting_lines(design) -> list[str]:
         out.append(
             f"sharp edges: {len(fit['sharp'])} left sharp (a fillet narrower than "
             f"{tol.fillet_floor:g} of the edge would be a sliver)"
+        )
+    creased = fit.get("creased", ())
+    if len(creased):
+        p = design.params
+        material = p.sheet_material()
+        length = design.mesh.edge_length
+        rounded = fit["fitted_radius"] > 0
+        share = length[creased].sum() / max(length[rounded].sum() + length[creased].sum(), 1e-300)
+        name = material.name if material is not None else "the sheet"
+        out.append(
+            f"creased for the material: {len(creased)} fillets ({100 * share:.1f} % of the "
+            f"fillets' length) are tighter than {name} bends at {p.size} and too narrow to "
+            "widen: straight creases (a larger --size keeps more of them round)"
         )
     rescued = fit["rescued"]
     if rescued:
