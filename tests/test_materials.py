@@ -68,14 +68,19 @@ def test_a_given_size_widens_the_fillets_to_the_floor():
     assert "bend floor" not in {c.name for c in plain.certificate.checks}
 
 
-def test_a_size_too_small_names_the_least_size_that_holds():
+def test_a_size_too_small_creases_the_fillets_or_strict_names_the_least_size():
     with pytest.raises(
         ParameterError, match=r"cannot hold .* --size 2mm; the least size .*: 2\.5mm"
     ):
-        filletfold.round_mesh("cube", size="2mm", material="card-300gsm")
-    design = filletfold.round_mesh("cube", size="2.5mm", material="card-300gsm")
+        filletfold.round_mesh("cube", size="2mm", material="card-300gsm", strict=True)
+    creased = filletfold.round_mesh("cube", size="2mm", material="card-300gsm")
+    assert creased.certificate.ok
+    assert len(creased.fitting["creased"]) == 12  # every edge: a straight crease
+    assert not (np.asarray(creased.rounding.radius) > 0).any()
+    design = filletfold.round_mesh("cube", size="2.5mm", material="card-300gsm", strict=True)
     r = np.asarray(design.rounding.radius) * design.params.mm_per_unit
     assert design.certificate.ok and (r[r > 0] >= 1.2 * (1 - 1e-9)).all()
+    assert len(design.fitting["creased"]) == 0
 
 
 @pytest.mark.slow

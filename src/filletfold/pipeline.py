@@ -385,33 +385,37 @@ def bend_floor(job: Job, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The fitted radii with the sheet material's bend floor held
     (:mod:`~filletfold.rounding.bend`), and the edges made creases for it ((n_edges,) bool).
 
-    At a size that was given every fillet below the floor is raised to it; an edge whose limit
-    is below it is refused, naming the least size that holds it. At the default size, the
-    size first grows until all but the tightest
+    At the default size, the size first grows until all but the tightest
     :data:`~filletfold.rounding.bend.CREASE_SHARE` of the fillets' length hold the floor
     (:func:`~filletfold.rounding.bend.share_floor_size`, at least the labels' and the least
-    size: :func:`~filletfold.layout.arrange.default_size`); there the fillets below the floor
-    are raised to it where their limits allow and the others become creases (radius 0, a
-    straight crease folded by the dihedral), and ``job.bend`` is the floor in mesh units at
-    that size. Unchanged without a material. Radii of the material-loss programme are never
-    raised or creased (they are consistent only as they are), and ``strict`` creases none: at
-    the default size, the size grows until they all hold it."""
+    size: :func:`~filletfold.layout.arrange.default_size`), and ``job.bend`` is the floor in
+    mesh units at that size. At that size, or at the size given, every fillet below the floor
+    is raised to it where its edge's limit allows, and the others become creases (radius 0, a
+    straight crease folded by the dihedral). Unchanged without a material.
+
+    With ``strict``, or with the material-loss programme's radii (consistent only as they are:
+    never raised or creased), nothing is creased: at the default size the size grows until
+    every fillet holds the floor, and at a size given a fillet that cannot is refused, naming
+    the edges and the least size at which they can."""
     p, pm, floor = job.params, job.mesh, job.bend
     none = np.zeros(pm.n_edges, dtype=bool)
     material = p.sheet_material()
     auto = material is not None and p.size == AUTO_SIZE
-    if floor <= 0 and auto and not (p.material_loss or p.strict):
-        radius = np.broadcast_to(np.asarray(radius, dtype=float), (pm.n_edges,))
+    if floor <= 0 and not auto:
+        return radius, none
+    radius = np.broadcast_to(np.asarray(radius, dtype=float), (pm.n_edges,)).copy()
+    if floor <= 0 and not (p.material_loss or p.strict):
         extent = float(np.ptp(pm.vertices, axis=0).max(initial=0.0))
         need = share_floor_size(extent, material.bend_floor_mm(), radius, pm.edge_length)
         if need is None:
             return radius, none
         mm, _ = default_size(extent, pm.mean_edge_length, None, need)
         job.bend = floor = material.bend_floor_mm() * extent / mm
-        held, short = hold_floor(pm, radius, floor)
-        return np.where(short, 0.0, held), short
     if floor <= 0:
         return radius, none
+    if not (p.material_loss or p.strict):  # too tight and too narrow to widen: a crease
+        held, short = hold_floor(pm, radius, floor)
+        return np.where(short, 0.0, held), short
     mm = p.mm_per_unit
     if p.material_loss:
         held, short = radius, (radius > 0) & (radius < floor * (1 - FLOOR_RTOL))
@@ -427,8 +431,7 @@ def bend_floor(job: Job, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         raise ParameterError(
             f"{material.name} bends no tighter than {material.bend_floor_mm():g} mm (its least "
             f"inner radius plus half its thickness), but {len(edges)} edge(s) ({listed}) cannot "
-            f"hold a fillet that wide at --size {size:.4g}mm; the least size that can: {least} "
-            "(without --size, the default size makes the tightest fillets creases)",
+            f"hold a fillet that wide at --size {size:.4g}mm; the least size that can: {least}",
             name="size",
         )
     return held, none
