@@ -386,10 +386,11 @@ def test_the_reports_fitting_counts_its_lists_and_lists_them_with_the_tables(tmp
     d.export(tmp_path / "tables", tables=True)
     short = json.loads((tmp_path / "summary" / "report.json").read_text())["fitting"]
     full = json.loads((tmp_path / "tables" / "report.json").read_text())["fitting"]
-    lists = ("reduced", "sharp", "rescued", "sharpened")
+    lists = ("reduced", "sharp", "creased", "rescued", "sharpened")
     assert not set(lists) & set(short)
     assert {k: v for k, v in full.items() if k not in lists} == short
     assert short["vertices_rescued"] == len(full["rescued"]) == 8
     assert short["edges_sharp"] == len(full["sharp"])
     assert short["vertices_sharpened"] == len(full["sharpened"])
     assert short["radii_reduced"] == len(full["reduced"])
+    assert short["edges_creased"] == len(full["creased"]) == 0  # no sheet material

@@ -57,6 +57,7 @@ import numpy as np
 import shapely
 
 from .arrays import run_next, run_owners
+from .check_making import kerf_check, relief_check
 from .defaults import DEFAULT_ARC_STEP
 from .errors import MeshReadError, ParameterError
 from .export.fold import FOLD_DIGITS
@@ -463,6 +464,7 @@ def certify(
     quantum_source: str = f"coordinates rounded to {FOLD_DIGITS} digits",
     arc_step: float = DEFAULT_ARC_STEP,
     bend_floor: float = 0.0,
+    material=None,
 ) -> Certificate:
     """Measure the invariants of a crease pattern against the mesh it rounds.
 
@@ -494,6 +496,10 @@ def certify(
         The least radius a cylinder may have (mesh units): a sheet material's bend floor at
         the design's size (:meth:`~filletfold.materials.Material.bend_floor_mm`); 0 (no
         material) leaves the ``bend floor`` check out.
+    material : Material, optional
+        The sheet material whose floor ``bend_floor`` is: with a ``"relief"`` or ``"kerf"``
+        material the ``relief`` check, with ``"kerf"`` the ``kerfs`` check
+        (:mod:`~filletfold.check_making`), of the making paths of the pattern's annotations.
 
     Returns
     -------
@@ -524,7 +530,23 @@ def certify(
     ]
     if bend_floor > 0:
         checks.append(_bend_floor(data, float(bend_floor)))
+        checks += _making_checks(data, pattern, float(bend_floor), material)
     return Certificate(checks=checks, size=data.size, coord_quantum=data.q)
+
+
+def _making_checks(g: _Data, pattern, floor: float, material) -> list[Check]:
+    """``relief`` and ``kerfs`` of a sheet material (:mod:`~filletfold.check_making`)."""
+    if material is None or material.making not in ("relief", "kerf"):
+        return []
+    making = list(pattern.annotations.making)
+    kinds = (_CONE, _CYLINDER, _FACE, _FILLET)
+    ok, value, detail, worst = relief_check(g, making, floor, kinds)
+    out = [Check("relief", ok, value, 0.0, detail, "<=", worst)]
+    if material.making == "kerf" and material.kerf is not None:
+        mm = material.bend_floor_mm() / floor
+        ok, value, detail, worst = kerf_check(g, making, material.kerf, mm, _CYLINDER)
+        out.append(Check("kerfs", ok, value, 0.0, detail, "<=", worst))
+    return out
 
 
 def _ruling_isometry(g: _Data) -> Check:
@@ -1284,6 +1306,7 @@ def certify_design(design) -> Certificate:
         quantum_source=f"round-off: {ROUNDOFF_ULPS} ulp of the largest coordinate",
         arc_step=float(design.params.arc_step),
         bend_floor=design.params.bend_floor(),
+        material=design.params.sheet_material(),
     )
 
 
@@ -1351,7 +1374,7 @@ def check_folder(path) -> Certificate:
         if not f.is_file():
             raise MeshReadError(f"{f}: no such file (write the design with 'filletfold round')")
     pattern, doc = read_fold_document(fold)
-    mesh_vertices, mesh_faces, edges, apex, arc_step, bend = _read_report(report, doc, fold)
+    mesh_vertices, mesh_faces, edges, apex, arc_step, sheet = _read_report(report, doc, fold)
     try:
         return certify(
             pattern,
@@ -1361,7 +1384,8 @@ def check_folder(path) -> Certificate:
             apex,
             coord_quantum=file_quantum(pattern),
             arc_step=arc_step,
-            bend_floor=bend,
+            bend_floor=sheet[0],
+            material=sheet[1],
         )
     except ParameterError as exc:
         raise MeshReadError(f"{fold} does not match {report.name}: {exc}") from None
@@ -1373,7 +1397,8 @@ MESH_KEY = "filletfold:mesh_"
 
 
 def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | None = None):
-    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step, bend floor) of a
+    """(mesh vertices, mesh faces, edges dict, vertex apices, arc step, (bend floor,
+    material)) of a
     design: the mesh
     and its edges and apices from the ``filletfold:mesh_*`` keys of its FOLD document when it
     has them, else from the tables of its ``report.json`` (written with ``--report-tables``,
@@ -1418,16 +1443,18 @@ def _read_report(path: Path, fold_doc: dict | None = None, fold_path: Path | Non
     edges = {"vertices": ev, "faces": ef, "radius": radius, "half_angle": gamma, "kappa": kappa}
     if not (math.isfinite(arc_step) and 0 <= arc_step <= 180):
         raise MeshReadError(f"{path}: arc_step {arc_step} is not in [0, 180] degrees")
-    return vertices, faces, edges, apex, arc_step, _report_bend_floor(doc, path)
+    return vertices, faces, edges, apex, arc_step, _report_sheet(doc, path)
 
 
-def _report_bend_floor(doc: dict, path: Path) -> float:
-    """The bend floor (mesh units) of the parameters a design's report names
-    (:meth:`~filletfold.parameters.Parameters.bend_floor`); 0 without a material."""
+def _report_sheet(doc: dict, path: Path) -> tuple:
+    """``(bend floor, material)`` of the parameters a design's report names: the floor in
+    mesh units (:meth:`~filletfold.parameters.Parameters.bend_floor`; 0 without a material)
+    and the :class:`~filletfold.materials.Material` (None)."""
     from .parameters import Parameters
 
     try:
-        return Parameters.from_dict(doc.get("parameters"), where=f"{path}: parameters").bend_floor()
+        params = Parameters.from_dict(doc.get("parameters"), where=f"{path}: parameters")
+        return params.bend_floor(), params.sheet_material()
     except ParameterError as exc:
         raise MeshReadError(f"{path}: {exc}") from None
 

@@ -21,7 +21,14 @@ from dataclasses import dataclass
 
 from .errors import ParameterError
 
-__all__ = ["MATERIALS", "Material", "din6935_k_factor", "material_table", "resolve_material"]
+__all__ = [
+    "MATERIALS",
+    "Kerf",
+    "Material",
+    "din6935_k_factor",
+    "material_table",
+    "resolve_material",
+]
 
 
 def din6935_k_factor(inner_radius_mm: float, thickness_mm: float) -> float:
@@ -36,6 +43,52 @@ def din6935_k_factor(inner_radius_mm: float, thickness_mm: float) -> float:
         return 0.5
     k = 0.65 + 0.5 * math.log10(max(ratio, 1e-12))
     return min(max(k / 2, 0.25), 0.5)
+
+
+@dataclass(frozen=True)
+class Kerf:
+    """How a rigid sheet is kerfed to bend (``making = "kerf"``): straight grooves along the
+    rulings of every bend, on its inner (concave) side, ``depth_mm`` deep (a skin of
+    ``thickness - depth`` stays), ``width_mm`` wide (the tool), at least ``land_mm`` of sheet
+    between two grooves.
+
+    The model (the kerf-bending relation of woodworking: a groove of width ``w`` and depth
+    ``d`` that closes turns the sheet by ``2 atan(w / 2d)``, so a bend of radius ``R`` takes
+    a groove every ``R w / d``): each groove closes by at most :meth:`turn_max`, the least of
+    that closure and ``w / skin_radius_mm`` (the skin bends over the groove's width, no
+    tighter than ``skin_radius_mm``). A bend turning by ``phi`` over an arc of length ``A``
+    gets ``n = ceil(phi / turn_max)`` grooves ``A / n`` apart, each turning it by ``phi / n``;
+    two grooves must leave ``land_mm`` between them: ``r phi / n >= w + land``. That holds
+    for every bend of ``n >= 2`` grooves at :meth:`min_radius` ``= 2 (w + land) /
+    turn_max`` (the worst bend turns by a little more than one groove's turn: two grooves
+    share it); a bend of many grooves needs only ``(w + land) (1 + turn_max / phi) /
+    turn_max``, which a floor per bend would allow (not yet: one floor holds for all).
+    """
+
+    width_mm: float
+    depth_mm: float
+    land_mm: float
+    skin_radius_mm: float
+
+    def turn_max(self) -> float:
+        """The most one groove turns the sheet (radians)."""
+        close = 2.0 * math.atan(self.width_mm / (2.0 * self.depth_mm))
+        return min(close, self.width_mm / self.skin_radius_mm)
+
+    def min_radius(self) -> float:
+        """The least radius (mm) at which every kerfed bend leaves ``land_mm`` between its
+        grooves: ``2 (w + land) / turn_max`` (the class docstring)."""
+        return 2.0 * (self.width_mm + self.land_mm) / self.turn_max()
+
+    def as_dict(self) -> dict:
+        return {
+            "width_mm": self.width_mm,
+            "depth_mm": self.depth_mm,
+            "land_mm": self.land_mm,
+            "skin_radius_mm": self.skin_radius_mm,
+            "turn_max_deg": math.degrees(self.turn_max()),
+            "min_radius_mm": self.min_radius(),
+        }
 
 
 @dataclass(frozen=True)
@@ -55,6 +108,9 @@ class Material:
         crease lines), ``"relief"`` (sheet metal: brake or roll the bends, relieve the
         corners where bends meet) or ``"kerf"`` (plywood, acrylic: cuts along the rulings).
     description : str
+    kerf : Kerf or None
+        The grooves of a ``"kerf"`` material; its :meth:`Kerf.min_radius` is the material's
+        ``min_bend_radius_mm``.
     """
 
     name: str
@@ -63,6 +119,7 @@ class Material:
     k_factor: float
     making: str
     description: str = ""
+    kerf: Kerf | None = None
 
     def bend_floor_mm(self) -> float:
         """The least radius a bend of the design's surface (the sheet's middle) may have:
@@ -78,12 +135,23 @@ class Material:
             "k_factor": self.k_factor,
             "making": self.making,
             "bend_floor_mm": self.bend_floor_mm(),
+            **({"kerf": self.kerf.as_dict()} if self.kerf is not None else {}),
         }
 
 
 def _metal(name, t, r_over_t, description) -> Material:
     r = r_over_t * t
     return Material(name, t, r, din6935_k_factor(r, t), "relief", description)
+
+
+def _kerfed(name, t, kerf: Kerf, description) -> Material:
+    return Material(name, t, kerf.min_radius(), 0.5, "kerf", description, kerf)
+
+
+#: 3 mm birch plywood grooved 2 mm deep by a 1/8 in (3.2 mm) router bit, 2 mm of wood left
+#: between grooves, the 1 mm skin bent no tighter than 25 mm over a groove: a groove turns
+#: the sheet by at most 7.3 degrees, a bend is no tighter than 81.3 mm.
+_PLYWOOD_KERF = Kerf(width_mm=3.2, depth_mm=2.0, land_mm=2.0, skin_radius_mm=25.0)
 
 
 #: The presets of ``--material`` (values and their basis: ``docs/materials.md``).
@@ -95,7 +163,9 @@ MATERIALS: dict[str, Material] = {
         Material("polypropylene-0.5mm", 0.5, 0.0, 0.5, "score", "polypropylene sheet, 0.5 mm"),
         _metal("aluminium-1mm", 1.0, 1.0, "aluminium 5052-H32, 1 mm"),
         _metal("steel-0.8mm", 0.8, 1.0, "cold-rolled mild steel (DC01), 0.8 mm"),
-        Material("plywood-3mm", 3.0, 150.0, 0.5, "kerf", "birch plywood, 3 mm, bent without kerfs"),
+        _kerfed(
+            "plywood-3mm", 3.0, _PLYWOOD_KERF, "birch plywood, 3 mm, kerfed (unkerfed: 150 mm)"
+        ),
     )
 }
 
@@ -159,4 +229,5 @@ def resolve_material(
         base.k_factor if k_factor is None else float(k_factor),
         base.making,
         base.description,
+        base.kerf,
     )

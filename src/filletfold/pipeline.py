@@ -45,6 +45,7 @@ from .errors import (
 from .errors import stage as _stage
 from .layout.arrange import arrange, default_size
 from .layout.fabrication import cut_first, recut_solved
+from .layout.making import making_paths
 from .layout.net import cut_edges_for_nets
 from .mesh import load_mesh
 from .mesh.coarsen import Coarsening, coarse_target, coarsen_and_clean
@@ -712,6 +713,11 @@ def layout_stage(
         ~(sol.rounding.radius > 0),
         tol.closure * job.size,  # the apex and the edges' points, to round-off of the size
     )
+    material = params.sheet_material()
+    if material is not None and params.scale is not None:  # reliefs and kerfs, at its size
+        pattern.annotations.making = making_paths(
+            pattern, pm, sol.rounding, sol.res.apex, material, params.mm_per_unit
+        )
     return Layout(pattern, layout_used, layout_note, fab, pieces, params)
 
 

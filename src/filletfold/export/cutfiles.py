@@ -242,6 +242,7 @@ def scaled_pattern(pattern: CreasePattern, scale: float) -> CreasePattern:
             ),
             sheets=np.asarray(ann.sheets, dtype=np.float64) * scale,
             seams=ann.seams,
+            making=[dataclasses.replace(m, points=m.points * scale) for m in ann.making],
         ),
     )
 

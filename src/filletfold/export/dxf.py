@@ -48,6 +48,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
+from ..layout.making import MAKING_KINDS
 from ..surface.pattern import CreasePattern
 from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units
@@ -59,7 +60,7 @@ from .paths import (
     pattern_extent,
     tab_cut_paths,
 )
-from .presets import Preset, dxf_lineweight, get_preset, hex_rgb
+from .presets import Preset, dxf_lineweight, get_preset, hex_rgb, making_pens
 
 __all__ = ["DXF_INSUNITS", "LAYER_COLOR", "check_scale", "pattern_dxf"]
 
@@ -168,6 +169,11 @@ def _fill(
     pens = preset.pens()
     if not flat_edges:
         del pens["flat"]
+    kinds = {m.kind for m in pattern.annotations.making}
+    making = making_pens(preset)
+    for kind in MAKING_KINDS:  # the layers of a sheet material's reliefs and grooves
+        if kind in kinds:
+            pens[kind] = making[kind]
     for pen in pens.values():
         layer = doc.layers.add(pen.layer, color=pen.aci)
         if preset.true_color:
@@ -224,6 +230,8 @@ def _fill(
     else:
         for a, b in hinges:
             msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": tab.layer})
+    for m in pattern.annotations.making:  # a sheet material's reliefs and kerf grooves
+        _add_path(msp, np.asarray(m.points) * scale, m.closed, making[m.kind].layer)
     for label in pattern.annotations.labels:
         pos = np.asarray(label.position, dtype=np.float64).reshape(2) * scale
         text = msp.add_text(

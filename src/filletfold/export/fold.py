@@ -428,7 +428,9 @@ def annotations_json(pattern: CreasePattern) -> str:
         ``"tabs"``, ``"tab_hinges"``, ``"labels"`` and ``"sheets"`` (empty lists when there
         are none), and with glue tabs ``"seams"``: ``"pieces"`` (the pieces' names),
         ``"joins"`` (per label, the two pieces it joins, by index) and ``"tab_on"`` (per
-        label, 0 or 1: the one that carries its tab; -1: no tab).
+        label, 0 or 1: the one that carries its tab; -1: no tab); with a sheet material's
+        reliefs or kerf grooves ``"making"``: one ``{"kind", "patch", "closed", "points"}``
+        each (:class:`~filletfold.layout.making.MakingPath`).
 
     Raises
     ------
@@ -447,6 +449,17 @@ def annotations_json(pattern: CreasePattern) -> str:
             "joins": seams.pieces.tolist(),
             "tab_on": seams.tab_on.tolist(),
         }
+    making = pattern.annotations.making
+    if making:  # a sheet material's reliefs and kerf grooves (none: no key, as before)
+        doc["making"] = [
+            {
+                "kind": m.kind,
+                "patch": m.patch,
+                "closed": bool(m.closed),
+                "points": np.asarray(m.points, dtype=np.float64).tolist(),
+            }
+            for m in making
+        ]
     return fold_json(doc, root="annotations")
 
 

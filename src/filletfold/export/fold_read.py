@@ -222,9 +222,27 @@ def _annotations(data, where: str = NAMESPACE + "annotations") -> Annotations:
         labels = _labels(data.get("labels", []))
         sheets = np.asarray(data.get("sheets", []), dtype=np.float64).reshape(-1, 4)
         seams = _seams(data.get("seams"))
+        making = _making(data.get("making", []))
     except (TypeError, ValueError, KeyError, AttributeError) as exc:
         raise MeshReadError(f"{where} is malformed ({exc!r})") from None
-    return Annotations(tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets, seams=seams)
+    return Annotations(
+        tabs=tabs, tab_hinges=hinges, labels=labels, sheets=sheets, seams=seams, making=making
+    )
+
+
+def _making(items) -> list:
+    """The :class:`~filletfold.layout.making.MakingPath` list of an annotations file's
+    ``"making"``."""
+    from ..layout.making import MAKING_KINDS, MakingPath
+
+    out = []
+    for item in items:
+        kind, patch = item["kind"], item["patch"]
+        if kind not in MAKING_KINDS or not isinstance(patch, str):
+            raise ValueError(f"making path of kind {kind!r}, patch {patch!r}")
+        points = np.asarray(item["points"], dtype=np.float64).reshape(-1, 2)
+        out.append(MakingPath(kind, patch, points, bool(item["closed"])))
+    return out
 
 
 def _seams(data):

@@ -10,6 +10,7 @@ import numpy as np
 from .. import __version__
 from ..arrays import run_next, run_starts
 from ..errors import named_stages
+from ..layout.making import score_layers
 from ..layout.tabs import assembly_text
 from ..memory import release_memory
 from ..rounding.edges import loss_from_radius
@@ -23,6 +24,7 @@ from .assembly import assembly_pdf
 from .cutfiles import DEFAULT_FORMATS, cut_files, output_names, parse_formats
 from .folder import write_design_folder
 from .png import parse_view
+from .presets import get_preset, score_preset
 from .report import Records
 
 #: The files :func:`export_design` writes by default (and ``assembly.txt`` with glue tabs).
@@ -166,7 +168,50 @@ def material_report(design) -> dict | None:
             "distance of its apex) and a tapering fillet near its sharp corner: relieve or "
             "crease the sheet there"
         ),
+        "making": _making_report(design, material),
     }
+
+
+#: Per way of making (:attr:`~filletfold.materials.Material.making`), what the cut files do.
+_MAKING_WHY = {
+    "score": (
+        "creases scored: mountains on the front (layer SCORE_FRONT), valleys on the back "
+        "(SCORE_BACK, the sheet turned over); the sheet bends its fillets and cones freely "
+        "and creases itself at a cone's tip"
+    ),
+    "relief": (
+        "bends rolled or braked; where a cone near its tip or a tapering fillet near its "
+        "sharp corner would bend tighter than the floor, the sheet is cut away (layer RELIEF)"
+    ),
+    "kerf": (
+        "every cylinder grooved along its rulings on its inner side (layers KERF_FRONT, "
+        "KERF_BACK), the grooves' turns adding up to its bend; the cones' tips and the "
+        "tapering fillets' corners relieved (RELIEF)"
+    ),
+}
+
+
+def _making_report(design, material) -> dict:
+    """How the material's bends are made (:mod:`~filletfold.layout.making`): the way, why,
+    and the counts of the paths drawn for it."""
+    making = design.pattern.annotations.making
+    reliefs = [m for m in making if m.kind == "relief"]
+    grooves = [m for m in making if m.kind != "relief"]
+    out = {
+        "method": material.making,
+        "why": _MAKING_WHY.get(material.making, ""),
+        "score_layers": score_layers(material.making),
+        "reliefs": len(reliefs),
+        "relieved_cones": len({m.patch for m in reliefs if m.patch.startswith("cone ")}),
+        "relieved_fillets": len({m.patch for m in reliefs if m.patch.startswith("fillet ")}),
+        "grooves_front": sum(m.kind == "kerf-front" for m in grooves),
+        "grooves_back": sum(m.kind == "kerf-back" for m in grooves),
+        "grooved_cylinders": len({m.patch for m in grooves}),
+        "creased_fillets": len((design.fitting or {}).get("creased", ())),
+    }
+    if material.kerf is not None:
+        out["kerf"] = material.kerf.as_dict()
+    return out
 
 
 #: The per-element tables of :func:`report_records`, in ``report.json`` only on request
@@ -531,17 +576,34 @@ def _material_lines(design) -> list[str]:
         line += f": {m['fillets']} fillets, the least {m['least_fillet_radius_mm']:.4g} mm"
     lines = [line]
     tips = m["cone_tip_zones"]
-    if tips is not None and tips["max_mm"] > 0:
+    mk = m["making"]
+    if mk["method"] == "score":
+        lines.append("  made by: " + mk["why"])
+    else:
         lines.append(
-            f"  note: the cones bend tighter than that within {tips['median_mm']:.3g} mm of "
-            f"their tips (median of {tips['cones']}; {tips['max_mm']:.3g} mm at vertex "
-            f"{tips['max_at_vertex']}): relieve or crease the sheet there"
+            f"  made by: {mk['reliefs']} reliefs ({mk['relieved_cones']} cone tips, "
+            f"{mk['relieved_fillets']} tapering fillets)"
+            + (
+                f", {mk['grooves_front'] + mk['grooves_back']} kerf grooves on "
+                f"{mk['grooved_cylinders']} cylinders ({mk['grooves_front']} front, "
+                f"{mk['grooves_back']} back)"
+                if mk["method"] == "kerf"
+                else ""
+            )
+            + " in the cut files"
         )
-    if m["tapering_fillets"]:
-        lines.append(
-            f"  note: {m['tapering_fillets']} tapering fillets narrow to their sharp corner: "
-            "crease the sheet there"
-        )
+    if mk["method"] == "score":
+        if tips is not None and tips["max_mm"] > 0:
+            lines.append(
+                f"  note: the cones bend tighter than that within {tips['median_mm']:.3g} mm "
+                f"of their tips (median of {tips['cones']}; {tips['max_mm']:.3g} mm at vertex "
+                f"{tips['max_at_vertex']}): the sheet creases there"
+            )
+        if m["tapering_fillets"]:
+            lines.append(
+                f"  note: {m['tapering_fillets']} tapering fillets narrow to their sharp "
+                "corner: the sheet creases there"
+            )
     return lines
 
 
@@ -819,7 +881,9 @@ def export_design(
         its sheet, or A4). Units given without a scale: scale 1.
     preset : str or Preset, optional
         Cutter preset of ``pattern.svg`` and ``pattern.dxf``
-        (:data:`~filletfold.export.presets.PRESETS`; default ``print``).
+        (:data:`~filletfold.export.presets.PRESETS`; default ``print``); with a scored sheet
+        material (``design.params.material``) its mountain and valley lines are on the layers
+        ``SCORE_FRONT`` and ``SCORE_BACK`` (:func:`~filletfold.export.presets.score_preset`).
     view : str or (2,) float, optional
         The direction ``preview.png`` is seen from (see
         :func:`~filletfold.export.cutfiles.cut_files`), up the design's ``up`` unless it
@@ -848,6 +912,9 @@ def export_design(
     title = title or f"filletfold design of {design.source}"
     pattern_formats = [f for f in formats if f != "json"]
     files = {}
+    material = design.params.sheet_material()
+    if material is not None:  # a scored material's fold lines on its score layers
+        preset = score_preset(get_preset(preset), score_layers(material.making))
     if pattern_formats:
         files = cut_files(
             design.pattern,

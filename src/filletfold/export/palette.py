@@ -8,7 +8,14 @@ border/cut black). The SVG and DXF follow a cutter preset instead
 
 from __future__ import annotations
 
-__all__ = ["ASSIGNMENT_COLOR", "LABEL_COLOR", "PATCH_COLOR", "SHEET_COLOR", "TAB_HINGE_COLOR"]
+__all__ = [
+    "ASSIGNMENT_COLOR",
+    "KERF_COLOR",
+    "LABEL_COLOR",
+    "PATCH_COLOR",
+    "SHEET_COLOR",
+    "TAB_HINGE_COLOR",
+]
 
 #: Stroke colour of each edge assignment.
 ASSIGNMENT_COLOR = {"M": "#ff0000", "V": "#0000ff", "B": "#000000", "F": "#dddddd"}
@@ -27,3 +34,6 @@ PATCH_COLOR = {
     "fillet": (0.24, 0.78, 0.78),
     "face": (0.45, 0.78, 0.45),
 }
+#: The kerf grooves of a sheet material, cut from the front and from the back (the presets'
+#: pens, :func:`~filletfold.export.presets.making_pens`).
+KERF_COLOR = {"kerf-front": "#ff8000", "kerf-back": "#8000ff"}

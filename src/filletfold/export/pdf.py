@@ -33,7 +33,7 @@ from ..surface.validate import validate_pattern
 from ..tolerances import tol
 from ..units import MM_PER_UNIT, check_units, sheet_size_mm
 from .dxf import check_scale
-from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
+from .palette import ASSIGNMENT_COLOR, KERF_COLOR, LABEL_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import drawn_points, edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 from .svg import nice_length
 
@@ -279,6 +279,10 @@ def _drawing_mm(pattern: CreasePattern, k: float) -> dict:
         for p, closed in tab_cut_paths(ann)
     ]
     out["TAB"] = [np.asarray(h, dtype=np.float64).reshape(2, 2) * k for h in ann.tab_hinges]
+    for m in ann.making:  # a sheet material's reliefs (cut) and kerf grooves
+        p = np.asarray(m.points, dtype=np.float64) * k
+        layer = "CUT" if m.kind == "relief" else m.kind.upper().replace("-", "_")
+        out.setdefault(layer, []).append(np.vstack([p, p[:1]]) if m.closed else p)
     sheets = np.asarray(ann.sheets, dtype=np.float64).reshape(-1, 4) * k
     out["SHEET"] = [
         np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]]) for x0, y0, x1, y1 in sheets
@@ -338,6 +342,8 @@ def _page_figure(layers: dict, tile: Tile, width: float, height: float, margin: 
         ("VALLEY", ASSIGNMENT_COLOR["V"], lw, "solid"),
         ("MOUNTAIN", ASSIGNMENT_COLOR["M"], lw, "solid"),
         ("TAB", TAB_HINGE_COLOR, lw, (0, (4, 3))),
+        ("KERF_FRONT", KERF_COLOR["kerf-front"], lw, "solid"),
+        ("KERF_BACK", KERF_COLOR["kerf-back"], lw, "solid"),
     ]
     for layer, color, width_pt, style in styles:
         if layer not in layers:

@@ -20,7 +20,7 @@ from ..surface.patch import patch_kind
 from ..surface.pattern import CreasePattern
 from ..surface.triangulate import triangulate_faces
 from ..surface.validate import validate_pattern
-from .palette import LABEL_COLOR, PATCH_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
+from .palette import KERF_COLOR, LABEL_COLOR, PATCH_COLOR, SHEET_COLOR, TAB_HINGE_COLOR
 from .paths import edge_chains, edge_layer_masks, pattern_extent, tab_cut_paths
 
 __all__ = [
@@ -150,6 +150,15 @@ def pattern_png(pattern: CreasePattern, *, width_px: int = 1600) -> bytes:
         ax.add_collection(
             LineCollection(hinges, colors=TAB_HINGE_COLOR, linewidths=lw, linestyles=(0, (4, 3)))
         )
+    reliefs = [np.asarray(m.points) for m in ann.making if m.kind == "relief"]
+    if reliefs:  # cut out: white, outlined as cuts
+        ax.add_collection(
+            PolyCollection(reliefs, facecolors="#ffffff", edgecolors="#000000", linewidths=lw)
+        )
+    for kind, color in KERF_COLOR.items():
+        grooves = [np.asarray(m.points) for m in ann.making if m.kind == kind]
+        if grooves:
+            ax.add_collection(LineCollection(grooves, colors=color, linewidths=lw))
     units_per_px = 2 * half[0] / width_px
     for lb in ann.labels:
         pt = float(lb.height) / units_per_px * 72.0 / _DPI / 0.72

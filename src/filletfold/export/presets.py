@@ -46,6 +46,7 @@ import dataclasses
 import math
 
 from ..errors import ParameterError
+from .palette import KERF_COLOR
 
 __all__ = [
     "DEFAULT_PRESET",
@@ -57,6 +58,8 @@ __all__ = [
     "dxf_lineweight",
     "get_preset",
     "hex_rgb",
+    "making_pens",
+    "score_preset",
 ]
 
 #: Finest printed length (mm) the coordinates of a cut file resolve (a preset's
@@ -305,4 +308,34 @@ def get_preset(preset: str | Preset | None = None) -> Preset:
         return PRESETS[preset.strip().lower()]
     raise ParameterError(
         f"unknown preset {preset!r}: choose from {', '.join(PRESETS)}", name="preset"
+    )
+
+
+def making_pens(preset: Preset) -> dict[str, Pen]:
+    """The pens of a sheet material's making paths (:mod:`~filletfold.layout.making`) in a
+    preset: a relief is cut through like the borders (the cut pen, whole even where the cut
+    pen perforates, on layer ``RELIEF``); a kerf groove is cut part way, from the front
+    (orange, ``KERF_FRONT``) or the back (violet, ``KERF_BACK``: the drawing as seen from the
+    front; the sheet is turned over to cut it), at the cut pen's width."""
+    cut = preset.cut
+    w = cut.width_mm
+    return {
+        "relief": dataclasses.replace(
+            cut, layer="RELIEF", perforation_mm=None, dash_mm=None, dash_share=None
+        ),
+        "kerf-front": Pen(KERF_COLOR["kerf-front"], "KERF_FRONT", 30, w),
+        "kerf-back": Pen(KERF_COLOR["kerf-back"], "KERF_BACK", 200, w),
+    }
+
+
+def score_preset(preset: Preset, layers: dict[str, str] | None) -> Preset:
+    """``preset`` with its mountain and valley pens on the score layers ``layers``
+    (:func:`~filletfold.layout.making.score_layers`: ``SCORE_FRONT``, ``SCORE_BACK``), or
+    itself when ``layers`` is None."""
+    if not layers:
+        return preset
+    return dataclasses.replace(
+        preset,
+        mountain=dataclasses.replace(preset.mountain, layer=layers["mountain"]),
+        valley=dataclasses.replace(preset.valley, layer=layers["valley"]),
     )

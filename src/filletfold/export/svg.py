@@ -43,6 +43,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from ..errors import ParameterError
+from ..layout.making import MAKING_KINDS
 from ..surface.pattern import CreasePattern, LabelRows
 from ..surface.validate import validate_pattern
 from ..units import MM_PER_UNIT, check_units
@@ -54,7 +55,7 @@ from .paths import (
     simplify_polylines,
     tab_cut_paths,
 )
-from .presets import RESOLUTION_MM, Pen, Preset, get_preset
+from .presets import RESOLUTION_MM, Pen, Preset, get_preset, making_pens
 
 __all__ = [
     "MIN_POINT_SPACING",
@@ -297,6 +298,9 @@ def _pattern_svg_chunks(
     legend = [(getattr(preset, _ROLE[code]).color, label) for code, _, label in groups]
     if len(hinges):
         legend.append((preset.tab.color, "tab hinge"))
+    for kind in MAKING_KINDS:
+        if any(m.kind == kind for m in ann.making):
+            legend.append((making_pens(preset)[kind].color, kind.replace("-", " ")))
 
     def body() -> Iterator[str]:
         """The drawing's groups, each made when it is written."""
@@ -336,6 +340,13 @@ def _pattern_svg_chunks(
             else:
                 yield draw.lines(hinges[:, 0], hinges[:, 1], pen.color)
             yield "</g>"
+        pens = making_pens(preset)
+        for kind in MAKING_KINDS:  # a sheet material's reliefs and kerf grooves
+            made = [(m.points, m.closed) for m in ann.making if m.kind == kind]
+            if made:
+                yield draw.group_open(kind, pens[kind], join=True)
+                yield draw.polylines(made, pens[kind].color)
+                yield "</g>"
         yield from _label_group(pattern, draw, preset.label.color)
 
     draw_w = float(size[0]) * k + 2 * margin

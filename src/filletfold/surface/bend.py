@@ -15,20 +15,44 @@ A cone that reaches its apex (the dimple's tip) bends tighter than any floor nea
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..arrays import run_next, run_owners
 from ..mesh.measures import newell_vectors
 
-__all__ = ["cone_bend_radii", "cone_tip_zones"]
+__all__ = ["ConeRulings", "cone_bend_radii", "cone_rulings", "cone_tip_zones"]
 
 #: A turn between two faces under this (radians) is no bend (a diagonal of a flat facet).
 FLAT_TURN = 1e-9
+_NO_ENDS = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
+
+
+class ConeRulings(NamedTuple):
+    """The bent ruling edges inside the cones of a pattern (:func:`cone_rulings`): per edge,
+    ``radius`` across it at its nearer end, its ``cone`` (mesh vertex), ``rate`` (the radius
+    per unit of distance from the apex) and its ends ``a`` (the nearer to the apex) and
+    ``b`` (pattern vertices)."""
+
+    radius: np.ndarray
+    cone: np.ndarray
+    rate: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
 
 
 def cone_bend_radii(
     v3: np.ndarray, flat: np.ndarray, start: np.ndarray, face_cone: np.ndarray, apex: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(radius, cone, rate)`` of :func:`cone_rulings`."""
+    r = cone_rulings(v3, flat, start, face_cone, apex)
+    return r.radius, r.cone, r.rate
+
+
+def cone_rulings(
+    v3: np.ndarray, flat: np.ndarray, start: np.ndarray, face_cone: np.ndarray, apex: np.ndarray
+) -> ConeRulings:
     """The radius of curvature across every ruling edge inside a cone.
 
     Parameters
@@ -44,19 +68,18 @@ def cone_bend_radii(
 
     Returns
     -------
-    radius : (k,) float
-        Per edge shared by two faces of one cone and bent (turn over :data:`FLAT_TURN`).
-    cone : (k,) int
-        The mesh vertex of its cone.
-    rate : (k,) float
+    ConeRulings
+        ``radius`` (k,) per edge shared by two faces of one cone and bent (turn over
+        :data:`FLAT_TURN`); ``cone`` (k,) the mesh vertex of its cone; ``rate`` (k,)
         ``dpsi / dtheta``: the radius grows by it per unit of distance from the apex, so the
         cone bends tighter than ``floor`` along that ruling within ``floor / rate`` of its
-        apex (``radius = s * rate``, ``s`` the edge's nearer end's distance from the apex).
+        apex (``radius = s * rate``, ``s`` the edge's nearer end's distance from the apex);
+        ``a``, ``b`` (k,) its nearer and farther end.
     """
     v3 = np.asarray(v3, dtype=np.float64)
     flat, start = np.asarray(flat, dtype=np.int64), np.asarray(start, dtype=np.int64)
     face_cone = np.asarray(face_cone, dtype=np.int64)
-    none = np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros(0)
+    none = ConeRulings(*(np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros(0)), *_NO_ENDS)
     if not len(flat) or not (face_cone >= 0).any():
         return none
     owner = run_owners(np.diff(start))
@@ -90,13 +113,15 @@ def cone_bend_radii(
     spread = np.arctan2(np.linalg.norm(np.cross(first, rays), axis=1), (first * rays).sum(axis=1))
     width = np.maximum.reduceat(spread, start[:-1]) if len(start) > 1 else np.zeros(0)
     u = cone[h1]
-    s = np.minimum(
-        np.linalg.norm(v3[a[h1]] - apex[u], axis=1), np.linalg.norm(v3[b[h1]] - apex[u], axis=1)
-    )
+    sa = np.linalg.norm(v3[a[h1]] - apex[u], axis=1)
+    sb = np.linalg.norm(v3[b[h1]] - apex[u], axis=1)
+    near = np.where(sa <= sb, a[h1], b[h1])
+    far = np.where(sa <= sb, b[h1], a[h1])
+    s = np.minimum(sa, sb)
     bent = turn > FLAT_TURN
     with np.errstate(divide="ignore", invalid="ignore"):
         rate = 0.5 * (width[f1] + width[f2]) / turn
-    return (s * rate)[bent], u[bent], rate[bent]
+    return ConeRulings((s * rate)[bent], u[bent], rate[bent], near[bent], far[bent])
 
 
 def cone_tip_zones(pattern, apex: np.ndarray, floor: float) -> np.ndarray:

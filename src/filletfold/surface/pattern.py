@@ -324,6 +324,9 @@ class Annotations:
     seams : Seams or None
         The numbered cut borders the labels name: the two pieces each joins and which one
         carries its tab (:class:`~filletfold.layout.tabs.Seams`; None without glue tabs).
+    making : list of MakingPath
+        How a sheet material's bends are made: reliefs and kerf grooves
+        (:mod:`~filletfold.layout.making`; none without a material, or for one that is scored).
     """
 
     tabs: list = field(default_factory=list)
@@ -331,6 +334,7 @@ class Annotations:
     labels: list = field(default_factory=list)
     sheets: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     seams: object = None
+    making: list = field(default_factory=list)
 
 
 @dataclass
