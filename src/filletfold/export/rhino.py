@@ -60,7 +60,10 @@ __all__ = [
     "RHINO_UNITS",
     "folded_3dm",
     "kind_layer",
+    "patch_meshes",
+    "path_curve",
     "pattern_3dm",
+    "pattern_paths",
     "require_rhino3dm",
 ]
 
@@ -144,23 +147,27 @@ class _Model:
         return attr
 
     def add_path(self, points: np.ndarray, closed: bool, layer: str, spline: bool) -> None:
-        """One run: a degree-3 curve through ``points`` with ``spline``, else a line (two
-        points) or a polyline (closed: back to its first point)."""
-        r = self.r
-        if spline:
-            curve = _interpolating_curve(r, np.asarray(points, dtype=np.float64))
-        else:
-            pts = [r.Point3d(x, y, z) for x, y, z in np.asarray(points, dtype=float).tolist()]
-            if len(pts) == 2 and not closed:
-                curve = r.LineCurve(pts[0], pts[1])
-            else:
-                curve = r.PolylineCurve([*pts, pts[0]] if closed else pts)
-        self.file.Objects.AddCurve(curve, self.attributes(layer))
+        """One run (:func:`path_curve`) on ``layer``."""
+        self.file.Objects.AddCurve(
+            path_curve(self.r, points, closed, spline), self.attributes(layer)
+        )
 
     def encode(self) -> bytes:
         options = self.r.File3dmWriteOptions()
         options.Version = RHINO_VERSION
         return _fixed_dates(base64.b64decode(self.file.Encode(options)))
+
+
+def path_curve(r, points: np.ndarray, closed: bool, spline: bool):
+    """One run of the 3dm files as a ``rhino3dm`` curve: a degree-3 curve through ``points``
+    (k, 3) with ``spline``, else a line (two points) or a polyline (closed: back to its first
+    point). ``r`` is the ``rhino3dm`` module."""
+    if spline:
+        return _interpolating_curve(r, np.asarray(points, dtype=np.float64))
+    pts = [r.Point3d(x, y, z) for x, y, z in np.asarray(points, dtype=float).tolist()]
+    if len(pts) == 2 and not closed:
+        return r.LineCurve(pts[0], pts[1])
+    return r.PolylineCurve([*pts, pts[0]] if closed else pts)
 
 
 def _interpolating_curve(r, points: np.ndarray):
@@ -300,20 +307,29 @@ def pattern_3dm(pattern: CreasePattern, *, units: str = "", scale: float = 1.0) 
     return _pattern_3dm(rhino3dm, pattern, units, scale)
 
 
-def _pattern_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> bytes:
-    model = _Model(rhino3dm, "pattern.3dm", units, PATTERN_LAYERS)
+def pattern_paths(pattern: CreasePattern, scale: float = 1.0):
+    """The runs ``pattern.3dm`` draws, in its order: ``(layer, points (k, 3), closed, spline)``
+    for the ``CUT`` runs and the tabs' cut outlines, the ``MOUNTAIN`` and ``VALLEY`` runs and
+    the ``TAB`` hinges, in the plane z = 0, times ``scale`` (the labels are not among them)."""
     v = np.c_[pattern.vertices_2d * scale, np.zeros(len(pattern.vertices_2d))]
     ann = pattern.annotations
     for layer, runs in crease_runs(pattern, ("CUT", "MOUNTAIN", "VALLEY")).items():
         for ids, spline, closed in runs:
-            model.add_path(v[ids], closed, layer, spline)
+            yield layer, v[ids], closed, spline
         if layer == "CUT":
             for pts, closed in tab_cut_paths(ann):
                 p = np.asarray(pts, dtype=np.float64).reshape(-1, 2) * scale
-                model.add_path(np.c_[p, np.zeros(len(p))], closed, "CUT", False)
+                yield "CUT", np.c_[p, np.zeros(len(p))], closed, False
     for hinge in ann.tab_hinges:
         h = np.asarray(hinge, dtype=np.float64).reshape(2, 2) * scale
-        model.add_path(np.c_[h, np.zeros(2)], False, "TAB", False)
+        yield "TAB", np.c_[h, np.zeros(2)], False, False
+
+
+def _pattern_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> bytes:
+    model = _Model(rhino3dm, "pattern.3dm", units, PATTERN_LAYERS)
+    ann = pattern.annotations
+    for layer, points, closed, spline in pattern_paths(pattern, scale):
+        model.add_path(points, closed, layer, spline)
     for label in ann.labels:
         x, y = (np.asarray(label.position, dtype=np.float64).reshape(2) * scale).tolist()
         at = rhino3dm.Point3d(x, y, 0.0)
@@ -351,11 +367,26 @@ def folded_3dm(pattern: CreasePattern, *, units: str = "", scale: float = 1.0) -
 
 
 def _folded_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> bytes:
-    from .mesh3d import folded_triangles
-
     kinds = kinds_present(pattern.face_patch)
     layers = {kind_layer(k): PATCH_COLOR.get(k, (0.8, 0.8, 0.8)) for k in kinds}
     model = _Model(rhino3dm, "folded.3dm", units, {**layers, **FOLDED_CREASE_LAYERS})
+    for name, mesh in patch_meshes(rhino3dm, pattern, scale):
+        attr = model.attributes(kind_layer(patch_kind(name, "patch")), str(name))
+        model.file.Objects.AddMesh(mesh, attr)
+    v3 = pattern.vertices_3d * scale
+    for layer, runs in crease_runs(pattern).items():
+        for ids, spline, closed in runs:
+            model.add_path(v3[ids], closed, layer, spline)
+    return model.encode()
+
+
+def patch_meshes(rhino3dm, pattern: CreasePattern, scale: float = 1.0):
+    """The folded form's patches as ``rhino3dm`` meshes, as ``folded.3dm`` holds them:
+    ``(patch name, Mesh)`` per patch in the order of their first face, with double-precision
+    vertices times ``scale`` and Rhino's vertex normals; triangles and quads stay as they are
+    (Rhino's mesh faces), larger polygons are split into triangles."""
+    from .mesh3d import folded_triangles
+
     v3 = pattern.vertices_3d * scale
     patches = dict.fromkeys(pattern.face_patch)
     for k, name in enumerate(patches):
@@ -366,7 +397,6 @@ def _folded_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> b
     flat, start = validated_faces(pattern)
     sizes = np.diff(start)
     tris, tri_face = folded_triangles(pattern)
-    # triangles and quads stay as they are (Rhino's mesh faces); larger polygons are split
     tris = tris[sizes[tri_face] > 4]
     tri_patch = face_patch[tri_face[sizes[tri_face] > 4]]
     small = np.flatnonzero(sizes <= 4)
@@ -389,9 +419,4 @@ def _folded_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> b
             mesh.Faces.AddFace(*local[at : at + len(c)])
             at += len(c)
         mesh.Normals.ComputeNormals()
-        attr = model.attributes(kind_layer(patch_kind(name, "patch")), str(name))
-        model.file.Objects.AddMesh(mesh, attr)
-    for layer, runs in crease_runs(pattern).items():
-        for ids, spline, closed in runs:
-            model.add_path(v3[ids], closed, layer, spline)
-    return model.encode()
+        yield name, mesh
