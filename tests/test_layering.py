@@ -1,7 +1,8 @@
 """Layering: the library never imports its front ends, and its rooms follow the method's flow.
 
-Geometry lives in the library; the browser app (:mod:`filletfold.app`) and the command line
-(:mod:`filletfold.cli`) only parse, call and display. So no other module imports
+Geometry lives in the library; the browser app (:mod:`filletfold.app`), the command line
+(:mod:`filletfold.cli`) and the Hops server (:mod:`filletfold.hops`) only parse, call and
+display. So no other module imports
 ``filletfold.app`` -- at the top or inside a function -- and in particular no writer under
 :mod:`filletfold.export`. The rooms follow the flow (mesh -> rounding -> vertex -> surface ->
 layout -> export): a room imports only from the rooms before it, and no module imports one
@@ -19,8 +20,8 @@ import pytest
 import filletfold
 
 ROOT = Path(filletfold.__file__).parent
-#: The front ends: they may import the app.
-FRONT_ENDS = ("filletfold.app", "filletfold.cli")
+#: The front ends: they may import the app (the Hops server takes the app's bind policy).
+FRONT_ENDS = ("filletfold.app", "filletfold.cli", "filletfold.hops")
 
 
 def module_name(path: Path, root: Path = ROOT) -> str:

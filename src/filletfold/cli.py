@@ -15,6 +15,8 @@ Commands
     parameters, the options given replacing theirs).
 ``filletfold app [MESH] [--port N] [--host ADDR]``
     Start the browser app (viser) on MESH and print its address.
+``filletfold hops [--port N] [--host ADDR]``
+    Serve the Grasshopper Hops components Round and Pattern on this machine.
 ``filletfold export DIR [--format dxf,pdf,svg,png] [--units U] [--scale S] [--sheet PAGE]``
 ``[--preset NAME] [--view V]``
     Read ``DIR/design.fold`` and write cut files (``pattern.dxf``, ``pattern.pdf``,
@@ -904,6 +906,44 @@ def app_cmd(
             "this address can drive it and upload files to it",
             highlight=False,
         )
+    server.wait()
+
+
+@app.command("hops")
+def hops_cmd(
+    port: Annotated[
+        int, typer.Option("--port", help="Port to serve on (0: a free one; Hops' own is 5000).")
+    ] = 5000,
+    host: Annotated[
+        str,
+        typer.Option(
+            "--host",
+            help="Address to bind: this machine only (127.0.0.1, ::1 or localhost); another "
+            "is refused.",
+        ),
+    ] = "127.0.0.1",
+):
+    """Serve the Grasshopper Hops components Round and Pattern (needs the 'hops' extra: pip
+    install 'filletfold[hops]').
+
+    In Grasshopper, give a Hops component the printed address followed by round or pattern
+    (http://127.0.0.1:5000/round). Prints a line per request and runs until Ctrl-C.
+    """
+    from .hops.server import run_hops
+
+    def say(line: str) -> None:
+        err_console.print(line, highlight=False, soft_wrap=True, markup=False)
+
+    try:
+        server = run_hops(host=host, port=port, say=say)
+    except FilletfoldError as exc:
+        raise _error(str(exc)) from None
+    console.print(
+        f"filletfold hops at {server.url}  (components: {server.url}round, {server.url}pattern;"
+        " Ctrl-C to stop)",
+        highlight=False,
+        soft_wrap=True,
+    )
     server.wait()
 
 
