@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow test-long lint install clean corpus
+.PHONY: demo test test-slow test-long lint install clean corpus bpy-venv blender-zip
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -44,6 +44,25 @@ CORPUS_ARGS ?=
 corpus: $(STAMP)
 	$(BIN)/python benchmarks/fetch_corpus.py
 	$(BIN)/python benchmarks/corpus.py --corpus --timeout 300 $(CORPUS_ARGS)
+
+# Blender as a Python module (bpy, from PyPI) with filletfold beside it, for the Blender
+# extension's headless test (tests/test_blender.py, slow tier; it runs this target and skips
+# with the reason when it fails). bpy 4.2 is built for Python 3.11 only and for numpy 1.x.
+BPY_VENV ?= out/bpy-venv
+BPY_VERSION ?= 4.2.0
+$(BPY_VENV)/.installed: pyproject.toml
+	rm -rf $(BPY_VENV)
+	$(PYTHON) -m venv $(BPY_VENV)
+	$(BPY_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(BPY_VENV)/bin/python -m pip install --quiet "bpy==$(BPY_VERSION)" "numpy<2" -e .
+	touch $@
+
+bpy-venv: $(BPY_VENV)/.installed
+
+# the Blender extension's installable zip (Blender 4.2+: Edit > Preferences > Get Extensions >
+# Install from Disk): out/filletfold_blender-<version>.zip
+blender-zip:
+	$(PYTHON) blender/build_zip.py --out out
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
