@@ -244,7 +244,7 @@ def test_small_batches_stay_with_numpy(monkeypatch):
     (the default threshold, 1, sends every batch to the kernel)."""
     called = []
     monkeypatch.setattr(batch, "USE_KERNEL", True)
-    monkeypatch.setattr(batch, "_kernel_loaded", False)
+    monkeypatch.setattr(batch, "_kernel_loaded", True)  # which path, not its loading
     monkeypatch.setattr(batch, "interior_point_numpy", lambda *a, **k: called.append("numpy"))
     monkeypatch.setattr(
         batch_kernel, "interior_point_numba", lambda *a, **k: called.append("numba")
@@ -282,15 +282,21 @@ def test_a_warm_kernel_leaves_small_batches_to_numpy(monkeypatch):
     assert not batch.warm_kernel()
 
 
-def test_a_large_design_reports_the_kernel_loading(monkeypatch):
-    """The first large design with the kernel wanted but not loaded says so in its progress:
-    "compiling" only when numba's cache has no kernel (that first load takes about 15 s),
-    "loading" when it has one; a small one does not load it."""
-    from filletfold.vertex.solve import KERNEL_COMPILE_STAGE, KERNEL_STAGE
+def test_a_design_reports_the_kernel_loading(monkeypatch):
+    """The first design whose solver batch loads the kernel (wanted, not loaded yet) says so
+    in its progress: "compiling" only when numba's cache has no kernel (that first load takes
+    about 15 s), "loading" when it has one. A design whose batches are all too small does not
+    load it, nor does the icosahedron, whose vertices are all at their targets (no batch)."""
+    from filletfold.vertex.batch import KERNEL_COMPILE_STAGE, KERNEL_STAGE
 
     monkeypatch.setattr(batch, "USE_KERNEL", True)
-    cases = ((256, True, None), (5, True, KERNEL_STAGE), (5, False, KERNEL_COMPILE_STAGE))
-    for n_min, cached, expected in cases:
+    cases = (
+        ("tetrahedron", 5, True, None),  # one batch of 4 problems
+        ("tetrahedron", 4, True, KERNEL_STAGE),
+        ("tetrahedron", 4, False, KERNEL_COMPILE_STAGE),
+        ("icosahedron", 1, True, None),
+    )
+    for mesh, n_min, cached, expected in cases:
         monkeypatch.setattr(batch, "_kernel_loaded", False)
         monkeypatch.setattr(batch, "KERNEL_MIN_PROBLEMS", n_min)
         monkeypatch.setattr(batch, "kernel_cached", lambda cached=cached: cached)
@@ -299,7 +305,7 @@ def test_a_large_design_reports_the_kernel_loading(monkeypatch):
         def progress(stage, done, total, stages=stages):
             stages.append(stage)
 
-        filletfold.round_mesh("icosahedron", tabs=False, progress=progress)
+        filletfold.round_mesh(mesh, tabs=False, progress=progress)
         shown = {KERNEL_STAGE, KERNEL_COMPILE_STAGE} & set(stages)
         assert shown == ({expected} if expected else set())
         assert batch._kernel_loaded == (expected is not None)

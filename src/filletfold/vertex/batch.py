@@ -31,6 +31,7 @@ import os
 import threading
 import warnings
 from collections.abc import Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,7 +73,9 @@ from .settings import (
 #: too: blob's slider change 1.2 s -> 0.33 s of compute). Which path solves a batch depends on
 #: the batch's size alone, never on what the process solved before, so a design gives the same
 #: bytes first or last in a long process, in the CLI, the API and the app (the two paths agree
-#: only to rounding). (numba itself is imported on that first use, not with filletfold.)
+#: only to rounding). numba itself is imported and the kernel loaded on the first batch it
+#: solves, not with filletfold nor before the apex stage: a design whose every vertex is at
+#: its target (the icosahedron, the cube) never loads it (its CLI run: 1.26 -> 0.85 s wall).
 USE_KERNEL = (
     importlib.util.find_spec("numba") is not None and os.environ.get("FILLETFOLD_NUMBA", "1") != "0"
 )
@@ -88,31 +91,41 @@ def interior_point(rows: RowBlock, q, c, y, **kwargs) -> tuple[np.ndarray, np.nd
     return interior_point_numpy(rows, q, c, y, **kwargs)
 
 
+#: The progress stage shown while the numba kernel loads from numba's cache (about 0.3-1 s).
+KERNEL_STAGE = "loading the compiled solver"
+#: The progress stage shown instead when numba's cache has no kernel: its first use compiles it.
+KERNEL_COMPILE_STAGE = "compiling the solver (first use only, about 15 s)"
+
 _kernel_loaded = False
+_load_lock = threading.Lock()
+#: ``progress(stage, done, total)`` callbacks of the apex stages running now
+#: (:func:`loading_shown`): told when the kernel loads (or compiles) during one of them.
+_watchers: list = []
+
+
+@contextmanager
+def loading_shown(progress):
+    """While in the block, a first load of the kernel (in any thread) is reported to
+    ``progress`` as the stage :data:`KERNEL_STAGE` (or :data:`KERNEL_COMPILE_STAGE` when
+    numba's cache has no kernel), 0/1 then 1/1."""
+    if progress is None:
+        yield
+        return
+    _watchers.append(progress)  # not under _load_lock: a load in progress does not hold it up
+    try:
+        yield
+    finally:
+        _watchers.remove(progress)
 
 
 def _kernel(rows: RowBlock, q, c, y, **kwargs):
-    """:func:`~filletfold.vertex.batch_kernel.interior_point_numba`, noting it is loaded.
-
-    When numba cannot be imported or cannot compile the kernel (e.g. a numba too old for the
-    installed numpy), the kernel is turned off with a warning and numpy solves.
-    """
-    global _kernel_loaded
+    """:func:`~filletfold.vertex.batch_kernel.interior_point_numba`, loaded first
+    (:func:`warm_kernel`); numpy solves when it cannot be loaded."""
+    if not (_kernel_loaded or warm_kernel()):
+        return interior_point_numpy(rows, q, c, y, **kwargs)
     from . import batch_kernel
 
-    if _kernel_loaded:
-        return batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
-    try:
-        if not batch_kernel.AVAILABLE:
-            raise ImportError("numba cannot be imported")
-        out = batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
-    except FilletfoldError:  # the user's error (e.g. FILLETFOLD_THREADS), not numba's
-        raise
-    except Exception as exc:  # only the first call (import and compile) is guarded
-        _turn_kernel_off(f"{type(exc).__name__}: {exc}")
-        return interior_point_numpy(rows, q, c, y, **kwargs)
-    _kernel_loaded = True
-    return out
+    return batch_kernel.interior_point_numba(rows, q, c, y, **kwargs)
 
 
 def _turn_kernel_off(why: str) -> None:
@@ -125,12 +138,6 @@ def _turn_kernel_off(why: str) -> None:
         RuntimeWarning,
         stacklevel=3,
     )
-
-
-def kernel_pending(n_problems: int) -> bool:
-    """Whether solving ``n_problems`` problems at once would load the numba kernel now (it is
-    wanted and not loaded yet)."""
-    return USE_KERNEL and not _kernel_loaded and n_problems >= KERNEL_MIN_PROBLEMS
 
 
 def kernel_cached() -> bool:
@@ -162,20 +169,44 @@ def kernel_cached() -> bool:
 
 def warm_kernel() -> bool:
     """Load (or compile, the first time ever: about 15 s) the numba kernel now, e.g. in a
-    background thread of the app, so that the first large batch does not wait for it (small
-    batches stay with numpy: see :data:`USE_KERNEL`).
+    background thread of the app; otherwise the first batch it solves does. Once: a thread
+    that comes while another loads it waits. A first load is reported to the ``progress`` of
+    :func:`loading_shown`. (Which batches it solves does not change: see :data:`USE_KERNEL`.)
+
+    When numba cannot be imported or cannot compile the kernel (e.g. a numba too old for the
+    installed numpy), the kernel is turned off with a warning and numpy solves.
 
     Returns
     -------
     bool
         Whether the kernel is in use (False without numba, with ``FILLETFOLD_NUMBA=0``, or
-        when it could not be loaded: then with a warning).
+        when it could not be loaded).
     """
-    if not USE_KERNEL:
-        return False
-    rows = pack([(np.ones(2), np.eye(2, 3), np.zeros(2))], 3)
-    _kernel(rows, np.full(3, 2.0), np.ones((1, 3)), np.zeros((1, 3)))
-    return USE_KERNEL
+    global _kernel_loaded
+    with _load_lock:
+        if USE_KERNEL and not _kernel_loaded:
+            watchers = list(_watchers)
+            stage = KERNEL_STAGE if not watchers or kernel_cached() else KERNEL_COMPILE_STAGE
+            for progress in watchers:
+                progress(stage, 0, 1)
+            try:
+                from . import batch_kernel
+
+                if not batch_kernel.AVAILABLE:
+                    raise ImportError("numba cannot be imported")
+                rows = pack([(np.ones(2), np.eye(2, 3), np.zeros(2))], 3)
+                batch_kernel.interior_point_numba(
+                    rows, np.full(3, 2.0), np.ones((1, 3)), np.zeros((1, 3))
+                )
+            except FilletfoldError:  # the user's error (e.g. FILLETFOLD_THREADS), not numba's
+                raise
+            except Exception as exc:  # only the first call (import and compile) is guarded
+                _turn_kernel_off(f"{type(exc).__name__}: {exc}")
+            else:
+                _kernel_loaded = True
+            for progress in watchers:
+                progress(stage, 1, 1)
+    return USE_KERNEL and _kernel_loaded
 
 
 def interior_point_numpy(

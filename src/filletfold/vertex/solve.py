@@ -407,11 +407,6 @@ THIN_ATTEMPTS = [(9, 0.1), (33, 0.1), (129, 0.1)]
 #: samples (a cutting plane), this many times per attempt, before the next attempt.
 CUT_ROUNDS = 2
 
-#: The progress stage shown while the numba kernel loads from numba's cache (about 0.3-1 s).
-KERNEL_STAGE = "loading the compiled solver"
-#: The progress stage shown instead when numba's cache has no kernel: its first use compiles it.
-KERNEL_COMPILE_STAGE = "compiling the solver (first use only, about 15 s)"
-
 #: Starts of the feasibility phase: ``U + t L D`` for these ``t`` (``L`` the mean incident
 #: edge length).
 START_DEPTHS = np.array([0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5])
@@ -648,23 +643,22 @@ def solve_apices(
     vertices = list(vertices)
     out = dict.fromkeys(vertices, (None, None))
     pending = _set_up(frames, depths, res, vertices, size, cuts)
-    if progress is not None and batch.kernel_pending(len(pending)):
-        # the first design after installing numba compiles the kernel: say so, and only then
-        stage = KERNEL_STAGE if batch.kernel_cached() else KERNEL_COMPILE_STAGE
-        progress(stage, 0, 1)
-        batch.warm_kernel()
-        progress(stage, 1, 1)
     total = len(pending)
-    while pending:  # one attempt per vertex and round, ROUND_SLICE vertices at a time
-        order = list(pending)
-        slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
-        # the slices are independent (each settles its own vertices): in threads
-        for _ in thread_map(
-            lambda part: _solve_round(part, pending, res, out, centres, thorough, lp, cuts, work),
-            slices,
-        ):
-            if progress is not None:
-                progress("apices", total - len(pending), total)
+    # the numba kernel loads on the first batch it solves (none when every vertex is at its
+    # target): the first design after installing numba compiles it, its progress says so
+    with batch.loading_shown(progress):
+        while pending:  # one attempt per vertex and round, ROUND_SLICE vertices at a time
+            order = list(pending)
+            slices = [order[lo : lo + ROUND_SLICE] for lo in range(0, len(order), ROUND_SLICE)]
+            # the slices are independent (each settles its own vertices): in threads
+            for _ in thread_map(
+                lambda part: _solve_round(
+                    part, pending, res, out, centres, thorough, lp, cuts, work
+                ),
+                slices,
+            ):
+                if progress is not None:
+                    progress("apices", total - len(pending), total)
     return out
 
 
