@@ -1,16 +1,25 @@
-"""Start-up time of what users run first: ``import filletfold`` and ``filletfold --help``.
+"""Start-up time of what users run first: ``import filletfold``, ``filletfold --help`` and a
+built-in example's design.
 
     .venv/bin/python benchmarks/startup.py [--repeat N] [--python EXE] [--filletfold EXE]
-                                           [--also CODE ...]
+                                           [--also CODE ...] [--example NAME] [--base REV]
+                                           [--bytecode]
 
-Issue 14's budgets: ``python -c "import filletfold"`` within 0.2 s and ``filletfold --help``
-within 0.3 s. Each command runs ``--repeat`` times (default 7) in a fresh child process, the
-commands taking turns (so a burst of load on a shared machine hits all of them alike), after
-one untimed warm-up run each (the file cache). Printed per command: the median wall time from
-start to exit, the fastest run, the ratio of the median to the baseline's (``python -c pass``:
-the interpreter's own start-up), the median less the baseline (what filletfold adds), the
+Budgets: issue 14's ``python -c "import filletfold"`` within 0.2 s and ``filletfold --help``
+within 0.3 s; issue 27's ``filletfold round EXAMPLE -o DIR`` (the default command, default
+formats and tabs; ``--example``, default icosahedron) within 0.5 s. Each command runs
+``--repeat`` times (default 7) in a fresh child process, the commands taking turns (so a
+burst of load on a shared machine hits all of them alike), after one untimed warm-up run
+each (the file cache). Printed per command: the median wall time from start to exit, the
+fastest run, the ratio of the median to the baseline's (``python -c pass``: the
+interpreter's own start-up), the median less the baseline (what filletfold adds), the
 median CPU time (user + system: on a shared machine less swayed by other jobs); then the heavy
-libraries the command loaded (none is the aim: they are imported where they are used).
+libraries the command loaded (none is the aim for the first two: they are imported where
+they are used; numba only where the solver's kernel solves a batch).
+``--base REV`` also times every command on the sources of ``REV`` (a commit, tag or branch,
+checked out into a temporary ``git worktree`` and put first on ``PYTHONPATH``; both trees'
+modules compiled to ``.pyc`` first), in the same turns, and prints its median and this
+checkout's median over it (below 1: faster now).
 ``--also CODE`` adds a ``python -c CODE`` row (``--also "import numpy"``, say).
 ``--python`` and ``--filletfold`` time another install (default: this interpreter and the
 ``filletfold`` script beside it). The children inherit the environment; with
@@ -26,9 +35,11 @@ import argparse
 import os
 import resource
 import shlex
+import signal
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -37,8 +48,8 @@ ROOT = os.path.dirname(HERE)
 #: Libraries that must not be loaded by ``import filletfold`` or ``filletfold --help``.
 HEAVY = ("scipy", "shapely", "trimesh", "meshio", "numba", "matplotlib", "ezdxf", "viser")
 
-#: Budgets of issue 14 (seconds, median wall time).
-BUDGETS = {"import filletfold": 0.2, "filletfold --help": 0.3}
+#: Budgets of issues 14 and 27 (seconds, median wall time).
+BUDGETS = {"import filletfold": 0.2, "filletfold --help": 0.3, "filletfold round": 0.5}
 
 # printed by a child after the command's own work: the heavy top-level modules it loaded
 _PROBE = (
@@ -53,15 +64,16 @@ def default_filletfold(python: str) -> list[str]:
     return [script] if os.path.isfile(script) else [python, "-m", "filletfold.cli"]
 
 
-def heavy_loaded(python: str, code: str | None, argv: list[str] | None, env: dict) -> str:
-    """The heavy libraries loaded after ``python -c code`` (or the CLI run with ``argv``)."""
+def heavy_loaded(python: str, what: str | list[str], env: dict) -> str:
+    """The heavy libraries loaded after ``python -c what`` (a str) or the command line run
+    with the arguments ``what`` (a list)."""
     probe = _PROBE % (HEAVY,)
-    if code is not None:
-        prog = f"{code}\n{probe}"
+    if isinstance(what, str):
+        prog = f"{what}\n{probe}"
     else:  # the entry point's own code, then the probe
         prog = (
             "import sys\nfrom filletfold.cli import main\n"
-            f"sys.argv = ['filletfold', *{argv!r}]\ntry:\n    main()\nfinally:\n"
+            f"sys.argv = ['filletfold', *{what!r}]\ntry:\n    main()\nfinally:\n"
             f"    {probe}"
         )
     out = subprocess.run([python, "-c", prog], capture_output=True, text=True, cwd=ROOT, env=env)
@@ -81,6 +93,20 @@ def run_once(cmd: list[str], env: dict) -> tuple[float, float]:
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+def worktree(rev: str, where: str, python: str) -> str:
+    """``rev`` checked out (detached) at ``where``; its ``src`` folder. The modules of both
+    trees are compiled (``.pyc``) first: under ``PYTHONDONTWRITEBYTECODE`` a fresh tree, or a
+    module changed since its ``.pyc``, would be compiled on every start, in one tree only."""
+    src = os.path.join(where, "src")
+    subprocess.run(
+        ["git", "-C", ROOT, "worktree", "add", "--detach", "-f", where, rev],
+        capture_output=True, check=True,
+    )  # fmt: skip
+    for tree in (src, os.path.join(ROOT, "src")):
+        subprocess.run([python, "-m", "compileall", "-q", tree], capture_output=True, check=True)
+    return src
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=7, help="timed runs per command (default 7)")
@@ -91,12 +117,29 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--also", action="append", default=[], metavar="CODE", help="also time python -c CODE"
     )
+    ap.add_argument("--example", default="icosahedron", help="the example filletfold rounds")
+    ap.add_argument("--base", metavar="REV", help="also time the sources of REV (git worktree)")
     ap.add_argument(
         "--bytecode",
         action="store_true",
         help="unset PYTHONDONTWRITEBYTECODE in the children (time with .pyc files)",
     )
     args = ap.parse_args(argv)
+    # a kill (SIGTERM) still removes the worktree and the temporary folder
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    with tempfile.TemporaryDirectory(prefix="startup-") as tmp:
+        try:
+            return timed(args, tmp)
+        finally:
+            if args.base:
+                subprocess.run(
+                    ["git", "-C", ROOT, "worktree", "remove", "--force", f"{tmp}/base"],
+                    capture_output=True,
+                )  # fmt: skip
+
+
+def timed(args, tmp: str) -> int:
+    """Time the commands (and those of ``--base``) with outputs under ``tmp``; print them."""
     env = dict(os.environ)
     if args.bytecode:
         env.pop("PYTHONDONTWRITEBYTECODE", None)
@@ -107,12 +150,26 @@ def main(argv=None) -> int:
     )
     py = args.python
     ff = [args.filletfold] if args.filletfold else default_filletfold(py)
+    out = os.path.join(tmp, "design")
+    round_argv = ["round", args.example, "-o", out, "--force"]
     cases = {
         "python -c pass": ([py, "-c", "pass"], "pass"),
         "import filletfold": ([py, "-c", "import filletfold"], "import filletfold"),
         **{f"python -c {c!r}": ([py, "-c", c], c) for c in args.also},
-        "filletfold --help": ([*ff, "--help"], None),
+        "filletfold --help": ([*ff, "--help"], ["--help"]),
+        "filletfold round": ([*ff, *round_argv], round_argv),
     }
+    envs = {"": env}
+    if args.base:
+        rev = subprocess.run(
+            ["git", "-C", ROOT, "rev-parse", "--short", args.base],
+            capture_output=True, text=True, check=True,
+        ).stdout.strip()  # fmt: skip
+        src = worktree(rev, os.path.join(tmp, "base"), py)
+        envs["base"] = {
+            **env,
+            "PYTHONPATH": os.pathsep.join(filter(None, [src, env.get("PYTHONPATH")])),
+        }
 
     sys.path.insert(0, HERE)
     from examples import machine
@@ -120,33 +177,42 @@ def main(argv=None) -> int:
     print(f"# machine: {machine()}")
     print(f"# command: {shlex.join([os.path.basename(sys.executable), *sys.argv])}")
     print(f"# timed: {py} and {shlex.join(ff)}; bytecode {bytecode}")
+    if args.base:
+        print(f"# base: {args.base} = {rev}, its src first on PYTHONPATH, in the same turns")
     print(
         f"# wall time from start to exit of a fresh process, {args.repeat} runs each (taking "
         "turns) after a warm-up; baseline = python -c pass; cpu = user + system; heavy = which of "
-        f"{', '.join(HEAVY)} were loaded"
+        f"{', '.join(HEAVY)} were loaded; filletfold round = {shlex.join(round_argv[:2])}"
     )
-    for cmd, _ in cases.values():
-        run_once(cmd, env)
-    times: dict[str, list[tuple[float, float]]] = {name: [] for name in cases}
+    runs = [
+        (name, tree) for name in cases for tree in envs if tree == "" or name != "python -c pass"
+    ]
+    for name, tree in runs:
+        run_once(cases[name][0], envs[tree])
+    times: dict = {run: [] for run in runs}
     for _ in range(args.repeat):
-        for name, (cmd, _) in cases.items():
-            times[name].append(run_once(cmd, env))
-    base = statistics.median(w for w, _ in times["python -c pass"])
+        for name, tree in runs:
+            times[name, tree].append(run_once(cases[name][0], envs[tree]))
+    base = statistics.median(w for w, _ in times["python -c pass", ""])
     print(
         f"{'command':28s} {'median s':>9s} {'min s':>7s} {'ratio':>6s} {'added s':>8s} "
         f"{'cpu s':>6s} {'budget':>7s}  heavy"
+        + (f"  | {'base s':>7s} {'/ base':>6s}  base heavy" if args.base else "")
     )
     for name, (_, code) in cases.items():
-        walls = [w for w, _ in times[name]]
+        walls = [w for w, _ in times[name, ""]]
         med = statistics.median(walls)
-        cpu = statistics.median(c for _, c in times[name])
+        cpu = statistics.median(c for _, c in times[name, ""])
         budget = BUDGETS.get(name)
         mark = "" if budget is None else f"{budget:.1f} {'ok' if med <= budget else 'over'}"
-        heavy = heavy_loaded(py, code, None if code is not None else ["--help"], env)
-        print(
+        line = (
             f"{name:28s} {med:9.3f} {min(walls):7.3f} {med / base:6.1f} "
-            f"{med - base:8.3f} {cpu:6.3f} {mark:>7s}  {heavy}"
+            f"{med - base:8.3f} {cpu:6.3f} {mark:>7s}  {heavy_loaded(py, code, env):9s}"
         )
+        if args.base and (name, "base") in times:
+            was = statistics.median(w for w, _ in times[name, "base"])
+            line += f"  | {was:7.3f} {med / was:6.2f}  {heavy_loaded(py, code, envs['base'])}"
+        print(line)
     return 0
 
 
