@@ -1,4 +1,5 @@
-"""Start-up (issue 14): ``import filletfold`` and ``filletfold --help`` load no heavy library.
+"""Start-up (issues 14, 27): ``import filletfold`` and ``filletfold --help`` load no heavy
+library, and the default command on a small example loads only the libraries it uses.
 
 Invariants, not timings (``benchmarks/startup.py`` times them): each check runs in a fresh
 interpreter and lists which heavy libraries ended up in ``sys.modules``. The public API stays
@@ -91,6 +92,33 @@ def test_the_pipeline_loads_no_optional_or_export_library():
         "assert 'scipy.optimize' not in sys.modules, 'scipy.optimize: import it where used'"
     )
     assert set(loaded_after(code)) <= {"scipy", "shapely"}
+
+
+#: Loaded only by the paths that need them: none by the default command on a small example.
+ON_DEMAND = ("numba", "llvmlite", "scipy.optimize", "matplotlib", "ezdxf", "trimesh", "PIL")
+
+
+def test_the_default_command_on_an_example_loads_no_solver_kernel(tmp_path):
+    """Issue 27: ``filletfold round icosahedron`` (default formats and tabs; the cube too, in
+    the same process) imports no numba: their vertices are all at their targets, no solver
+    batch runs, and the kernel (0.4-0.6 s to import and load) is loaded by the first batch it
+    solves, not before. Nor do they load the libraries of other paths (material loss, the
+    other cut files, the mesh reader)."""
+    runs = [["round", name, "-q", "-o", str(tmp_path / name)] for name in ("icosahedron", "cube")]
+    code = (
+        "import contextlib, io, sys\nfrom filletfold.cli import main\n"
+        f"for argv in {runs!r}:\n"
+        "    with contextlib.redirect_stdout(io.StringIO()):\n"
+        "        assert main(argv) == 0, argv\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in "
+        f"{ON_DEMAND!r} or m in {ON_DEMAND!r}))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    assert (tmp_path / "icosahedron" / "design.fold").is_file()
+    assert (tmp_path / "cube" / "design.fold").is_file()
+    assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
 def test_every_public_name_is_loaded_on_first_use():
