@@ -184,7 +184,9 @@ def main(argv=None) -> int:
                     f"{statistics.median(times):.3f} s (min {min(times):.3f}, "
                     f"{args.changes} changes)"
                 )
-            pattern = body("/pattern", data, {**INPUTS, "Size": "auto", "Sheet": "A4"})
+            pattern = body(
+                "/pattern", data, {**INPUTS, "Size": "auto", "Sheet": "A4", "Material": ""}
+            )
             t, preply = post(server.url + "pattern", pattern)
             print(f"  Pattern (A4): {len(pattern):,} B -> {len(preply):,} B in {t:.3f} s")
             if k == 0 and args.pictures:

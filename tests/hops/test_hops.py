@@ -292,7 +292,12 @@ def test_the_pattern_is_the_command_lines_pattern_3dm(service, tmp_path):
     for obj in model.Objects:
         name = layers[obj.Attributes.LayerIndex]
         counts[name] = counts.get(name, 0) + 1
-    inputs = {**ROUND_INPUTS, "Size": ("System.String", "auto"), "Sheet": ("System.String", "A4")}
+    inputs = {
+        **ROUND_INPUTS,
+        "Size": ("System.String", "auto"),
+        "Sheet": ("System.String", "A4"),
+        "Material": ("System.String", ""),
+    }
     mesh = json.dumps(rhino_mesh("icosahedron").Encode())
     status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
     assert status == 200, text
@@ -303,3 +308,34 @@ def test_the_pattern_is_the_command_lines_pattern_3dm(service, tmp_path):
     assert out["Units"] == ["mm"]
     report = json.loads((folder / "report.json").read_text())
     assert len(out["Sheets"]) == report["fabrication"]["sheets"]
+
+
+def test_the_pattern_in_a_sheet_material_has_its_reliefs_and_grooves(service, tmp_path):
+    """Pattern with Material plywood-3mm: the reliefs and the kerf grooves of the command
+    line's pattern.3dm, layer by layer; a bad material is one line naming it."""
+    folder = tmp_path / "cube"
+    args = ["round", "cube", "-o", str(folder), "--format", "3dm", "-q"]
+    assert main([*args, "--material", "plywood-3mm", "--size", "1500mm"]) == 0
+    model = rhino3dm.File3dm.Read(str(folder / "pattern.3dm"))
+    layers = {layer.Index: layer.Name for layer in model.Layers}
+    counts: dict = {}
+    for obj in model.Objects:
+        name = layers[obj.Attributes.LayerIndex]
+        counts[name] = counts.get(name, 0) + 1
+    assert counts["RELIEF"] > 0 and counts["KERF_BACK"] > 0
+    inputs = {
+        **ROUND_INPUTS,
+        "Size": ("System.String", "1500mm"),
+        "Sheet": ("System.String", ""),
+        "Material": ("System.String", "plywood-3mm"),
+    }
+    mesh = json.dumps(rhino_mesh("cube").Encode())
+    status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
+    assert status == 200, text
+    out = {k: v["0"] for k, v in outputs(text).items()}
+    assert len(out["Relief"]) == counts["RELIEF"]
+    assert len(out["KerfBack"]) == counts["KERF_BACK"]
+    assert len(out.get("KerfFront", [])) == counts.get("KERF_FRONT", 0)
+    inputs["Material"] = ("System.String", "cardboard")
+    status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
+    assert status != 200 and "unknown material 'cardboard'" in text and "\n" not in text.strip()

@@ -13,6 +13,8 @@ layer        content
 ``VALLEY``   ``V`` edges
 ``TAB``      the tab hinges (the fold between a tab and its piece), one line each
 ``LABEL``    the labels (part numbers, seam labels) as text dots, named by their kind
+``RELIEF``   with a sheet material that is relieved: the reliefs' outlines (cut through)
+``KERF_*``   with a kerfed sheet material: the grooves, ``KERF_FRONT`` and ``KERF_BACK``
 ===========  =============================================================================
 
 Edges of one layer are chained end to end and cut into runs exactly as in the DXF
@@ -50,12 +52,13 @@ from ..surface.validate import validated_faces
 from ..units import check_units
 from .dxf import check_scale
 from .mesh3d import kinds_present
-from .palette import ASSIGNMENT_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
+from .palette import ASSIGNMENT_COLOR, KERF_COLOR, LABEL_COLOR, TAB_HINGE_COLOR
 from .paths import chain_runs, edge_chains, edge_layer_masks, tab_cut_paths
 from .png import PATCH_COLOR
 
 __all__ = [
     "FOLDED_CREASE_LAYERS",
+    "MAKING_LAYERS",
     "PATTERN_LAYERS",
     "RHINO_UNITS",
     "folded_3dm",
@@ -77,6 +80,10 @@ PATTERN_LAYERS = {
     "TAB": TAB_HINGE_COLOR,
     "LABEL": LABEL_COLOR,
 }
+#: Layers of a sheet material's making paths (:mod:`~filletfold.layout.making`) in
+#: ``pattern.3dm``, after :data:`PATTERN_LAYERS` where a design has them, and their colours.
+MAKING_LAYERS = {"relief": "RELIEF", "kerf-front": "KERF_FRONT", "kerf-back": "KERF_BACK"}
+MAKING_COLORS = {"relief": ASSIGNMENT_COLOR["B"], **KERF_COLOR}
 #: Crease layers of ``folded.3dm`` (after its patch layers) and their colours.
 FOLDED_CREASE_LAYERS = {"MOUNTAIN": ASSIGNMENT_COLOR["M"], "VALLEY": ASSIGNMENT_COLOR["V"]}
 #: The Rhino file version written.
@@ -323,10 +330,18 @@ def pattern_paths(pattern: CreasePattern, scale: float = 1.0):
     for hinge in ann.tab_hinges:
         h = np.asarray(hinge, dtype=np.float64).reshape(2, 2) * scale
         yield "TAB", np.c_[h, np.zeros(2)], False, False
+    for m in ann.making:  # a sheet material's reliefs and kerf grooves
+        p = np.asarray(m.points, dtype=np.float64).reshape(-1, 2) * scale
+        yield MAKING_LAYERS[m.kind], np.c_[p, np.zeros(len(p))], m.closed, False
 
 
 def _pattern_3dm(rhino3dm, pattern: CreasePattern, units: str, scale: float) -> bytes:
-    model = _Model(rhino3dm, "pattern.3dm", units, PATTERN_LAYERS)
+    layers = dict(PATTERN_LAYERS)
+    kinds = {m.kind for m in pattern.annotations.making}
+    for kind, colour in MAKING_COLORS.items():  # only the layers a material's making draws
+        if kind in kinds:
+            layers[MAKING_LAYERS[kind]] = colour
+    model = _Model(rhino3dm, "pattern.3dm", units, layers)
     ann = pattern.annotations
     for layer, points, closed, spline in pattern_paths(pattern, scale):
         model.add_path(points, closed, layer, spline)

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import MeshReadError
 from ..export.mesh3d import KIND_ORDER
-from ..export.rhino import crease_runs, patch_meshes, path_curve, pattern_paths
+from ..export.rhino import MAKING_LAYERS, crease_runs, patch_meshes, path_curve, pattern_paths
 from ..mesh.polymesh import PolyMesh
 from ..surface.patch import patch_kind
 
@@ -123,7 +123,9 @@ def pattern_outputs(design) -> dict:
     -------
     dict
         ``cut``, ``mountain``, ``valley``, ``tab`` (the tab hinges): curves of the layers of
-        ``pattern.3dm`` (``CUT`` with the tabs' cut outlines); ``sheets``: each sheet's outline,
+        ``pattern.3dm`` (``CUT`` with the tabs' cut outlines); ``relief``, ``kerf_front``,
+        ``kerf_back``: a sheet material's reliefs and grooves (empty without one that is
+        relieved or kerfed); ``sheets``: each sheet's outline,
         a closed polyline (none without sheets); ``label_points`` and ``labels``: where each
         label is and its text; ``units``: the drawing unit (``""``: none); ``summary``.
     """
@@ -131,7 +133,9 @@ def pattern_outputs(design) -> dict:
 
     p = design.params
     scale = float(p.scale or 1.0)
-    layers: dict = {"CUT": [], "MOUNTAIN": [], "VALLEY": [], "TAB": []}
+    layers: dict = {
+        name: [] for name in ("CUT", "MOUNTAIN", "VALLEY", "TAB", *MAKING_LAYERS.values())
+    }
     for layer, points, closed, spline in pattern_paths(design.pattern, scale):
         layers[layer].append(path_curve(r, points, closed, spline))
     ann = design.pattern.annotations
@@ -149,6 +153,9 @@ def pattern_outputs(design) -> dict:
         "mountain": layers["MOUNTAIN"],
         "valley": layers["VALLEY"],
         "tab": layers["TAB"],
+        "relief": layers["RELIEF"],
+        "kerf_front": layers["KERF_FRONT"],
+        "kerf_back": layers["KERF_BACK"],
         "sheets": sheets,
         "label_points": label_points,
         "labels": labels,

@@ -17,9 +17,10 @@ reusing an earlier design of the same mesh: :class:`Designs`) and convert the de
 * *Round* (mesh, radius, depth, samples, sharp) -> the folded patches, their names, the
   mountain and valley creases, the flat pattern, each vertex's status, the summary; laid out
   as vertex modules without tabs, as the browser app draws a slider change.
-* *Pattern* (the same, and size and sheet) -> the cut, mountain, valley and tab curves of
-  ``pattern.3dm``, the sheets' outlines and the labels, laid out as the command line lays it
-  out (nets, glue tabs, the default size), in the drawing's units.
+* *Pattern* (the same, and size, sheet and sheet material) -> the cut, mountain, valley and
+  tab curves of ``pattern.3dm`` (and a material's reliefs and kerf grooves), the sheets'
+  outlines and the labels, laid out as the command line lays it out (nets, glue tabs, the
+  default size), in the drawing's units.
 
 A bad input or a design that fails answers HTTP 500 with ``{"values": [], "errors": [one
 line]}`` (as ghhops-server answers a failure, so Hops shows it on the component), naming the
@@ -255,12 +256,27 @@ class HopsService:
                 hs.HopsString(
                     "Sheet", "Sh", "Sheet size: A4, A3, Letter or WxH in mm; empty: no sheets"
                 ),
+                hs.HopsString(
+                    "Material",
+                    "Mat",
+                    "Sheet material (card-300gsm, aluminium-1mm, plywood-3mm, ...; empty: none): "
+                    "fillets no tighter than it bends, reliefs and kerf grooves",
+                ),
             ],
             outputs=[
                 hs.HopsCurve("Cut", "C", "Layer CUT: piece borders and tab outlines", access=many),
                 hs.HopsCurve("Mountain", "M", "Layer MOUNTAIN", access=many),
                 hs.HopsCurve("Valley", "V", "Layer VALLEY", access=many),
                 hs.HopsCurve("Tab", "T", "Layer TAB: the tabs' hinges", access=many),
+                hs.HopsCurve(
+                    "Relief", "Rf", "Layer RELIEF: cut out (a relieved material)", access=many
+                ),
+                hs.HopsCurve(
+                    "KerfFront", "KF", "Layer KERF_FRONT: grooves cut from the front", access=many
+                ),
+                hs.HopsCurve(
+                    "KerfBack", "KB", "Layer KERF_BACK: grooves cut from the back", access=many
+                ),
                 hs.HopsCurve("Sheets", "Sh", "Each sheet's outline", access=many),
                 hs.HopsPoint("LabelPoints", "LP", "Where each label is", access=many),
                 hs.HopsString("Labels", "L", "Each label's text", access=many),
@@ -276,13 +292,15 @@ class HopsService:
             sharp=DEFAULT_SHARP,
             size="auto",
             sheet="",
+            material="",
         ):
-            return self._run(9, self._pattern, mesh, (radius, depth, samples, sharp, size, sheet))
+            inputs = (radius, depth, samples, sharp, size, sheet, material)
+            return self._run(12, self._pattern, mesh, inputs)
 
         names = [p.name for p in design_inputs]
         self.components = {
             ROUND_URI: ("Round", names),
-            PATTERN_URI: ("Pattern", [*names, "Size", "Sheet"]),
+            PATTERN_URI: ("Pattern", [*names, "Size", "Sheet", "Material"]),
         }
         return hops
 
@@ -309,10 +327,11 @@ class HopsService:
     def _pattern(self, mesh, inputs):
         from .convert import mesh_from_rhino, pattern_outputs
 
-        radius, depth, samples, sharp, size, sheet = inputs
+        radius, depth, samples, sharp, size, sheet, material = inputs
         pm = mesh_from_rhino(mesh)
         size = _text(size, "size", "auto")
         sheet = _text(sheet, "sheet", "")
+        material = _text(material, "material", "")
         params = _parameters(
             radius,
             depth,
@@ -320,9 +339,11 @@ class HopsService:
             sharp,
             size=None if size.lower() == "none" else size,
             sheet=sheet or None,
+            material=material or None,
         )
         out = pattern_outputs(self.designs.design(pm, params, "pattern"))
-        keys = ("cut", "mountain", "valley", "tab", "sheets", "label_points", "labels")
+        keys = ("cut", "mountain", "valley", "tab", "relief", "kerf_front", "kerf_back")
+        keys += ("sheets", "label_points", "labels")
         return (*(out[k] for k in keys), out["units"], out["summary"])
 
     # -- requests ------------------------------------------------------------------------
