@@ -194,9 +194,12 @@ def test_the_report_gives_the_cones_tip_zones(tmp_path, capsys):
         main(["round", "blob", "--size", "100mm", "--material", "aluminium-1mm", "-o", str(out)])
         == 0
     )
-    assert "the cones bend tighter than that within" in capsys.readouterr().out
-    tips = json.loads((out / "report.json").read_text())["material"]["cone_tip_zones"]
+    said = capsys.readouterr().out
+    assert "  made by: " in said and " cone tips" in said  # relieved, not left to the user
+    material = json.loads((out / "report.json").read_text())["material"]
+    tips = material["cone_tip_zones"]
     assert tips["cones"] > 100 and 0 < tips["median_mm"] <= tips["max_mm"] < 100
+    assert material["making"]["relieved_cones"] > 100
 
 
 def test_the_default_size_leaves_the_tightest_tenth_of_the_fillets_out():
