@@ -270,6 +270,25 @@ def test_a_host_other_machines_reach_is_refused():
         run_hops(host="0.0.0.0", port=0)
 
 
+def layer_counts(path) -> dict:
+    """The number of objects on each layer of a ``.3dm`` file."""
+    model = rhino3dm.File3dm.Read(str(path))
+    layers = {layer.Index: layer.Name for layer in model.Layers}
+    counts: dict = {}
+    for obj in model.Objects:
+        name = layers[obj.Attributes.LayerIndex]
+        counts[name] = counts.get(name, 0) + 1
+    return counts
+
+
+def pattern_outputs(service, name: str, inputs: dict) -> dict:
+    """The outputs of a *Pattern* request on a built-in example (branch {0}), asserting 200."""
+    mesh = json.dumps(rhino_mesh(name).Encode())
+    status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
+    assert status == 200, text
+    return {k: v["0"] for k, v in outputs(text).items()}
+
+
 def test_the_pattern_is_the_command_lines_pattern_3dm(service, tmp_path):
     """Pattern (size auto, sheets A4) gives the curves of the command line's pattern.3dm, layer
     by layer, and its sheets and labels."""
@@ -286,22 +305,14 @@ def test_the_pattern_is_the_command_lines_pattern_3dm(service, tmp_path):
         "-q",
     ]
     assert main(args) == 0
-    model = rhino3dm.File3dm.Read(str(folder / "pattern.3dm"))
-    layers = {layer.Index: layer.Name for layer in model.Layers}
-    counts: dict = {}
-    for obj in model.Objects:
-        name = layers[obj.Attributes.LayerIndex]
-        counts[name] = counts.get(name, 0) + 1
+    counts = layer_counts(folder / "pattern.3dm")
     inputs = {
         **ROUND_INPUTS,
         "Size": ("System.String", "auto"),
         "Sheet": ("System.String", "A4"),
         "Material": ("System.String", ""),
     }
-    mesh = json.dumps(rhino_mesh("icosahedron").Encode())
-    status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
-    assert status == 200, text
-    out = {k: v["0"] for k, v in outputs(text).items()}
+    out = pattern_outputs(service, "icosahedron", inputs)
     for layer, name in (("CUT", "Cut"), ("MOUNTAIN", "Mountain"), ("TAB", "Tab")):
         assert len(out[name]) == counts[layer], layer
     assert len(out["Labels"]) == len(out["LabelPoints"]) == counts["LABEL"]
@@ -316,12 +327,7 @@ def test_the_pattern_in_a_sheet_material_has_its_reliefs_and_grooves(service, tm
     folder = tmp_path / "cube"
     args = ["round", "cube", "-o", str(folder), "--format", "3dm", "-q"]
     assert main([*args, "--material", "plywood-3mm", "--size", "1500mm"]) == 0
-    model = rhino3dm.File3dm.Read(str(folder / "pattern.3dm"))
-    layers = {layer.Index: layer.Name for layer in model.Layers}
-    counts: dict = {}
-    for obj in model.Objects:
-        name = layers[obj.Attributes.LayerIndex]
-        counts[name] = counts.get(name, 0) + 1
+    counts = layer_counts(folder / "pattern.3dm")
     assert counts["RELIEF"] > 0 and counts["KERF_BACK"] > 0
     inputs = {
         **ROUND_INPUTS,
@@ -329,13 +335,11 @@ def test_the_pattern_in_a_sheet_material_has_its_reliefs_and_grooves(service, tm
         "Sheet": ("System.String", ""),
         "Material": ("System.String", "plywood-3mm"),
     }
-    mesh = json.dumps(rhino_mesh("cube").Encode())
-    status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
-    assert status == 200, text
-    out = {k: v["0"] for k, v in outputs(text).items()}
+    out = pattern_outputs(service, "cube", inputs)
     assert len(out["Relief"]) == counts["RELIEF"]
     assert len(out["KerfBack"]) == counts["KERF_BACK"]
     assert len(out.get("KerfFront", [])) == counts.get("KERF_FRONT", 0)
     inputs["Material"] = ("System.String", "cardboard")
+    mesh = json.dumps(rhino_mesh("cube").Encode())
     status, text = service.solve("/pattern", request("/pattern", mesh, inputs))
     assert status != 200 and "unknown material 'cardboard'" in text and "\n" not in text.strip()
