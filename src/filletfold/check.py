@@ -544,7 +544,7 @@ def _making_checks(g: _Data, pattern, floor: float, material) -> list[Check]:
     out = [Check("relief", ok, value, 0.0, detail, "<=", worst)]
     if material.making == "kerf" and material.kerf is not None:
         mm = material.bend_floor_mm() / floor
-        ok, value, detail, worst = kerf_check(g, making, material.kerf, mm, _CYLINDER)
+        ok, value, detail, worst = kerf_check(g, pattern, making, material.kerf, mm, kinds)
         out.append(Check("kerfs", ok, value, 0.0, detail, "<=", worst))
     return out
 

@@ -22,6 +22,9 @@ never from what made them:
 
 from __future__ import annotations
 
+import itertools
+import math
+
 import numpy as np
 import shapely
 
@@ -147,7 +150,7 @@ def relief_check(g, making: list, floor: float, kinds) -> tuple:
     return bad + outside == 0, float(bad + outside), detail, worst
 
 
-def kerf_check(g, making: list, kerf, mm_per_unit: float, cylinder: int) -> tuple:
+def kerf_check(g, pattern, making: list, kerf, mm_per_unit: float, kinds) -> tuple:
     """``(ok, value, detail, worst)`` of the ``kerfs`` check (module docstring).
 
     Parameters
@@ -156,9 +159,10 @@ def kerf_check(g, making: list, kerf, mm_per_unit: float, cylinder: int) -> tupl
     making : list of MakingPath
     kerf : Kerf
     mm_per_unit : float
-    cylinder : int
-        The certificate's code of the cylinder patch kind.
+    kinds : (cone, cylinder, face, fillet) int
+        The certificate's patch kind codes.
     """
+    cylinder = kinds[1]
     turn = kerf.turn_max()
     land = (kerf.width_mm + kerf.land_mm) / mm_per_unit
     grooves: dict[int, list] = {}
@@ -207,12 +211,85 @@ def kerf_check(g, making: list, kerf, mm_per_unit: float, cylinder: int) -> tupl
             if not ok:
                 bad += 1
                 where = where or f"cylinder {e}"
+    cones, cone_grooves, cone_bad, cone_where = _cone_kerfs(g, pattern, making, turn, land)
+    where = where or cone_where
     detail = (
-        f"{len(edges)} cylinders, {n_grooves} grooves (each turning at most "
-        f"{np.degrees(turn):.4g} deg, at least {land:.6g} apart in mesh units): {bad} "
-        "cylinder part(s) not grooved as they bend"
+        f"{len(edges)} cylinders, {n_grooves} grooves; {cones} cone fans, {cone_grooves} "
+        f"grooves (each turning at most {np.degrees(turn):.4g} deg, at least {land:.6g} "
+        f"apart in mesh units): {bad} cylinder part(s) and {cone_bad} cone part(s) not "
+        "grooved as they bend"
     )
+    bad += cone_bad
     return bad == 0, float(bad), detail, ({"patch": where} if where else {})
+
+
+def _cone_kerfs(g, pattern, making: list, turn_max: float, land: float) -> tuple:
+    """``(cone parts, grooves, parts failing, first failing patch)`` of the cones: in every
+    part of a cone (a fan about its apex, :func:`~filletfold.layout.making.cone_fans`) the
+    grooves are rays from the apex, outside its reliefs, at least ``land`` apart at their
+    inner ends, and as many as its turn outside the reliefs needs (``ceil(T / turn_max)``);
+    every groove of a cone lies on a ray of one of its fans."""
+    from .layout.making import cone_fans, outside_turn
+
+    tol = POSITION_RTOL * g.size + 4 * g.q
+    reliefs: dict = {}
+    grooves: dict = {}
+    for m in making:
+        if m.kind == "relief":
+            reliefs.setdefault(m.patch, []).append(shapely.Polygon(m.points))
+        elif m.patch.startswith("cone "):
+            grooves.setdefault(m.patch, []).append(m)
+    fans = cone_fans(pattern, g.apex)
+    bad, where, count = 0, None, 0
+    placed: dict = {}
+    for fan in fans:
+        patch, c2 = f"cone {fan.vertex}", fan.apex_2d
+        hole = shapely.union_all(reliefs.get(patch, []))
+        outside = float(outside_turn(fan, hole.buffer(tol), g.size).sum())
+        need = math.ceil(outside / turn_max - 1e-9) if outside > 1e-12 else 0
+        part = fan.part.buffer(tol)
+        mine = [
+            m
+            for m in grooves.get(patch, [])
+            if _on_ray(m.points, c2, tol) and part.covers(shapely.LineString(m.points))
+        ]
+        placed[patch] = placed.get(patch, 0) + len(mine)
+        count += len(mine)
+        inner: dict = {}
+        for m in mine:
+            a = round(_angle(m.points, c2), 9)
+            r = float(np.linalg.norm(m.points - c2, axis=1).min())
+            inner[a] = min(inner.get(a, np.inf), r)
+        ok = len(inner) >= need
+        shrunk = hole.buffer(-2 * tol)
+        ok &= not any(shrunk.intersects(shapely.LineString(m.points)) for m in mine)
+        keys = sorted(inner)
+        for a, b in itertools.pairwise(keys):
+            if 2 * min(inner[a], inner[b]) * math.sin(0.5 * (b - a)) < land * (1 - 1e-6) - tol:
+                ok = False
+        if not ok:
+            bad += 1
+            where = where or patch
+    for patch, lines in grooves.items():  # a groove on no fan: not along the cone's rulings
+        if placed.get(patch, 0) < len(lines):
+            bad += 1
+            where = where or patch
+    return len(fans), count, bad, where
+
+
+def _on_ray(points: np.ndarray, c2: np.ndarray, tol: float) -> bool:
+    """Whether a groove's centre line lies on a ray from ``c2``."""
+    d = points[-1] - points[0]
+    n = np.linalg.norm(d)
+    if n == 0:
+        return False
+    r = points[0] - c2
+    return abs(d[0] * r[1] - d[1] * r[0]) / n <= max(tol, 1e-9 * np.linalg.norm(r))
+
+
+def _angle(points: np.ndarray, c2: np.ndarray) -> float:
+    far = points[np.argmax(np.linalg.norm(points - c2, axis=1))] - c2
+    return math.atan2(far[1], far[0])
 
 
 def _parts(g, faces: np.ndarray) -> list:

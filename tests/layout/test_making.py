@@ -168,3 +168,30 @@ def test_no_making_without_a_material():
     assert design.pattern.annotations.making == []
     assert {"relief", "kerfs"}.isdisjoint(_checks(design))
     assert isinstance(MakingPath("relief", "cone 0", np.zeros((3, 2)), True), MakingPath)
+
+
+def test_plywood_cones_are_grooved_along_their_rulings(ply):
+    """The cube's corner cones in plywood: grooves are rays from each cone's apex, outside its
+    relief, as many as its turn needs, at least the land apart; one turned off its ray, or
+    one removed, fails the check."""
+    from filletfold.layout.making import cone_fans
+
+    kerf = MATERIALS["plywood-3mm"].kerf
+    making = list(ply.pattern.annotations.making)
+    fans = cone_fans(ply.pattern, ply.vertices.apex)
+    assert len(fans) == 8
+    for fan in fans:
+        rays = [m for m in making if m.patch == f"cone {fan.vertex}" and m.kind != "relief"]
+        assert len(rays) >= math.ceil(fan.turn.sum() / kerf.turn_max() - 1e-9) - 1
+        for m in rays:
+            d, r = m.points[-1] - m.points[0], m.points[0] - fan.apex_2d
+            assert abs(d[0] * r[1] - d[1] * r[0]) <= 1e-9 * np.linalg.norm(d) * (
+                1 + np.linalg.norm(r)
+            )  # on a ray from the apex
+    assert _checks(ply)["kerfs"].ok
+    k = next(i for i, m in enumerate(making) if m.patch.startswith("cone ") and m.kind != "relief")
+    g = making[k]
+    off = dataclasses.replace(g, points=g.points + np.array([0.0, 0.05 * np.ptp(g.points)]))
+    assert not _checks(_with_making(ply, [*making[:k], off, *making[k + 1 :]]))["kerfs"].ok
+    fewer = [m for m in making if not (m.patch == g.patch and m.kind == g.kind)]
+    assert not _checks(_with_making(ply, fewer))["kerfs"].ok

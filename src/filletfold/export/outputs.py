@@ -184,9 +184,9 @@ _MAKING_WHY = {
         "sharp corner would bend tighter than the floor, the sheet is cut away (layer RELIEF)"
     ),
     "kerf": (
-        "every cylinder grooved along its rulings on its inner side (layers KERF_FRONT, "
-        "KERF_BACK), the grooves' turns adding up to its bend; the cones' tips and the "
-        "tapering fillets' corners relieved (RELIEF)"
+        "every cylinder and cone grooved along its rulings on its inner side (layers "
+        "KERF_FRONT, KERF_BACK), the grooves' turns adding up to its bend; the cones' tips, "
+        "the cones too tight to groove and the tapering fillets' corners relieved (RELIEF)"
     ),
 }
 
@@ -206,7 +206,8 @@ def _making_report(design, material) -> dict:
         "relieved_fillets": len({m.patch for m in reliefs if m.patch.startswith("fillet ")}),
         "grooves_front": sum(m.kind == "kerf-front" for m in grooves),
         "grooves_back": sum(m.kind == "kerf-back" for m in grooves),
-        "grooved_cylinders": len({m.patch for m in grooves}),
+        "grooved_cylinders": len({m.patch for m in grooves if m.patch.startswith("cylinder ")}),
+        "grooved_cones": len({m.patch for m in grooves if m.patch.startswith("cone ")}),
         "creased_fillets": len((design.fitting or {}).get("creased", ())),
     }
     if material.kerf is not None:
@@ -585,8 +586,8 @@ def _material_lines(design) -> list[str]:
             f"{mk['relieved_fillets']} tapering fillets)"
             + (
                 f", {mk['grooves_front'] + mk['grooves_back']} kerf grooves on "
-                f"{mk['grooved_cylinders']} cylinders ({mk['grooves_front']} front, "
-                f"{mk['grooves_back']} back)"
+                f"{mk['grooved_cylinders']} cylinders and {mk['grooved_cones']} cones "
+                f"({mk['grooves_front']} front, {mk['grooves_back']} back)"
                 if mk["method"] == "kerf"
                 else ""
             )

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import shapely
@@ -36,9 +37,13 @@ from ..surface.pattern import face_arrays
 
 __all__ = [
     "MAKING_KINDS",
+    "Fan",
     "MakingPath",
+    "cone_fans",
+    "cone_kerfs",
     "cylinder_kerfs",
     "making_paths",
+    "outside_turn",
     "patch_indices",
     "relief_cuts",
     "score_layers",
@@ -260,10 +265,186 @@ def cylinder_kerfs(pattern, mesh, rounding, kerf) -> list[MakingPath]:
                 line = shapely.LineString(_apply(m, ends))
                 cut = shape.intersection(line)
                 for g in getattr(cut, "geoms", [cut]):
-                    if isinstance(g, shapely.LineString) and g.length > 0:
+                    if isinstance(g, shapely.LineString) and g.length > 1e-9 * pad:
                         out.append(
                             MakingPath(kind, f"cylinder {edge}", np.asarray(g.coords), False)
                         )
+    return out
+
+
+def cone_fans(pattern, apex: np.ndarray) -> list:
+    """Every cone's parts as fans about their apex: per part (a cone may lie in several pieces
+    and places), ``(vertex, apex_2d, psi, turn, valley)``: ``psi`` the developed angles of its
+    rulings about the apex, increasing (the sides between its faces, and its two ends),
+    ``turn`` (len(psi) - 1,) the turn of the surface's normal over each face's angle, spread
+    evenly over it (a faceted cone turns at its rulings; half of each ruling's turn is given
+    to each face beside it), and ``valley`` whether the cone bends toward the front (the sum
+    of its signed turns, FOLD's sign)."""
+    cone = patch_indices(pattern.face_patch, "cone")
+    v2, v3 = pattern.vertices_2d, pattern.vertices_3d
+    apex = np.asarray(apex, dtype=np.float64)
+    out = []
+    for vertex in np.unique(cone[cone >= 0]).tolist():
+        if not np.isfinite(apex[vertex]).all():
+            continue
+        faces = np.flatnonzero(cone == vertex)
+        for part, idx in _parts(pattern, faces):
+            c2 = v2[idx[np.argmin(np.linalg.norm(v3[idx] - apex[vertex], axis=1))]]
+            rows = []  # (angle from, angle to, normal) per face of the part
+            for f in faces.tolist():
+                corners = np.asarray(pattern.faces[f])
+                if not part.buffer(1e-9 * (1 + part.length)).covers(
+                    shapely.Point(v2[corners].mean(axis=0))
+                ):
+                    continue
+                rel = v2[corners] - c2
+                far = np.linalg.norm(rel, axis=1) > 1e-12 * (1 + np.abs(c2).max())
+                if far.sum() < 2:
+                    continue
+                ang = np.arctan2(rel[far, 1], rel[far, 0])
+                p3 = v3[corners]
+                n = np.cross(p3[1] - p3[0], p3[2] - p3[0])
+                for k in range(3, len(p3)):
+                    n = n + np.cross(p3[k - 1] - p3[0], p3[k] - p3[0])
+                rows.append((ang, n / max(np.linalg.norm(n), 1e-300)))
+            if len(rows) < 2:
+                continue
+            # angles from the start of the fan: just past the widest gap between its rulings
+            # (a cut module's wedge opening), so that no face straddles the branch cut
+            every = np.sort(np.concatenate([ang for ang, _ in rows]) % (2 * math.pi))
+            gaps = np.diff(np.r_[every, every[0] + 2 * math.pi])
+            ref = every[(int(np.argmax(gaps)) + 1) % len(every)]
+            spans = []
+            for ang, n in rows:
+                a = (ang - ref) % (2 * math.pi)
+                a = np.where(a > 2 * math.pi - 1e-12, 0.0, a)  # the first ruling itself
+                spans.append((a.min() + ref, a.max() + ref, n))
+            spans.sort(key=lambda t: t[0] + t[1])
+            lo = np.array([t[0] for t in spans])
+            hi = np.array([t[1] for t in spans])
+            normals = np.array([t[2] for t in spans])
+            cos = np.clip(np.einsum("ij,ij->i", normals[:-1], normals[1:]), -1.0, 1.0)
+            step = np.arccos(cos)  # at the ruling between faces i and i + 1
+            ruling = np.stack([np.cos(hi[:-1]), np.sin(hi[:-1])], axis=1)  # in 2D
+            sign = np.sign(
+                np.einsum(
+                    "ij,ij->i",
+                    np.cross(normals[:-1], normals[1:]),
+                    _lift(pattern, idx, c2, apex[vertex], ruling),
+                )
+            )
+            turn = np.zeros(len(spans))
+            turn[:-1] += 0.5 * step
+            turn[1:] += 0.5 * step
+            psi = np.r_[lo[0], hi]
+            out.append(Fan(vertex, c2, psi, turn, float((sign * step).sum()) >= 0, part))
+    return out
+
+
+class Fan(NamedTuple):
+    """One part of a cone as a fan about its apex (:func:`cone_fans`)."""
+
+    vertex: int
+    apex_2d: np.ndarray
+    psi: np.ndarray
+    turn: np.ndarray
+    valley: bool
+    part: object
+
+
+def outside_turn(fan: Fan, hole, size: float) -> np.ndarray:
+    """(len(fan.turn),) the turn of each face span of ``fan`` that the relief ``hole`` (a
+    shapely geometry) does not wholly cover (0 where it does: a relieved face needs no
+    groove)."""
+    out = np.zeros(len(fan.turn))
+    for j in range(len(fan.turn)):
+        arc = np.linspace(fan.psi[j], fan.psi[j + 1], 4)
+        wedge = shapely.Polygon(
+            [fan.apex_2d, *(fan.apex_2d + 4 * size * np.stack([np.cos(arc), np.sin(arc)], axis=1))]
+        )
+        if not hole.covers(fan.part.intersection(wedge)):
+            out[j] = fan.turn[j]
+    return out
+
+
+def _lift(pattern, idx, c2, apex3, dirs2):
+    """3D directions from the apex of the 2D directions ``dirs2`` (k, 2) about ``c2``: the
+    pattern's isometry of the cone's fan, fitted on its points ``idx``."""
+    v2, v3 = pattern.vertices_2d[idx] - c2, pattern.vertices_3d[idx] - apex3
+    # the linear map taking the developed fan onto the folded cone near each ruling is not
+    # one map; the ruling's own 3D direction is that of its points: the nearest point of the
+    # fan in angle, far from the apex
+    ang = np.arctan2(v2[:, 1], v2[:, 0])
+    far = np.linalg.norm(v2, axis=1) > 1e-12
+    out = np.zeros((len(dirs2), 3))
+    for k, d in enumerate(dirs2):
+        a = math.atan2(d[1], d[0])
+        gap = np.abs(np.angle(np.exp(1j * (ang - a))))
+        gap[~far] = np.inf
+        j = int(np.argmin(gap))
+        out[k] = v3[j] / max(np.linalg.norm(v3[j]), 1e-300)
+    return out
+
+
+def cone_kerfs(pattern, apex: np.ndarray, kerf, land: float, reliefs: list) -> list[MakingPath]:
+    """The kerf grooves of every cone: rays from its apex along its rulings, ``n =
+    ceil(T / turn_max)`` of them for a cone part turning by ``T``, at the developed angles
+    where its normal has turned by ``(j + 1/2) T / n`` (each groove takes ``T / n``), on the
+    cone's inner side, from the circle of its relief (or the apex) -- or farther, where two
+    grooves ``d psi`` apart are ``land`` (pattern units: the groove's width and land) apart --
+    to its border. A cone part too tight for that (a groove that would have nothing left) is
+    relieved whole instead: the material cannot bend it.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    apex : (n_vertices, 3) float
+    kerf : Kerf
+    land : float
+        The least distance between two grooves' centre lines (pattern units).
+    reliefs : list of MakingPath
+        The reliefs, whose cones' grooves start outside them.
+    """
+    out: list[MakingPath] = []
+    turn_max = kerf.turn_max()
+    holes: dict = {}
+    for m in reliefs:
+        if m.kind == "relief":
+            holes.setdefault(m.patch, []).append(shapely.Polygon(m.points))
+    size = float(np.ptp(pattern.vertices_2d, axis=0).max()) if len(pattern.vertices_2d) else 1.0
+    for fan in cone_fans(pattern, apex):
+        c2 = fan.apex_2d
+        hole = shapely.union_all(holes.get(f"cone {fan.vertex}", []))
+        turn = outside_turn(fan, hole, size)  # the relieved spans take no groove
+        total = float(turn.sum())
+        if not total > 0:
+            continue
+        n = max(1, math.ceil(total / turn_max - 1e-9))
+        cum = np.r_[0.0, np.cumsum(turn)]
+        at = np.interp((np.arange(n) + 0.5) * total / n, cum, fan.psi)
+        gaps = np.diff(at)
+        start = land / (2 * np.sin(0.5 * gaps.min())) if len(gaps) and gaps.min() > 0 else 0.0
+        reach = 2.0 * float(np.abs(shapely.get_coordinates(fan.part) - c2).max()) + 1.0
+        kind = "kerf-front" if fan.valley else "kerf-back"
+        grooves = []
+        for a in at.tolist():
+            d = np.array([math.cos(a), math.sin(a)])
+            ray = shapely.LineString([c2 + start * d, c2 + reach * d])
+            cut = fan.part.intersection(ray).difference(hole)
+            found = [
+                g
+                for g in getattr(cut, "geoms", [cut])
+                if isinstance(g, shapely.LineString) and g.length > 1e-9 * reach
+            ]
+            if not found:  # the cone is too tight there for grooves a land apart
+                grooves = None
+                break
+            grooves += [MakingPath(kind, f"cone {fan.vertex}", np.asarray(g.coords), False)
+                        for g in found]  # fmt: skip
+        if grooves is None:  # it cannot be grooved as it bends: relieved whole
+            out += _outlines("relief", f"cone {fan.vertex}", fan.part.difference(hole))
+        else:
+            out += grooves
     return out
 
 
@@ -291,6 +472,9 @@ def making_paths(pattern, design_mesh, rounding, apex, material, mm_per_unit: fl
     floor = material.bend_floor_mm() / mm_per_unit
     least = material.thickness_mm / mm_per_unit
     out = relief_cuts(pattern, apex, floor, least, design_mesh, rounding)
-    if material.making == "kerf" and material.kerf is not None:
-        out += cylinder_kerfs(pattern, design_mesh, rounding, material.kerf)
+    kerf = material.kerf
+    if material.making == "kerf" and kerf is not None:
+        land = (kerf.width_mm + kerf.land_mm) / mm_per_unit
+        out += cylinder_kerfs(pattern, design_mesh, rounding, kerf)
+        out += cone_kerfs(pattern, apex, kerf, land, list(out))
     return out
