@@ -256,8 +256,8 @@ def _cone_kerfs(g, pattern, making: list, turn_max: float, land: float) -> tuple
         placed[patch] = placed.get(patch, 0) + len(mine)
         count += len(mine)
         inner: dict = {}
-        for m in mine:
-            a = round(_angle(m.points, c2), 9)
+        for m in mine:  # angles from the fan's first ruling: neighbours never across its cut
+            a = round((_angle(m.points, c2) - float(fan.psi[0])) % (2 * math.pi), 9)
             r = float(np.linalg.norm(m.points - c2, axis=1).min())
             inner[a] = min(inner.get(a, np.inf), r)
         ok = len(inner) >= need

@@ -319,13 +319,22 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
                 a = (ang - ref) % (2 * math.pi)
                 a = np.where(a > 2 * math.pi - 1e-12, 0.0, a)  # the first ruling itself
                 spans.append((a.min() + ref, a.max() + ref, n))
-            spans.sort(key=lambda t: t[0] + t[1])
+            # the fan's rulings: every face's two bounding angles; between two neighbouring
+            # ones the surface is one face's (a cone's faces may also be split across its
+            # rulings, near the apex and beyond: any face over the interval gives its normal)
             lo = np.array([t[0] for t in spans])
             hi = np.array([t[1] for t in spans])
-            normals = np.array([t[2] for t in spans])
+            bounds = np.unique(np.round(np.r_[lo, hi], 12))
+            mids = 0.5 * (bounds[:-1] + bounds[1:])
+            cover = (lo[None, :] <= mids[:, None]) & (mids[:, None] <= hi[None, :])
+            has = cover.any(axis=1)
+            if has.sum() < 2:
+                continue
+            normals = np.array([t[2] for t in spans])[np.argmax(cover, axis=1)][has]
+            psi = np.r_[bounds[:-1][has][0], bounds[1:][has]]
             cos = np.clip(np.einsum("ij,ij->i", normals[:-1], normals[1:]), -1.0, 1.0)
-            step = np.arccos(cos)  # at the ruling between faces i and i + 1
-            ruling = np.stack([np.cos(hi[:-1]), np.sin(hi[:-1])], axis=1)  # in 2D
+            step = np.arccos(cos)  # at the ruling between intervals i and i + 1
+            ruling = np.stack([np.cos(psi[1:-1]), np.sin(psi[1:-1])], axis=1)  # in 2D
             sign = np.sign(
                 np.einsum(
                     "ij,ij->i",
@@ -333,10 +342,9 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
                     _lift(pattern, idx, c2, apex[vertex], ruling),
                 )
             )
-            turn = np.zeros(len(spans))
+            turn = np.zeros(len(normals))
             turn[:-1] += 0.5 * step
             turn[1:] += 0.5 * step
-            psi = np.r_[lo[0], hi]
             out.append(Fan(vertex, c2, psi, turn, float((sign * step).sum()) >= 0, part))
     return out
 
