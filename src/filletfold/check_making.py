@@ -28,6 +28,7 @@ import math
 import numpy as np
 import shapely
 
+from .layout.making import cone_fans, fillet_ends, outside_turn, relief_polygons
 from .surface.bend import cone_rulings
 from .surface.faces import face_polygons
 
@@ -45,9 +46,7 @@ def _patch_faces(g, kind: int, index: int) -> np.ndarray:
     return np.flatnonzero((g.kind == kind) & (g.index == index))
 
 
-def _union(g, faces: np.ndarray, piece: int | None = None):
-    if piece is not None:
-        faces = faces[g.piece[faces] == piece]
+def _union(g, faces: np.ndarray):
     if not len(faces):
         return shapely.Polygon()
     lists = [g.flat[g.start[f] : g.start[f + 1]] for f in faces.tolist()]
@@ -68,10 +67,7 @@ def relief_check(g, making: list, floor: float, kinds) -> tuple:
     """
     cone_k, _, _, fillet_k = kinds
     tol = POSITION_RTOL * g.size + 4 * g.q
-    reliefs: dict[str, list] = {}
-    for m in making:
-        if m.kind == "relief" and len(m.points) >= 3:
-            reliefs.setdefault(m.patch, []).append(shapely.Polygon(m.points))
+    reliefs = relief_polygons(making)
     covers = {p: shapely.union_all(polys).buffer(tol) for p, polys in reliefs.items()}
     bad, where = 0, None
     # cones: the stretch of every ruling tighter than the floor
@@ -99,11 +95,7 @@ def relief_check(g, making: list, floor: float, kinds) -> tuple:
     for e in np.unique(g.index[g.kind == fillet_k]).tolist():
         faces = _patch_faces(g, fillet_k, e)
         idx = np.unique(np.concatenate([g.flat[g.start[f] : g.start[f + 1]] for f in faces]))
-        a, b = g.edge_vertices[e]
-        ends = g.mv[[a, b]]
-        d = np.linalg.norm(g.v3[idx][:, None, :] - ends[None], axis=2)
-        tip = int(np.argmin(d.min(axis=0)))
-        s_end, other = ends[tip], ends[1 - tip]
+        s_end, other = fillet_ends(g.mv[g.edge_vertices[e]], g.v3[idx])
         length = float(np.linalg.norm(other - s_end))
         if not (length > 0 and g.radius[e] > 0):
             continue
@@ -229,15 +221,11 @@ def _cone_kerfs(g, pattern, making: list, turn_max: float, land: float) -> tuple
     grooves are rays from the apex, outside its reliefs, at least ``land`` apart at their
     inner ends, and as many as its turn outside the reliefs needs (``ceil(T / turn_max)``);
     every groove of a cone lies on a ray of one of its fans."""
-    from .layout.making import cone_fans, outside_turn
-
     tol = POSITION_RTOL * g.size + 4 * g.q
-    reliefs: dict = {}
+    reliefs = relief_polygons(making)
     grooves: dict = {}
     for m in making:
-        if m.kind == "relief":
-            reliefs.setdefault(m.patch, []).append(shapely.Polygon(m.points))
-        elif m.patch.startswith("cone "):
+        if m.kind != "relief" and m.patch.startswith("cone "):
             grooves.setdefault(m.patch, []).append(m)
     fans = cone_fans(pattern, g.apex)
     bad, where, count = 0, None, 0

@@ -31,9 +31,9 @@ from typing import NamedTuple
 import numpy as np
 import shapely
 
-from ..surface.bend import cone_bend_radii
+from ..surface.bend import cone_tip_zones
 from ..surface.faces import face_polygons
-from ..surface.pattern import face_arrays
+from ..surface.patch import kind_indices
 
 __all__ = [
     "MAKING_KINDS",
@@ -42,10 +42,11 @@ __all__ = [
     "cone_fans",
     "cone_kerfs",
     "cylinder_kerfs",
+    "fillet_ends",
     "making_paths",
     "outside_turn",
-    "patch_indices",
     "relief_cuts",
+    "relief_polygons",
     "score_layers",
 ]
 
@@ -84,16 +85,6 @@ def score_layers(making: str) -> dict[str, str] | None:
     if making != "score":
         return None
     return {"mountain": "SCORE_FRONT", "valley": "SCORE_BACK"}
-
-
-def patch_indices(face_patch, kind: str) -> np.ndarray:
-    """(n_faces,) int: the index of each face's patch of ``kind`` (``"cone"``, ...), -1 for
-    the faces of other patches."""
-    prefix = kind + " "
-    return np.array(
-        [int(str(p)[len(prefix) :]) if str(p).startswith(prefix) else -1 for p in face_patch],
-        dtype=np.int64,
-    )
 
 
 def _components(pattern, faces: np.ndarray) -> list:
@@ -142,13 +133,31 @@ def _outlines(kind: str, patch: str, shape) -> list[MakingPath]:
     return out
 
 
+def fillet_ends(ends: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sharp end, other end)`` of a tapering fillet's edge, its ``ends`` (2, 3): the one
+    that is a point of the fillet (its ``points`` (k, 3), folded), where it narrows to 0."""
+    d = np.linalg.norm(points[:, None, :] - ends[None], axis=2)  # (k, 2)
+    tip = int(np.argmin(d.min(axis=0)))
+    return ends[tip], ends[1 - tip]
+
+
+def relief_polygons(making: list) -> dict:
+    """The reliefs of ``making`` (:class:`MakingPath`) as shapely polygons, by patch name."""
+    out: dict = {}
+    for m in making:
+        if m.kind == "relief" and len(m.points) >= 3:
+            out.setdefault(m.patch, []).append(shapely.Polygon(m.points))
+    return out
+
+
 def relief_cuts(
     pattern, apex: np.ndarray, floor: float, least: float, mesh, rounding
 ) -> list[MakingPath]:
     """The reliefs of a design: where the sheet bends tighter than ``floor`` (pattern units).
 
     * A **cone** bends tighter than the floor within ``floor / rate`` of its apex along each
-      ruling (:func:`~filletfold.surface.bend.cone_bend_radii`): its relief is the circle
+      ruling (its tip zone, :func:`~filletfold.surface.bend.cone_tip_zones`): its relief is
+      the circle
       about the apex (in the pattern) of the largest such distance, at least ``least``
       across in radius (a relief narrower than the sheet is thick cannot be cut), clipped to
       the cone's faces (nothing else is cut).
@@ -174,28 +183,20 @@ def relief_cuts(
     list of MakingPath
     """
     out: list[MakingPath] = []
-    flat, start = face_arrays(pattern.faces)
     v2, v3 = pattern.vertices_2d, pattern.vertices_3d
     apex = np.asarray(apex, dtype=np.float64)
-    cone = patch_indices(pattern.face_patch, "cone")
-    radius, u, rate = cone_bend_radii(v3, flat, start, cone, np.where(np.isfinite(apex), apex, 0))
-    tight = radius < floor
-    reach = np.zeros(len(apex))
-    np.maximum.at(reach, u[tight], floor / rate[tight])
+    cone = kind_indices(pattern.face_patch, "cone")
+    reach = np.nan_to_num(cone_tip_zones(pattern, apex, floor))  # 0: no cone, or never tight
     for vertex in np.flatnonzero(reach > 0).tolist():
         for part, idx in _parts(pattern, np.flatnonzero(cone == vertex)):
             near = idx[np.argmin(np.linalg.norm(v3[idx] - apex[vertex], axis=1))]
             disc = _circle(v2[near], max(float(reach[vertex]), least))
             out += _outlines("relief", f"cone {vertex}", part.intersection(disc))
-    fillet = patch_indices(pattern.face_patch, "fillet")
+    fillet = kind_indices(pattern.face_patch, "fillet")
     for edge in np.unique(fillet[fillet >= 0]).tolist():
         faces = np.flatnonzero(fillet == edge)
         idx = np.unique(np.concatenate([pattern.faces[f] for f in faces.tolist()]))
-        a, b = mesh.edges[edge]
-        ends = mesh.vertices[[a, b]]
-        d = np.linalg.norm(v3[idx][:, None, :] - ends[None], axis=2)  # (k, 2)
-        tip = int(np.argmin(d.min(axis=0)))  # the sharp end: a point of the fillet
-        s_end, other = ends[tip], ends[1 - tip]
+        s_end, other = fillet_ends(mesh.vertices[mesh.edges[edge]], v3[idx])
         length = float(np.linalg.norm(other - s_end))
         axis = (other - s_end) / length
         x = (v3[idx] - s_end) @ axis  # distance along the edge from S
@@ -233,7 +234,7 @@ def cylinder_kerfs(pattern, mesh, rounding, kerf) -> list[MakingPath]:
         centre lines; the certificate holds their spacing to its width and land).
     """
     out: list[MakingPath] = []
-    cyl = patch_indices(pattern.face_patch, "cylinder")
+    cyl = kind_indices(pattern.face_patch, "cylinder")
     v2, v3 = pattern.vertices_2d, pattern.vertices_3d
     turn = kerf.turn_max()
     for edge in np.unique(cyl[cyl >= 0]).tolist():
@@ -274,13 +275,13 @@ def cylinder_kerfs(pattern, mesh, rounding, kerf) -> list[MakingPath]:
 
 def cone_fans(pattern, apex: np.ndarray) -> list:
     """Every cone's parts as fans about their apex: per part (a cone may lie in several pieces
-    and places), ``(vertex, apex_2d, psi, turn, valley)``: ``psi`` the developed angles of its
-    rulings about the apex, increasing (the sides between its faces, and its two ends),
-    ``turn`` (len(psi) - 1,) the turn of the surface's normal over each face's angle, spread
-    evenly over it (a faceted cone turns at its rulings; half of each ruling's turn is given
-    to each face beside it), and ``valley`` whether the cone bends toward the front (the sum
-    of its signed turns, FOLD's sign)."""
-    cone = patch_indices(pattern.face_patch, "cone")
+    and places), a :class:`Fan`: ``psi`` the developed angles of its rulings about the apex,
+    increasing (the rulings that bound its faces, and its two ends), ``turn`` (len(psi) - 1,)
+    the turn of the surface's normal over each interval between two rulings (a faceted cone
+    turns at its rulings; half of each ruling's turn is given to each interval beside it),
+    ``valley`` whether the cone bends toward the front (the sum of its signed turns, FOLD's
+    sign), and ``part`` the part's polygon."""
+    cone = kind_indices(pattern.face_patch, "cone")
     v2, v3 = pattern.vertices_2d, pattern.vertices_3d
     apex = np.asarray(apex, dtype=np.float64)
     out = []
@@ -290,7 +291,7 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
         faces = np.flatnonzero(cone == vertex)
         for part, idx in _parts(pattern, faces):
             c2 = v2[idx[np.argmin(np.linalg.norm(v3[idx] - apex[vertex], axis=1))]]
-            rows = []  # (angle from, angle to, normal) per face of the part
+            rows = []  # (angles of its corners, normal) per face of the part
             for f in faces.tolist():
                 corners = np.asarray(pattern.faces[f])
                 if not part.buffer(1e-9 * (1 + part.length)).covers(
@@ -301,12 +302,13 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
                 far = np.linalg.norm(rel, axis=1) > 1e-12 * (1 + np.abs(c2).max())
                 if far.sum() < 2:
                     continue
-                ang = np.arctan2(rel[far, 1], rel[far, 0])
                 p3 = v3[corners]
                 n = np.cross(p3[1] - p3[0], p3[2] - p3[0])
                 for k in range(3, len(p3)):
                     n = n + np.cross(p3[k - 1] - p3[0], p3[k] - p3[0])
-                rows.append((ang, n / max(np.linalg.norm(n), 1e-300)))
+                rows.append(
+                    (np.arctan2(rel[far, 1], rel[far, 0]), n / max(np.linalg.norm(n), 1e-300))
+                )
             if len(rows) < 2:
                 continue
             # angles from the start of the fan: just past the widest gap between its rulings
@@ -415,10 +417,7 @@ def cone_kerfs(pattern, apex: np.ndarray, kerf, land: float, reliefs: list) -> l
     """
     out: list[MakingPath] = []
     turn_max = kerf.turn_max()
-    holes: dict = {}
-    for m in reliefs:
-        if m.kind == "relief":
-            holes.setdefault(m.patch, []).append(shapely.Polygon(m.points))
+    holes = relief_polygons(reliefs)
     size = float(np.ptp(pattern.vertices_2d, axis=0).max()) if len(pattern.vertices_2d) else 1.0
     for fan in cone_fans(pattern, apex):
         c2 = fan.apex_2d

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..arrays import run_next, run_owners
 from ..mesh.measures import newell_vectors
+from .patch import kind_indices
 
 __all__ = ["ConeRulings", "cone_bend_radii", "cone_rulings", "cone_tip_zones"]
 
@@ -133,13 +134,7 @@ def cone_tip_zones(pattern, apex: np.ndarray, floor: float) -> np.ndarray:
     from .pattern import face_arrays
 
     flat, start = face_arrays(pattern.faces)
-    cone = np.array(
-        [
-            int(str(p).split(" ")[1]) if str(p).startswith("cone ") else -1
-            for p in pattern.face_patch
-        ],
-        dtype=np.int64,
-    )
+    cone = kind_indices(pattern.face_patch, "cone")
     apex = np.asarray(apex, dtype=np.float64)
     out = np.full(len(apex), np.nan)
     out[np.unique(cone[cone >= 0])] = 0.0

@@ -5,8 +5,8 @@ a mesh edge, the conical fillet of an edge beside a sharp vertex, the cone of a 
 the flat piece of a mesh face. :class:`Patch` is that record, ``(kind, index)``, and pieces and
 patterns keep one per face. Its name, ``str(patch)`` (``"cone 3"``, ``"cylinder 12"``), is what
 files carry (FOLD's ``filletfold:faces_patch``, OBJ groups, 3dm objects); :func:`as_patch` reads
-a name back. :func:`patch_kinds`, :func:`patch_indices` and :func:`patch_ids` give a whole
-pattern's faces at once.
+a name back. :func:`patch_kinds`, :func:`patch_indices`, :func:`kind_indices` and :func:`patch_ids`
+give a whole pattern's faces at once.
 """
 
 from __future__ import annotations
@@ -80,6 +80,14 @@ def patch_indices(patches) -> np.ndarray:
         parts = str(p).split()
         index[p] = int(parts[1]) if len(parts) == 2 and parts[1].isdigit() else -1
     return np.fromiter((index[p] for p in patches), dtype=np.int64, count=len(patches))
+
+
+def kind_indices(patches, kind: str) -> np.ndarray:
+    """(n,) int64: the element index of each of ``patches`` of ``kind`` (``"cone"``, ...), -1
+    for the others."""
+    if not len(patches):
+        return np.zeros(0, dtype=np.int64)
+    return np.where(patch_kinds(patches) == kind, patch_indices(patches), -1)
 
 
 def patch_ids(patches) -> np.ndarray:
