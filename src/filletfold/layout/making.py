@@ -31,9 +31,12 @@ from typing import NamedTuple
 import numpy as np
 import shapely
 
+from ..arrays import run_next
+from ..mesh.measures import newell_vectors
 from ..surface.bend import cone_tip_zones
 from ..surface.faces import face_polygons
 from ..surface.patch import kind_indices
+from ..surface.pattern import face_arrays
 
 __all__ = [
     "MAKING_KINDS",
@@ -284,6 +287,9 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
     cone = kind_indices(pattern.face_patch, "cone")
     v2, v3 = pattern.vertices_2d, pattern.vertices_3d
     apex = np.asarray(apex, dtype=np.float64)
+    flat, start = face_arrays(pattern.faces)
+    normal = newell_vectors(v3[flat], start, run_next(start))  # every face's front normal
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
     out = []
     for vertex in np.unique(cone[cone >= 0]).tolist():
         if not np.isfinite(apex[vertex]).all():
@@ -302,13 +308,7 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
                 far = np.linalg.norm(rel, axis=1) > 1e-12 * (1 + np.abs(c2).max())
                 if far.sum() < 2:
                     continue
-                p3 = v3[corners]
-                n = np.cross(p3[1] - p3[0], p3[2] - p3[0])
-                for k in range(3, len(p3)):
-                    n = n + np.cross(p3[k - 1] - p3[0], p3[k] - p3[0])
-                rows.append(
-                    (np.arctan2(rel[far, 1], rel[far, 0]), n / max(np.linalg.norm(n), 1e-300))
-                )
+                rows.append((np.arctan2(rel[far, 1], rel[far, 0]), normal[f]))
             if len(rows) < 2:
                 continue
             # angles from the start of the fan: just past the widest gap between its rulings
@@ -334,13 +334,17 @@ def cone_fans(pattern, apex: np.ndarray) -> list:
                 continue
             normals = np.array([t[2] for t in spans])[np.argmax(cover, axis=1)][has]
             psi = np.r_[bounds[:-1][has][0], bounds[1:][has]]
-            cos = np.clip(np.einsum("ij,ij->i", normals[:-1], normals[1:]), -1.0, 1.0)
-            step = np.arccos(cos)  # at the ruling between intervals i and i + 1
+            cross = np.cross(normals[:-1], normals[1:])
+            # at the ruling between intervals i and i + 1; atan2, not arccos of the dot product,
+            # which turned two parallel normals by 1e-8 (a flat cone got a groove)
+            step = np.arctan2(
+                np.linalg.norm(cross, axis=1), np.einsum("ij,ij->i", normals[:-1], normals[1:])
+            )
             ruling = np.stack([np.cos(psi[1:-1]), np.sin(psi[1:-1])], axis=1)  # in 2D
             sign = np.sign(
                 np.einsum(
                     "ij,ij->i",
-                    np.cross(normals[:-1], normals[1:]),
+                    cross,
                     _lift(pattern, idx, c2, apex[vertex], ruling),
                 )
             )
