@@ -56,6 +56,12 @@ def face_piece_centres(
     u /= np.linalg.norm(u, axis=1)[:, None]
     n = mesh.face_normal[face_of]
     base = p + half[mesh.halfedge_edge][:, None] * np.cross(n, u)  # a point of each tangent line
+    # face coordinates: origin at the first corner, e1 along the first edge
+    origin = p[start[:-1]]
+    e1 = u[start[:-1]]
+    e2 = np.cross(mesh.face_normal, e1)
+    frame = (start, face_of, nxt, mesh.halfedge_prev, origin, e1, e2)
+    centre, starred = _centres(base, u, frame)
     if sharp is not None:  # conical fillets: the line from the sharp end through the midpoint's
         e = mesh.halfedge_edge
         a, b = sharp[mesh.halfedge_from], sharp[mesh.halfedge_to]
@@ -64,10 +70,30 @@ def face_piece_centres(
             mid = 0.5 * (p[cone] + p[nxt][cone]) + half[e[cone], None] * np.cross(n[cone], u[cone])
             tip = np.where(a[cone, None], p[cone], p[nxt][cone])  # the sharp end
             line = np.where(a[cone, None], mid - tip, tip - mid)  # from the half-edge's start
+            base, u = base.copy(), u.copy()
             base[cone] = mid
             u[cone] = line / np.linalg.norm(line, axis=1)[:, None]
-    # corner of half-edge h: the tangent lines of the previous half-edge and of h cross at T
-    prev = mesh.halfedge_prev
+            coned, ok = _centres(base, u, frame)
+            # where the conical lines leave no point that sees the whole piece, the tangent
+            # lines' centre stays (as before the sharp vertices were known)
+            centre = np.where(ok[:, None], coned, centre)
+            starred |= ok
+    if not starred.all():
+        fi = int(np.flatnonzero(~starred)[0])
+        raise MeshError(
+            f"face {fi} is not star-shaped after rounding: no point of it sees the whole "
+            "face piece; split it into convex polygons or use a smaller radius",
+            face=fi,
+        )
+    return origin + centre[:, :1] * e1 + centre[:, 1:] * e2
+
+
+def _centres(base: np.ndarray, u: np.ndarray, frame) -> tuple[np.ndarray, np.ndarray]:
+    """Each face piece's centre (face coordinates, (n_faces, 2)) for the lines through
+    ``base`` along ``u`` (one per half-edge), and whether it is star-shaped ((n_faces,) bool;
+    where not, the centre is meaningless)."""
+    start, face_of, nxt, prev, origin, e1, e2 = frame
+    # corner of half-edge h: the lines of the previous half-edge and of h cross at T
     delta = base - base[prev]
     cos = np.einsum("ij,ij->i", u[prev], u)
     sin2 = 1 - cos**2
@@ -76,10 +102,6 @@ def face_piece_centres(
         np.where(parallel, 1.0, sin2)
     )
     T = np.where(parallel[:, None], base, base[prev] + z[:, None] * u[prev])
-    # face coordinates: origin at the first corner, e1 along the first edge
-    origin = p[start[:-1]]
-    e1 = u[start[:-1]]
-    e2 = np.cross(mesh.face_normal, e1)
     rel = T - origin[face_of]
     xy = np.stack(
         [np.einsum("ij,ij->i", rel, e1[face_of]), np.einsum("ij,ij->i", rel, e2[face_of])], axis=1
@@ -95,16 +117,12 @@ def face_piece_centres(
     turn = d[:, 0] * d[nxt][:, 1] - d[:, 1] * d[nxt][:, 0]
     convex = (np.minimum.reduceat(turn, start[:-1]) >= 0) & (area > 0)
     centre = np.stack([cx, cy], axis=1)
+    starred = convex.copy()
     for fi in np.nonzero(~convex)[0]:
         c = _kernel_centroid(xy[start[fi] : start[fi + 1]])
-        if c is None:
-            raise MeshError(
-                f"face {fi} is not star-shaped after rounding: no point of it sees the whole "
-                "face piece; split it into convex polygons or use a smaller radius",
-                face=int(fi),
-            )
-        centre[fi] = c
-    return origin + centre[:, :1] * e1 + centre[:, 1:] * e2
+        if c is not None:
+            centre[fi], starred[fi] = c, True
+    return centre, starred
 
 
 def _kernel_centroid(xy: np.ndarray) -> np.ndarray | None:
